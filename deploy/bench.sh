@@ -1,0 +1,8 @@
+#!/usr/bin/env bash
+# Benchmarks (Release, Google Benchmark). Extra arguments go to every benchmark binary,
+# e.g. deploy/bench.sh --benchmark_filter=Floyd
+set -euo pipefail
+cd "$(dirname "$0")/.."
+bash deploy/setup.sh build build-bench -DCMAKE_BUILD_TYPE=Release -DDISPATCH_BUILD_TESTS=OFF \
+  -DDISPATCH_BUILD_BENCHMARKS=ON >/dev/null
+build-bench/tests/benchmarks/routing_bench "$@"
