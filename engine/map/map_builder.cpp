@@ -1,5 +1,6 @@
 #include "engine/map/map_builder.h"
 
+#include <algorithm>
 #include <cmath>
 #include <deque>
 #include <limits>
@@ -26,6 +27,34 @@ double PolygonArea(const std::vector<Eigen::Vector2d>& poly) {
 }
 
 bool Finite(const Eigen::Vector2d& p) { return std::isfinite(p.x()) && std::isfinite(p.y()); }
+
+std::string Num(double v) {
+  std::ostringstream out;
+  out << v;
+  return out.str();
+}
+
+double Cross(const Eigen::Vector2d& o, const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
+  return (a.x() - o.x()) * (b.y() - o.y()) - (a.y() - o.y()) * (b.x() - o.x());
+}
+
+// Proper crossing of segments ab and cd (shared endpoints and touching do not count).
+bool SegmentsCross(const Eigen::Vector2d& a, const Eigen::Vector2d& b, const Eigen::Vector2d& c,
+                   const Eigen::Vector2d& d) {
+  const double d1 = Cross(c, d, a), d2 = Cross(c, d, b), d3 = Cross(a, b, c), d4 = Cross(a, b, d);
+  return ((d1 > 0 && d2 < 0) || (d1 < 0 && d2 > 0)) && ((d3 > 0 && d4 < 0) || (d3 < 0 && d4 > 0));
+}
+
+bool SelfIntersecting(const std::vector<Eigen::Vector2d>& poly) {
+  const std::size_t n = poly.size();
+  for (std::size_t i = 0; i < n; ++i) {
+    for (std::size_t j = i + 2; j < n; ++j) {
+      if (i == 0 && j == n - 1) continue;  // adjacent through the closing edge
+      if (SegmentsCross(poly[i], poly[(i + 1) % n], poly[j], poly[(j + 1) % n])) return true;
+    }
+  }
+  return false;
+}
 
 // Points reachable from `start` following arcs forward (or backward).
 std::vector<char> Reach(const WarehouseMap& map, PointId start, bool forward) {
@@ -107,6 +136,17 @@ Result<WarehouseMap> MapBuilder::Build(const MapBuildOptions& options) const {
     }
     zone.area = PolygonArea(zone.polygon);
     if (!(zone.area > 0)) return InvalidArgument(where + ": area is zero");
+    if (SelfIntersecting(zone.polygon)) {
+      return InvalidArgument(where + ": polygon crosses itself, so its area is undefined");
+    }
+    if (floor_) {
+      for (const auto& v : zone.polygon) {
+        if ((v.array() < floor_->first.array() - 1e-9).any() ||
+            (v.array() > floor_->second.array() + 1e-9).any()) {
+          return InvalidArgument(where + ": vertex " + Fmt(v) + " lies outside the floor");
+        }
+      }
+    }
     if (!map.zone_index_.emplace(zone.name, static_cast<ZoneId>(i)).second) {
       return InvalidArgument(where + ": duplicate zone id");
     }
@@ -201,11 +241,11 @@ Result<WarehouseMap> MapBuilder::Build(const MapBuildOptions& options) const {
     const double length = spec.length.value_or(straight);
     if (!std::isfinite(length) || !(length > 0)) {
       return InvalidArgument(where + ": length must be a positive number of metres, got " +
-                             std::to_string(length));
+                             Num(length));
     }
     if (length < straight - 1e-6) {
-      return InvalidArgument(where + ": length " + std::to_string(length) +
-                             " is shorter than the straight distance " + std::to_string(straight));
+      return InvalidArgument(where + ": length " + Num(length) +
+                             " is shorter than the straight distance " + Num(straight));
     }
     if (!std::isfinite(spec.max_speed) || spec.max_speed < 0) {
       return InvalidArgument(where + ": max_speed must be >= 0 (0 = no limit)");
@@ -240,6 +280,9 @@ Result<WarehouseMap> MapBuilder::Build(const MapBuildOptions& options) const {
       auto p = map.FindPoint(n);
       if (!p) return InvalidArgument(where + ": unknown inner point '" + n + "'");
       int& owner = map.intersection_of_[static_cast<std::size_t>(*p)];
+      if (owner == static_cast<int>(i)) {
+        return InvalidArgument(where + ": inner point '" + n + "' is listed twice");
+      }
       if (owner >= 0) {
         return InvalidArgument(where + ": point '" + n + "' is already inside intersection '" +
                                map.intersections_[static_cast<std::size_t>(owner)].name + "'");
@@ -250,12 +293,23 @@ Result<WarehouseMap> MapBuilder::Build(const MapBuildOptions& options) const {
     for (const std::string& n : spec.approach) {
       auto p = map.FindPoint(n);
       if (!p) return InvalidArgument(where + ": unknown approach point '" + n + "'");
-      if (map.intersection_of_[static_cast<std::size_t>(*p)] == static_cast<int>(i)) {
-        return InvalidArgument(where + ": point '" + n + "' is both inner and approach");
+      if (std::find(inter.approach.begin(), inter.approach.end(), *p) != inter.approach.end()) {
+        return InvalidArgument(where + ": approach point '" + n + "' is listed twice");
       }
       inter.approach.push_back(*p);
     }
     map.intersections_.push_back(std::move(inter));
+  }
+  // Approach points lie outside every inner region (checked once all regions are known).
+  for (const Intersection& inter : map.intersections_) {
+    for (PointId p : inter.approach) {
+      const int owner = map.intersection_of_[static_cast<std::size_t>(p)];
+      if (owner < 0) continue;
+      const std::string& other = map.intersections_[static_cast<std::size_t>(owner)].name;
+      return InvalidArgument("intersection '" + inter.name + "': approach point '" +
+                             map.point(p).name + "' lies inside intersection '" + other + "'" +
+                             (other == inter.name ? " (both inner and approach)" : ""));
+    }
   }
 
   // Stations.
@@ -272,6 +326,12 @@ Result<WarehouseMap> MapBuilder::Build(const MapBuildOptions& options) const {
                              PointKindName(map.point(*p).kind) + " point, not park or charge");
     }
     if (spec.capacity < 1) return InvalidArgument(where + ": capacity must be >= 1");
+    for (const ParkingStation& other : map.stations_) {
+      if (other.point == *p) {
+        return InvalidArgument(where + ": point '" + spec.point + "' already holds station '" +
+                               other.name + "'");
+      }
+    }
     map.stations_.push_back({spec.name, *p, spec.capacity});
   }
 

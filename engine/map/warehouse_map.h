@@ -7,8 +7,10 @@
 //  - every path joins two distinct existing points and has a finite length > 0 that is not
 //    shorter than the straight distance between its ends;
 //  - every point lies inside the zone it names (or in some zone, when it names none);
-//  - every zone has a positive area; intersections name existing points, inner and approach
-//    sets are disjoint and non-empty; stations sit on points of kind park with capacity >= 1;
+//  - every zone is a simple polygon with a positive area inside the floor; intersections name
+//    existing points, each at most once; no point is inner to two intersections, and approach
+//    points are inner to none; stations sit on distinct points of kind park or charge, with
+//    capacity >= 1;
 //  - every pick, drop and park point reaches every other one (strong connectivity of service
 //    points), so a served order never hits a disconnected drop.
 // A WarehouseMap is immutable once built: safe to share between threads for reading.

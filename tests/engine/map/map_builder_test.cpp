@@ -124,5 +124,34 @@ TEST(MapBuilderTest, RejectsBadIntersectionsStationsShelvesZones) {
   EXPECT_THAT(BuildError(dup), HasSubstr("duplicate path"));
 }
 
+TEST(MapBuilderTest, RejectsRepeatedOrOverlappingIntersectionPointsAndSharedStations) {
+  MapBuilder twice = LoopBuilder();
+  twice.AddIntersection("I", {"b", "b"}, {"a"});
+  EXPECT_THAT(BuildError(twice), HasSubstr("inner point 'b' is listed twice"));
+  MapBuilder approach_twice = LoopBuilder();
+  approach_twice.AddIntersection("I", {"b"}, {"a", "a"});
+  EXPECT_THAT(BuildError(approach_twice), HasSubstr("approach point 'a' is listed twice"));
+  MapBuilder other = LoopBuilder();
+  other.AddIntersection("I1", {"b"}, {"a"});
+  other.AddIntersection("I2", {"c"}, {"b"});
+  EXPECT_THAT(BuildError(other), HasSubstr("approach point 'b' lies inside intersection 'I1'"));
+  MapBuilder shared = LoopBuilder();
+  shared.AddPoint("p", {8, 1}, PointKind::kPark);
+  shared.AddPath("b", "p", std::nullopt, 0, true);
+  shared.AddStation("S1", "p", 2);
+  shared.AddStation("S2", "p", 2);
+  EXPECT_THAT(BuildError(shared), HasSubstr("already holds station 'S1'"));
+}
+
+TEST(MapBuilderTest, RejectsSelfCrossingZonesAndZonesOffTheFloor) {
+  MapBuilder bowtie = LoopBuilder();
+  bowtie.AddZone("Bow", {{0, 0}, {4, 2}, {4, 0}, {0, 3}});
+  EXPECT_THAT(BuildError(bowtie), HasSubstr("polygon crosses itself"));
+  MapBuilder off = LoopBuilder();
+  off.SetFloor({0, 0}, {10, 10});
+  off.AddRectZone("Out", {5, 5}, {12, 8});
+  EXPECT_THAT(BuildError(off), HasSubstr("vertex (12, 5) lies outside the floor"));
+}
+
 }  // namespace
 }  // namespace dispatch::engine

@@ -1,0 +1,72 @@
+// Runs the real dispatch-map binary and checks what a person would read.
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <array>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+namespace {
+
+using ::testing::HasSubstr;
+
+struct CliRun {
+  int status;
+  std::string output;
+};
+
+CliRun RunMap(const std::string& args) {
+  const std::string cmd = std::string(DISPATCH_MAP_BIN) + " " + args + " 2>&1";
+  FILE* pipe = ::popen(cmd.c_str(), "r");
+  EXPECT_NE(pipe, nullptr);
+  std::string out;
+  std::array<char, 4096> buf{};
+  while (std::fgets(buf.data(), buf.size(), pipe)) out += buf.data();
+  const int status = ::pclose(pipe);
+  return {WEXITSTATUS(status), out};
+}
+
+TEST(DispatchMapCliTest, SummaryOfTheChu2024Floor) {
+  const CliRun r = RunMap("summary --map chu2024");
+  EXPECT_EQ(r.status, 0) << r.output;
+  EXPECT_THAT(r.output, HasSubstr("Map 'chu2024'"));
+  EXPECT_THAT(r.output, HasSubstr("shelves: 30, parking stations: 18 (108 slots)"));
+  EXPECT_THAT(r.output, HasSubstr("Zones: 6"));
+}
+
+TEST(DispatchMapCliTest, RoutesBetweenNamedPointsAndStations) {
+  const CliRun r = RunMap("routes --map chu2024 --from P1 --to D-T3");
+  EXPECT_EQ(r.status, 0) << r.output;
+  EXPECT_THAT(r.output, HasSubstr("Route table: floyd"));
+  EXPECT_THAT(r.output, HasSubstr("park-P1 > J1 >"));
+  EXPECT_THAT(r.output, HasSubstr("> D-T3"));
+  const CliRun sample = RunMap("routes --map chu2024 --method lazy --samples 3");
+  EXPECT_EQ(sample.status, 0) << sample.output;
+  EXPECT_THAT(sample.output, HasSubstr("Route table: lazy"));
+}
+
+TEST(DispatchMapCliTest, WritesAnSvg) {
+  const auto path = std::filesystem::path(DISPATCH_BINARY_DIR) / "dispatch_map_cli_test.svg";
+  const CliRun r = RunMap("svg --map chu2024 --out " + path.string());
+  EXPECT_EQ(r.status, 0) << r.output;
+  std::ifstream in(path);
+  std::stringstream text;
+  text << in.rdbuf();
+  EXPECT_THAT(text.str(), HasSubstr("<svg"));
+  EXPECT_THAT(text.str(), HasSubstr("</svg>"));
+}
+
+TEST(DispatchMapCliTest, BadInputIsAClearErrorAndNonZeroExit) {
+  CliRun r = RunMap("summary --map nowhere.json");
+  EXPECT_NE(r.status, 0);
+  EXPECT_THAT(r.output, HasSubstr("nowhere.json"));
+  r = RunMap("routes --map chu2024 --from P1 --to NOPE");
+  EXPECT_NE(r.status, 0);
+  EXPECT_THAT(r.output, HasSubstr("unknown point or station 'NOPE'"));
+  r = RunMap("routes --map chu2024 --speed -1");
+  EXPECT_NE(r.status, 0);
+}
+
+}  // namespace
