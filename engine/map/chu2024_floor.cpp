@@ -59,6 +59,15 @@ using LineNodes = std::map<double, std::string>;
 
 }  // namespace
 
+std::vector<Eigen::Vector2d> Chu2024FloorOptions::Row4NorthFaceDocks() {
+  std::vector<Eigen::Vector2d> docks;
+  const double y = kShelfY0 + kRowPitch * 3 + kShelfDepth + 0.25;  // 16.5
+  for (int c = 0; c < kShelfCols; ++c) {
+    for (double dx : kSlotOffsets) docks.push_back({kShelfX0 + kColumnPitch * c + dx, y});
+  }
+  return docks;
+}
+
 std::vector<std::string> Chu2024StationNames() {
   std::vector<std::string> names;
   for (int i = 1; i <= 18; ++i) names.push_back("P" + std::to_string(i));

@@ -27,10 +27,13 @@ struct Chu2024FloorOptions {
   double approach_distance = 0.6;
   // Robots per parking station (seed 000 §4.1: "can park 6 robots").
   int station_capacity = 6;
-  // Pick positions the seed's tables use off the lanes (y = 16.5 lies half a metre from the
-  // lane at y = 17, against shelf row 4's north face): each becomes a pick dock joined to the
-  // lane point above it by a short bidirectional single lane.
-  std::vector<Eigen::Vector2d> extra_pick_docks = {{14.0, 16.5}, {19.0, 16.5}};
+  // Pick positions off the lanes, each joined to the nearest lane point by a short
+  // bidirectional single lane. The seed's tables pick at (14, 16.5) and (19, 16.5), half a
+  // metre below the lane at y = 17, against shelf row 4's north face; by default every slot of
+  // that face gets such a dock (18), so any table written like the paper's resolves.
+  std::vector<Eigen::Vector2d> extra_pick_docks = Row4NorthFaceDocks();
+
+  static std::vector<Eigen::Vector2d> Row4NorthFaceDocks();
 };
 
 Result<WarehouseMap> BuildChu2024Floor(const Chu2024FloorOptions& options = {});

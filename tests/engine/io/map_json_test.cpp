@@ -365,7 +365,7 @@ TEST(MapJsonErrorTest, BadStationAndIntersection) {
   EXPECT_NE(ParseError(doc).find("point 'd' is a pick point"), std::string::npos);
   doc = SampleDoc();
   doc["intersections"][0]["approach"].push_back("b");
-  EXPECT_NE(ParseError(doc).find("'b' is both inner and approach"), std::string::npos);
+  EXPECT_NE(ParseError(doc).find("approach point 'b' lies inside intersection 'X1' (both inner and approach)"), std::string::npos);
 }
 
 TEST(MapJsonErrorTest, EmptyIdsAreRejected) {

@@ -1,0 +1,110 @@
+#include "engine/routing/lazy_route_table.h"
+
+#include <limits>
+#include <string>
+
+#include "engine/routing/dijkstra.h"
+
+namespace dispatch::engine {
+namespace {
+
+std::string Describe(const WarehouseMap& map, PointId p) {
+  if (p < 0 || static_cast<std::size_t>(p) >= map.point_count()) {
+    return "unknown point " + std::to_string(p);
+  }
+  return "point '" + map.point(p).name + "' (" + std::to_string(p) + ")";
+}
+
+}  // namespace
+
+Result<std::unique_ptr<LazyRouteTable>> LazyRouteTable::Build(
+    std::shared_ptr<const WarehouseMap> map, const RouteTableOptions& options) {
+  if (!map) return InvalidArgument("LazyRouteTable: null map");
+  auto graph = BuildMapCostGraph(*map, options);
+  if (!graph.ok()) return graph.error();
+  std::unique_ptr<LazyRouteTable> t(new LazyRouteTable());
+  t->map_ = std::move(map);
+  t->graph_ = std::move(graph).value();
+  t->cache_bytes_ = options.lazy_cache_bytes;
+  return t;
+}
+
+std::shared_ptr<const LazyRouteTable::Entry> LazyRouteTable::Lookup(PointId to) const {
+  {
+    std::lock_guard lock(mu_);
+    if (auto it = index_.find(to); it != index_.end()) {
+      lru_.splice(lru_.begin(), lru_, it->second);
+      return it->second->second;
+    }
+    ++searches_;
+  }
+  const std::vector<VertexId> targets = graph_.TargetVertices(*map_, to);
+  ShortestPathTree tree = ReverseDijkstra(graph_.graph, targets);
+  auto entry = std::make_shared<const Entry>(Entry{std::move(tree.dist), std::move(tree.via)});
+  const std::size_t entry_bytes =
+      entry->dist.size() * sizeof(double) + entry->via.size() * sizeof(std::int32_t);
+
+  std::lock_guard lock(mu_);
+  if (auto it = index_.find(to); it != index_.end()) return it->second->second;  // raced
+  lru_.emplace_front(to, entry);
+  index_[to] = lru_.begin();
+  bytes_ += entry_bytes;
+  while (bytes_ > cache_bytes_ && lru_.size() > 1) {
+    const auto& victim = lru_.back();
+    bytes_ -= victim.second->dist.size() * sizeof(double) +
+              victim.second->via.size() * sizeof(std::int32_t);
+    index_.erase(victim.first);
+    lru_.pop_back();
+  }
+  return entry;
+}
+
+double LazyRouteTable::Cost(PointId from, PointId to) const {
+  if (!Known(from) || !Known(to)) return std::numeric_limits<double>::infinity();
+  if (from == to) return 0.0;
+  return Lookup(to)->dist[static_cast<std::size_t>(from)];
+}
+
+PointId LazyRouteTable::NextHop(PointId from, PointId to) const {
+  if (!Known(from) || !Known(to) || from == to) return kNoPoint;
+  const std::int32_t via = Lookup(to)->via[static_cast<std::size_t>(from)];
+  if (via < 0) return kNoPoint;
+  return map_->arc(graph_.map_arc[static_cast<std::size_t>(via)]).to;
+}
+
+Result<Route> LazyRouteTable::Path(PointId from, PointId to) const {
+  if (!Known(from) || !Known(to)) {
+    return NotFound("no route from " + Describe(*map_, from) + " to " + Describe(*map_, to) +
+                    ": unknown point");
+  }
+  if (from == to) return Route{{from}, {}, 0.0, 0.0};
+  const std::shared_ptr<const Entry> entry = Lookup(to);
+  if (entry->via[static_cast<std::size_t>(from)] < 0) {
+    return Unreachable("no route from " + Describe(*map_, from) + " to " + Describe(*map_, to));
+  }
+  // Follow the first-arc pointers; they form a tree rooted at the destination's vertices.
+  std::vector<VertexId> path{from};
+  VertexId v = from;
+  while (entry->via[static_cast<std::size_t>(v)] >= 0) {
+    v = graph_.graph.arc(entry->via[static_cast<std::size_t>(v)]).to;
+    path.push_back(v);
+  }
+  return RouteFromVertexPath(*map_, graph_, path);
+}
+
+RouteTableBuildInfo LazyRouteTable::build_info() const {
+  return {"lazy", graph_.point_count, graph_.graph.vertex_count(), graph_.graph.arc_count(),
+          graph_.expanded, cache_bytes_};
+}
+
+std::size_t LazyRouteTable::cached_destinations() const {
+  std::lock_guard lock(mu_);
+  return lru_.size();
+}
+
+std::size_t LazyRouteTable::searches() const {
+  std::lock_guard lock(mu_);
+  return searches_;
+}
+
+}  // namespace dispatch::engine

@@ -1,0 +1,62 @@
+// LazyRouteTable: a RouteTable for maps too large for an N x N matrix (SPEC §3.1). The first
+// query towards a destination runs one reverse Dijkstra to it over the searched graph (turn
+// penalties included: the search starts from the destination point and all its arrival arc
+// vertices) and caches, per searched vertex, the double distance to the destination and the
+// first arc towards it (12 bytes per vertex). Later queries to that destination are O(1)
+// (Path walks the cached arcs). Answers equal FloydRouteTable's up to its float rounding.
+//
+// The cache is an LRU bounded by options.lazy_cache_bytes (the most recent destination is
+// always kept). Thread safety: all const methods may be called concurrently; `mu_` guards the
+// LRU list and index. Searches run outside the lock (two threads may search the same
+// destination; the first insert wins); entries are immutable shared_ptrs, so a query keeps
+// its entry alive even if another thread evicts it.
+#pragma once
+
+#include <list>
+#include <memory>
+#include <mutex>
+#include <unordered_map>
+
+#include "engine/routing/cost_graph.h"
+#include "engine/routing/route_table.h"
+
+namespace dispatch::engine {
+
+class LazyRouteTable final : public RouteTable {
+ public:
+  static Result<std::unique_ptr<LazyRouteTable>> Build(std::shared_ptr<const WarehouseMap> map,
+                                                       const RouteTableOptions& options);
+
+  std::size_t point_count() const override { return graph_.point_count; }
+  double Cost(PointId from, PointId to) const override;
+  PointId NextHop(PointId from, PointId to) const override;
+  Result<Route> Path(PointId from, PointId to) const override;
+  std::string_view method() const override { return "lazy"; }
+  RouteTableBuildInfo build_info() const override;
+
+  // Cache statistics, for tests and monitoring.
+  std::size_t cached_destinations() const;
+  std::size_t searches() const;
+
+ private:
+  struct Entry {
+    std::vector<double> dist;       // per searched vertex: cost to the destination
+    std::vector<std::int32_t> via;  // per searched vertex: first graph arc towards it, or -1
+  };
+  LazyRouteTable() = default;
+  bool Known(PointId p) const { return p >= 0 && static_cast<std::size_t>(p) < graph_.point_count; }
+  std::shared_ptr<const Entry> Lookup(PointId to) const;
+
+  std::shared_ptr<const WarehouseMap> map_;
+  MapCostGraph graph_;
+  std::size_t cache_bytes_ = 0;
+
+  mutable std::mutex mu_;
+  using Lru = std::list<std::pair<PointId, std::shared_ptr<const Entry>>>;
+  mutable Lru lru_;                                            // guarded by mu_; front = newest
+  mutable std::unordered_map<PointId, Lru::iterator> index_;   // guarded by mu_
+  mutable std::size_t bytes_ = 0;                              // guarded by mu_
+  mutable std::size_t searches_ = 0;                           // guarded by mu_
+};
+
+}  // namespace dispatch::engine

@@ -1,0 +1,140 @@
+#include "engine/routing/lazy_route_table.h"
+
+#include <gtest/gtest.h>
+
+#include <thread>
+
+#include "engine/routing/floyd_route_table.h"
+#include "routing_test_util.h"
+
+namespace dispatch::engine {
+namespace {
+
+using testing::CostsAgree;
+using testing::ExpectValidRoute;
+using testing::RandomMap;
+using testing::ReferenceCosts;
+
+struct LazyCase {
+  unsigned seed;
+  int side;
+  double penalty;
+};
+
+class LazyRouteTableModelTest : public ::testing::TestWithParam<LazyCase> {};
+
+TEST_P(LazyRouteTableModelTest, SameAnswersAsTheDenseTableAndReference) {
+  const LazyCase c = GetParam();
+  const auto map = RandomMap(c.seed, c.side);
+  RouteTableOptions options;
+  options.speed = 0.8;
+  options.turn_penalty_s = c.penalty;
+  const auto dense = FloydRouteTable::Build(map, options).value();
+  const auto lazy = LazyRouteTable::Build(map, options).value();
+  EXPECT_EQ(lazy->method(), "lazy");
+  const auto n = static_cast<PointId>(map->point_count());
+  for (PointId u = 0; u < n; ++u) {
+    const std::vector<double> ref = ReferenceCosts(*map, u, options.speed, c.penalty);
+    for (PointId v = 0; v < n; ++v) {
+      const double expected = ref[static_cast<std::size_t>(v)];
+      if (std::isinf(expected)) {
+        ASSERT_TRUE(std::isinf(lazy->Cost(u, v))) << u << "->" << v;
+      } else {
+        ASSERT_NEAR(lazy->Cost(u, v), expected, 1e-9 * std::max(1.0, expected)) << u << "->" << v;
+      }
+      ASSERT_TRUE(CostsAgree(dense->Cost(u, v), lazy->Cost(u, v)));
+      EXPECT_EQ(std::isinf(expected), lazy->NextHop(u, v) == kNoPoint && u != v);
+      ExpectValidRoute(*map, *lazy, u, v, options.speed, c.penalty);
+      if (::testing::Test::HasFatalFailure()) return;
+    }
+  }
+  EXPECT_EQ(lazy->searches(), map->point_count());  // one search per destination
+}
+
+INSTANTIATE_TEST_SUITE_P(RandomMaps, LazyRouteTableModelTest,
+                         ::testing::Values(LazyCase{21, 6, 0.0}, LazyCase{22, 10, 0.0},
+                                           LazyCase{23, 7, 1.0}, LazyCase{24, 9, 4.0}),
+                         [](const ::testing::TestParamInfo<LazyCase>& info) {
+                           return "seed" + std::to_string(info.param.seed) +
+                                  (info.param.penalty > 0 ? "_turns" : "");
+                         });
+
+TEST(LazyRouteTableTest, CacheIsBoundedAndEvictsLeastRecentlyUsed) {
+  const auto map = RandomMap(31, 8);
+  RouteTableOptions options;
+  const std::size_t entry_bytes = map->point_count() * 12;
+  options.lazy_cache_bytes = 3 * entry_bytes;
+  const auto lazy = LazyRouteTable::Build(map, options).value();
+  const auto dense = FloydRouteTable::Build(map, options).value();
+  lazy->Cost(0, 1);
+  lazy->Cost(0, 2);
+  lazy->Cost(0, 3);
+  EXPECT_EQ(lazy->cached_destinations(), 3u);
+  EXPECT_EQ(lazy->searches(), 3u);
+  lazy->Cost(5, 1);  // hit: 1 becomes the most recent
+  EXPECT_EQ(lazy->searches(), 3u);
+  lazy->Cost(0, 4);  // evicts 2, the least recently used
+  EXPECT_EQ(lazy->cached_destinations(), 3u);
+  lazy->Cost(7, 1);
+  lazy->Cost(7, 3);
+  EXPECT_EQ(lazy->searches(), 4u);
+  lazy->Cost(7, 2);
+  EXPECT_EQ(lazy->searches(), 5u);
+  // Still right after churning through every destination.
+  const auto n = static_cast<PointId>(map->point_count());
+  for (PointId v = 0; v < n; ++v) {
+    for (PointId u = 0; u < n; u += 3) ASSERT_TRUE(CostsAgree(dense->Cost(u, v), lazy->Cost(u, v)));
+  }
+  EXPECT_LE(lazy->cached_destinations(), 3u);
+  // A bound below one entry still keeps the newest.
+  options.lazy_cache_bytes = 1;
+  const auto tiny = LazyRouteTable::Build(map, options).value();
+  EXPECT_TRUE(CostsAgree(dense->Cost(0, 9), tiny->Cost(0, 9)));
+  EXPECT_EQ(tiny->cached_destinations(), 1u);
+}
+
+TEST(LazyRouteTableTest, ConcurrentQueriesAgreeWithSequentialOnes) {
+  const auto map = RandomMap(41, 10);
+  RouteTableOptions options;
+  options.turn_penalty_s = 1.0;
+  options.lazy_cache_bytes = 20 * (map->point_count() + map->arcs().size()) * 12;  // churn
+  const auto dense = FloydRouteTable::Build(map, options).value();
+  const auto lazy = LazyRouteTable::Build(map, options).value();
+  const auto n = static_cast<PointId>(map->point_count());
+  std::vector<int> mismatches(2, 0);
+  auto work = [&](int id) {
+    for (int round = 0; round < 3; ++round) {
+      for (PointId v = 0; v < n; ++v) {
+        const PointId to = (v * 7 + id * 13 + round) % n;
+        for (PointId u = 0; u < n; u += 5) {
+          if (!CostsAgree(dense->Cost(u, to), lazy->Cost(u, to))) ++mismatches[id];
+          const auto path = lazy->Path(u, to);
+          if (path.ok() && !CostsAgree(path.value().cost, lazy->Cost(u, to))) ++mismatches[id];
+        }
+      }
+    }
+  };
+  {
+    std::jthread other(work, 1);
+    work(0);
+  }
+  EXPECT_EQ(mismatches[0], 0);
+  EXPECT_EQ(mismatches[1], 0);
+}
+
+TEST(LazyRouteTableTest, ErrorsNameBothPoints) {
+  const auto map = RandomMap(51, 5);
+  const auto lazy = LazyRouteTable::Build(map, {}).value();
+  const auto unknown = lazy->Path(0, 1000);
+  ASSERT_FALSE(unknown.ok());
+  EXPECT_EQ(unknown.error().code, ErrorCode::kNotFound);
+  EXPECT_NE(unknown.error().message.find("'" + map->point(0).name + "'"), std::string::npos);
+  EXPECT_NE(unknown.error().message.find("1000"), std::string::npos);
+  EXPECT_TRUE(std::isinf(lazy->Cost(0, -3)));
+  EXPECT_EQ(lazy->NextHop(0, -3), kNoPoint);
+  EXPECT_EQ(lazy->searches(), 0u);
+  EXPECT_EQ(LazyRouteTable::Build(nullptr, {}).error().code, ErrorCode::kInvalidArgument);
+}
+
+}  // namespace
+}  // namespace dispatch::engine
