@@ -1,0 +1,139 @@
+#include "engine/fleet/plan.h"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+namespace dispatch::engine {
+namespace {
+
+bool ValidPoint(const WarehouseMap& map, PointId id) {
+  return id >= 0 && static_cast<std::size_t>(id) < map.point_count();
+}
+
+void Append(Plan& plan, PointId point, const Eigen::Vector2d& xy, double eta,
+            WaypointAction action, double dwell) {
+  Waypoint w;
+  w.seq = static_cast<int>(plan.waypoints.size());
+  w.point = point;
+  w.xy = xy;
+  w.eta = eta;
+  w.action = action;
+  w.dwell = dwell;
+  plan.waypoints.push_back(w);
+}
+
+}  // namespace
+
+const char* WaypointActionName(WaypointAction action) {
+  switch (action) {
+    case WaypointAction::kMove: return "move";
+    case WaypointAction::kPick: return "pick";
+    case WaypointAction::kDrop: return "drop";
+    case WaypointAction::kWait: return "wait";
+    case WaypointAction::kPark: return "park";
+    case WaypointAction::kCharge: return "charge";
+  }
+  return "unknown";
+}
+
+std::optional<WaypointAction> ParseWaypointAction(std::string_view name) {
+  for (WaypointAction a : {WaypointAction::kMove, WaypointAction::kPick, WaypointAction::kDrop,
+                           WaypointAction::kWait, WaypointAction::kPark, WaypointAction::kCharge}) {
+    if (name == WaypointActionName(a)) return a;
+  }
+  return std::nullopt;
+}
+
+Eigen::Vector2d Plan::PositionAt(double t) const {
+  if (waypoints.empty()) throw std::logic_error("Plan::PositionAt on an empty plan");
+  if (t <= waypoints.front().eta) return waypoints.front().xy;
+  // The last waypoint whose arrival is <= t.
+  auto next = std::upper_bound(waypoints.begin(), waypoints.end(), t,
+                               [](double time, const Waypoint& w) { return time < w.eta; });
+  const Waypoint& from = *(next - 1);
+  if (next == waypoints.end() || t <= from.departure()) return from.xy;
+  const Waypoint& to = *next;
+  const double span = to.eta - from.departure();
+  if (span <= 0.0) return to.xy;
+  const double s = (t - from.departure()) / span;
+  return from.xy + s * (to.xy - from.xy);
+}
+
+double Plan::start_time() const {
+  if (waypoints.empty()) throw std::logic_error("Plan::start_time on an empty plan");
+  return waypoints.front().eta;
+}
+
+double Plan::end_time() const {
+  if (waypoints.empty()) throw std::logic_error("Plan::end_time on an empty plan");
+  return waypoints.back().departure();
+}
+
+int TaskPointCount(const PlanTask& task) { return static_cast<int>(task.picks.size()) + 1; }
+
+double TaskWorkTime(const PlanTask& task) { return TaskPointCount(task) * task.work_time; }
+
+Result<Plan> BuildPlan(const WarehouseMap& map, const RouteTable& routes, PointId start,
+                       double start_time, double speed, const std::vector<PlanTask>& tasks) {
+  if (!std::isfinite(speed) || speed <= 0.0) {
+    return InvalidArgument("speed must be > 0 m/s, got " + std::to_string(speed));
+  }
+  if (!std::isfinite(start_time)) return InvalidArgument("start time is not finite");
+  if (!ValidPoint(map, start)) return NotFound("unknown start point id " + std::to_string(start));
+  for (std::size_t k = 0; k < tasks.size(); ++k) {
+    const PlanTask& task = tasks[k];
+    const std::string what = "task " + std::to_string(k + 1) + ": ";
+    if (task.picks.empty()) return InvalidArgument(what + "no pick points");
+    if (!std::isfinite(task.work_time) || task.work_time < 0.0) {
+      return InvalidArgument(what + "work time must be >= 0 s, got " +
+                             std::to_string(task.work_time));
+    }
+    for (PointId p : task.picks) {
+      if (!ValidPoint(map, p)) return NotFound(what + "unknown pick point id " + std::to_string(p));
+    }
+    if (!ValidPoint(map, task.drop)) {
+      return NotFound(what + "unknown drop point id " + std::to_string(task.drop));
+    }
+  }
+
+  Plan plan;
+  Append(plan, start, map.point(start).position, start_time, WaypointAction::kMove, 0.0);
+  PointId at = start;
+  double time = start_time;
+  // Drives from `at` to `stop` along the table's route, then works `dwell` there.
+  auto visit = [&](PointId stop, WaypointAction action, double dwell) -> Status {
+    Result<Route> route = routes.Path(at, stop);
+    if (!route.ok()) return route.error();
+    const Route& r = *route;
+    for (std::size_t i = 0; i < r.arcs.size(); ++i) {
+      const Arc& arc = map.arc(r.arcs[i]);
+      const double v = arc.max_speed > 0.0 ? std::min(speed, arc.max_speed) : speed;
+      time += arc.length / v;
+      const PointId p = r.points[i + 1];
+      if (i + 1 < r.arcs.size()) {
+        Append(plan, p, map.point(p).position, time, WaypointAction::kMove, 0.0);
+      }
+    }
+    Append(plan, stop, map.point(stop).position, time, action, dwell);
+    time += dwell;
+    at = stop;
+    return Ok{};
+  };
+  for (std::size_t k = 0; k < tasks.size(); ++k) {
+    const PlanTask& task = tasks[k];
+    const std::string what = "task " + std::to_string(k + 1);
+    for (std::size_t i = 0; i < task.picks.size(); ++i) {
+      if (Status s = visit(task.picks[i], WaypointAction::kPick, task.work_time); !s.ok()) {
+        return Error{s.error().code,
+                     what + ", pick " + std::to_string(i + 1) + ": " + s.error().message};
+      }
+    }
+    if (Status s = visit(task.drop, WaypointAction::kDrop, task.work_time); !s.ok()) {
+      return Error{s.error().code, what + ", drop: " + s.error().message};
+    }
+  }
+  return plan;
+}
+
+}  // namespace dispatch::engine

@@ -1,0 +1,85 @@
+// Timed plans (SPEC §3.4): the waypoints a robot follows, each with its ETA and action.
+// Plans are what the dispatcher streams to robots and what traffic prediction reads.
+//
+// ETA convention: a waypoint's `eta` is the time the robot ARRIVES there. At a pick or drop
+// waypoint the robot then works for `dwell` seconds (t_w) standing still and departs at
+// eta + dwell; so the next waypoint's eta already includes the work time. Move waypoints have
+// dwell 0. Between the departure from one waypoint and the arrival at the next the robot
+// moves in a straight line at constant speed.
+//
+// Work time counting (Chu2024 eq. (3): T_w = n_c * t_w): the paper's task points ("任务点")
+// are an order's pick points AND its target (drop) point, so a task with k picks has
+// n_c = k + 1 and the robot works t_w at every pick and again at the drop.
+//
+// Invariants of a Plan from BuildPlan: waypoints non-empty, seq = 0, 1, 2, ...; etas
+// non-decreasing; eta[i+1] >= eta[i] + dwell[i]. Plain values; safe to share once built.
+// BuildPlan is pure (reads the map and route table only).
+#pragma once
+
+#include <Eigen/Core>
+
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "engine/common/result.h"
+#include "engine/map/warehouse_map.h"
+#include "engine/routing/route_table.h"
+
+namespace dispatch::engine {
+
+enum class WaypointAction { kMove, kPick, kDrop, kWait, kPark, kCharge };
+
+// "move", "pick", "drop", "wait", "park", "charge".
+const char* WaypointActionName(WaypointAction action);
+std::optional<WaypointAction> ParseWaypointAction(std::string_view name);
+
+struct Waypoint {
+  int seq = 0;
+  PointId point = kNoPoint;
+  Eigen::Vector2d xy = Eigen::Vector2d::Zero();  // where the robot is (a formation member's
+                                                 // slot may be off the point itself)
+  double eta = 0.0;    // arrival time, seconds
+  WaypointAction action = WaypointAction::kMove;
+  double dwell = 0.0;  // seconds standing still after arrival (t_w at pick/drop), >= 0
+
+  double departure() const { return eta + dwell; }
+};
+
+struct Plan {
+  std::string robot_id;
+  std::vector<Waypoint> waypoints;
+
+  // Position at time t: the first waypoint before the plan starts, the last after it ends,
+  // still during a dwell, linear between departure and the next arrival otherwise.
+  // Precondition: waypoints non-empty (else throws std::logic_error). O(log n).
+  Eigen::Vector2d PositionAt(double t) const;
+  double start_time() const;  // first eta (precondition as above)
+  double end_time() const;    // last departure (precondition as above)
+};
+
+// One task for one robot: visit the picks in order, then the drop; t_w at each (see above).
+struct PlanTask {
+  std::vector<PointId> picks;
+  PointId drop = kNoPoint;
+  double work_time = 0.0;  // t_w, seconds, >= 0
+};
+
+// n_c of one task: picks + the drop (Chu2024 eq. (3)).
+int TaskPointCount(const PlanTask& task);
+// T_w of one task: n_c * t_w (Chu2024 eq. (3)).
+double TaskWorkTime(const PlanTask& task);
+
+// Builds the plan of one robot at `start` at `start_time` serving `tasks` in order at speed
+// `speed` (m/s; an arc's own max_speed caps it where lower). Waypoint 0 is the start (move,
+// eta = start_time); every point of the RouteTable's route between consecutive stops becomes
+// a waypoint (move for passed points, pick/drop at the stops, with dwell = t_w), ETAs by
+// arc length / speed (the table's optional turn penalty chooses routes but adds no time
+// here). No tasks: just the start waypoint. robot_id is left empty.
+// Errors: kInvalidArgument (speed <= 0, non-finite start time, a task without picks or with
+// negative t_w), kNotFound (unknown point id), kUnreachable (names both points).
+Result<Plan> BuildPlan(const WarehouseMap& map, const RouteTable& routes, PointId start,
+                       double start_time, double speed, const std::vector<PlanTask>& tasks);
+
+}  // namespace dispatch::engine
