@@ -132,15 +132,15 @@ int RunRoutes(const WarehouseMap& loaded, const RouteTableOptions& options, cons
   } else {
     pairs = SampleRoutes(*map, samples);
   }
-  std::printf("%-14s %-14s %9s %9s %5s  %s\n", "from", "to", "length_m", "time_s", "hops", "via");
+  std::printf("%-18s %-18s %9s %9s %5s  %s\n", "from", "to", "length_m", "time_s", "hops", "via");
   for (const auto& [f, t] : pairs) {
     auto route = (*table)->Path(f, t);
     if (!route.ok()) {
-      std::printf("%-14s %-14s %s\n", map->point(f).name.c_str(), map->point(t).name.c_str(),
+      std::printf("%-18s %-18s %s\n", map->point(f).name.c_str(), map->point(t).name.c_str(),
                   route.error().message.c_str());
       continue;
     }
-    std::printf("%-14s %-14s %9.2f %9.2f %5zu  %s\n", map->point(f).name.c_str(),
+    std::printf("%-18s %-18s %9.2f %9.2f %5zu  %s\n", map->point(f).name.c_str(),
                 map->point(t).name.c_str(), route->length, route->cost, route->arcs.size(),
                 Via(*map, *route, pairs.size() == 1 ? 1000 : 6).c_str());
   }

@@ -1,0 +1,1 @@
+target_sources(dispatch_engine PRIVATE traffic_prediction.cpp)

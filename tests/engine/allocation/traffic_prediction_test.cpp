@@ -1,0 +1,591 @@
+#include "engine/allocation/traffic_prediction.h"
+
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <map>
+#include <memory>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "engine/map/chu2024_floor.h"
+#include "engine/map/map_builder.h"
+#include "engine/routing/route_table.h"
+
+namespace dispatch::engine {
+namespace {
+
+// The reference ZoneAt: the lowest zone id whose Contains holds.
+ZoneId BruteForceZone(const WarehouseMap& map, const Eigen::Vector2d& xy) {
+  for (std::size_t z = 0; z < map.zones().size(); ++z) {
+    if (map.zones()[z].Contains(xy)) return static_cast<ZoneId>(z);
+  }
+  return -1;
+}
+
+// Probe points: `n_random` uniform over the floor grown by `pad`, as many on cell corners of
+// `cell` (from floor_min), and per zone edge its vertex plus `per_edge` points on the edge,
+// each also shifted a hair (1e-12 .. 1e-4 m) off it.
+std::vector<Eigen::Vector2d> ProbePoints(const WarehouseMap& map, int n_random, int per_edge,
+                                         double pad, double cell, std::mt19937& rng) {
+  std::vector<Eigen::Vector2d> pts;
+  const Eigen::Vector2d lo = map.floor_min() - Eigen::Vector2d::Constant(pad);
+  const Eigen::Vector2d hi = map.floor_max() + Eigen::Vector2d::Constant(pad);
+  std::uniform_real_distribution<double> ux(lo.x(), hi.x()), uy(lo.y(), hi.y());
+  std::uniform_real_distribution<double> u01(0.0, 1.0);
+  for (int i = 0; i < n_random; ++i) {
+    pts.emplace_back(ux(rng), uy(rng));
+    const Eigen::Vector2d p(ux(rng), uy(rng));
+    pts.push_back(map.floor_min() +
+                  cell * ((p - map.floor_min()) / cell).array().floor().matrix());
+  }
+  for (const Zone& zone : map.zones()) {
+    const auto& poly = zone.polygon;
+    for (std::size_t i = 0, j = poly.size() - 1; i < poly.size(); j = i++) {
+      pts.push_back(poly[i]);
+      for (int k = 0; k < per_edge; ++k) {
+        const Eigen::Vector2d p = poly[j] + u01(rng) * (poly[i] - poly[j]);
+        pts.push_back(p);
+        for (double off : {1e-12, 1e-10, 1e-8, 1e-6, 1e-4}) {
+          pts.push_back(p + Eigen::Vector2d(off, 0));
+          pts.push_back(p - Eigen::Vector2d(0, off));
+          pts.push_back(p + Eigen::Vector2d(-off, off));
+        }
+      }
+    }
+  }
+  return pts;
+}
+
+void ExpectZoneAtMatchesBruteForce(const WarehouseMap& map, const TrafficPredictor& pred,
+                                   int n_random, int per_edge, std::uint32_t seed) {
+  std::mt19937 rng(seed);
+  const std::vector<Eigen::Vector2d> pts =
+      ProbePoints(map, n_random, per_edge, 1.5, pred.zone_cell_size(), rng);
+  int mismatches = 0;
+  for (const Eigen::Vector2d& p : pts) {
+    const ZoneId want = BruteForceZone(map, p);
+    const ZoneId got = pred.ZoneAt(p);
+    if (got != want && ++mismatches <= 10) {
+      ADD_FAILURE() << "ZoneAt(" << p.x() << ", " << p.y() << ") = " << got << ", want " << want;
+    }
+  }
+  EXPECT_EQ(mismatches, 0) << "of " << pts.size() << " points";
+}
+
+// --- ZoneAt -----------------------------------------------------------------------------------
+
+TEST(TrafficPredictionZoneAtTest, MatchesBruteForceOnChu2024Floor) {
+  const WarehouseMap map = BuildChu2024Floor().value();
+  ASSERT_EQ(map.zones().size(), 6u);
+  for (double cell : {0.25, 0.1, 1.0, 3.3}) {
+    TrafficPredictionConfig config;
+    config.zone_cell_size = cell;
+    const TrafficPredictor pred(map, config);
+    EXPECT_DOUBLE_EQ(pred.zone_cell_size(), cell);
+    ExpectZoneAtMatchesBruteForce(map, pred, 50000, 20, 7);
+  }
+  const TrafficPredictor pred(map, {});
+  EXPECT_EQ(pred.ZoneAt({1e9, 0}), -1);
+  EXPECT_EQ(pred.ZoneAt({std::nan(""), 3.0}), -1);
+  EXPECT_EQ(pred.ZoneAt({-1e9, -1e9}), -1);
+  // Shared border x = 12.25 of Z1 | Z2: the lower id answers, as BruteForceZone does.
+  EXPECT_EQ(pred.ZoneAt({12.25, 5.0}), map.FindZone("Z1").value());
+  EXPECT_EQ(pred.ZoneAt({12.2500001, 5.0}), map.FindZone("Z2").value());
+}
+
+// A concave polygon with slanted edges, a triangle, a quad overlapping both and a rectangle
+// inside the quad (interior overlaps: the lowest id wins).
+WarehouseMap PolygonMap(bool overlapping) {
+  MapBuilder b("polygons");
+  b.SetFloor({0, 0}, {20, 10});
+  b.AddZone("L", {{0, 0}, {12, 0}, {12, 3}, {5.3, 3.7}, {3.1, 10}, {0, 10}});
+  b.AddZone("tri", {{12, 0}, {20, 0}, {20, 10}});
+  if (overlapping) {
+    b.AddZone("quad", {{4, 2}, {13, 2.5}, {19.7, 9.9}, {2.9, 9.5}});
+    b.AddRectZone("rect", {8, 5}, {10, 7});
+  } else {
+    b.AddZone("quad", {{5.3, 3.7}, {12, 3}, {12, 0}, {20, 10}, {3.1, 10}});
+  }
+  b.AddPoint("a", {1, 1}, PointKind::kLane);
+  b.AddPoint("b", {2, 1}, PointKind::kLane);
+  b.AddPath("a", "b", std::nullopt, 0.0, true);
+  return b.Build().value();
+}
+
+TEST(TrafficPredictionZoneAtTest, MatchesBruteForceOnNonRectangularZones) {
+  for (bool overlapping : {false, true}) {
+    const WarehouseMap map = PolygonMap(overlapping);
+    for (double cell : {0.25, 0.07, 1.3}) {
+      TrafficPredictionConfig config;
+      config.zone_cell_size = cell;
+      const TrafficPredictor pred(map, config);
+      ExpectZoneAtMatchesBruteForce(map, pred, 50000, 20, 11);
+    }
+  }
+}
+
+// A zone border a hair (2e-10 m) past a cell border: Zone::Contains of the lower-id zone
+// accepts points just across it, inside a cell that lies wholly in the other zone. The grid
+// must not answer that cell directly.
+TEST(TrafficPredictionZoneAtTest, HairlineGapBetweenZoneBorderAndCellBorder) {
+  const double cut = 5.0 + 2e-10;
+  MapBuilder b("hairline");
+  b.SetFloor({0, 0}, {10, 10});
+  b.AddRectZone("right", {cut, 0}, {10, 10});  // id 0: wins on the shared border
+  b.AddRectZone("left", {0, 0}, {cut, 10});
+  b.AddPoint("a", {1, 1}, PointKind::kLane);
+  b.AddPoint("b", {2, 1}, PointKind::kLane);
+  b.AddPath("a", "b", std::nullopt, 0.0, true);
+  const WarehouseMap map = b.Build().value();
+  TrafficPredictionConfig config;
+  config.zone_cell_size = 0.25;  // a cell border at x = 5
+  const TrafficPredictor pred(map, config);
+  for (int k = -2000; k <= 2000; ++k) {
+    const Eigen::Vector2d p(5.0 + k * 1e-12, 3.3);
+    EXPECT_EQ(pred.ZoneAt(p), BruteForceZone(map, p)) << "x = 5 + " << k << "e-12";
+  }
+}
+
+// The LoRR warehouse_large scale: a 500 x 140 m floor cut into 700 zones of 10 x 10 m.
+TEST(TrafficPredictionZoneAtTest, LorrScaleFloorIsFastAndExact) {
+  MapBuilder b("lorr-like");
+  b.SetFloor({0, 0}, {500, 140});
+  for (int r = 0; r < 14; ++r) {
+    for (int c = 0; c < 50; ++c) {
+      b.AddRectZone("z" + std::to_string(r * 50 + c), {10.0 * c, 10.0 * r},
+                    {10.0 * (c + 1), 10.0 * (r + 1)});
+    }
+  }
+  b.AddPoint("a", {1, 1}, PointKind::kLane);
+  b.AddPoint("b", {2, 1}, PointKind::kLane);
+  b.AddPath("a", "b", std::nullopt, 0.0, true);
+  const WarehouseMap map = b.Build().value();
+  ASSERT_EQ(map.zones().size(), 700u);
+
+  const auto t0 = std::chrono::steady_clock::now();
+  const TrafficPredictor pred(map, {});
+  const double build_ms =
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+  std::printf("700-zone 500x140 m grid: cell %.3f m, built in %.1f ms\n", pred.zone_cell_size(),
+              build_ms);
+  EXPECT_DOUBLE_EQ(pred.zone_cell_size(), 0.25);
+  ExpectZoneAtMatchesBruteForce(map, pred, 20000, 1, 13);
+  EXPECT_EQ(pred.ZoneAt({10.0, 10.0}), 0);  // corner of z0, z1, z50, z51: the lowest id
+  EXPECT_EQ(pred.ZoneAt({15.0, 135.0}), 13 * 50 + 1);
+}
+
+TEST(TrafficPredictionZoneAtTest, CellSizeGrowsToKeepTheGridBounded) {
+  MapBuilder b("huge");
+  b.SetFloor({0, 0}, {4000, 3000});
+  b.AddZone("diamond", {{2000, 0}, {4000, 1500}, {2000, 3000}, {0, 1500}});
+  b.AddPoint("a", {2000, 1500}, PointKind::kLane);
+  b.AddPoint("b", {2001, 1500}, PointKind::kLane);
+  b.AddPath("a", "b", std::nullopt, 0.0, true);
+  const WarehouseMap map = b.Build().value();
+  const TrafficPredictor pred(map, {});
+  const double cell = pred.zone_cell_size();
+  EXPECT_GT(cell, 0.25);
+  const double cells = (std::floor(4000 / cell) + 3) * (std::floor(3000 / cell) + 3);
+  EXPECT_LE(cells, static_cast<double>(TrafficPredictionConfig::kMaxZoneCells));
+  ExpectZoneAtMatchesBruteForce(map, pred, 20000, 20, 17);
+}
+
+TEST(TrafficPredictionConfigTest, RejectsBadSettings) {
+  const WarehouseMap map = BuildChu2024Floor().value();
+  TrafficPredictionConfig config;
+  config.bucket_seconds = 0.0;
+  EXPECT_THROW(TrafficPredictor(map, config), std::invalid_argument);
+  config = {};
+  config.zone_cell_size = -1.0;
+  EXPECT_THROW(TrafficPredictor(map, config), std::invalid_argument);
+  config = {};
+  config.origin_time = std::nan("");
+  EXPECT_THROW(TrafficPredictor(map, config), std::invalid_argument);
+}
+
+// --- Counts: model test -------------------------------------------------------------------
+
+class TrafficPredictionModelTest : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    map_ = std::make_shared<const WarehouseMap>(BuildChu2024Floor().value());
+    routes_ = std::shared_ptr<const RouteTable>(MakeRouteTable(map_, {}).value().release());
+    for (PointId p = 0; p < static_cast<PointId>(map_->point_count()); ++p) {
+      const PointKind kind = map_->point(p).kind;
+      if (kind == PointKind::kPick) picks_.push_back(p);
+      if (kind == PointKind::kDrop) drops_.push_back(p);
+      if (kind == PointKind::kPark) parks_.push_back(p);
+    }
+  }
+
+  // A hand-made plan: random points over the floor (some just outside it, in no zone),
+  // dwells, repeated positions; or a BuildPlan over the route table.
+  static Plan RandomPlan(std::mt19937& rng) {
+    std::uniform_real_distribution<double> u01(0.0, 1.0);
+    const double start = -10.0 + 120.0 * u01(rng);
+    if (u01(rng) < 0.4) {
+      std::uniform_int_distribution<std::size_t> pick(0, picks_.size() - 1);
+      std::uniform_int_distribution<std::size_t> drop(0, drops_.size() - 1);
+      std::uniform_int_distribution<std::size_t> park(0, parks_.size() - 1);
+      std::vector<PlanTask> tasks(1 + rng() % 2);
+      for (PlanTask& t : tasks) {
+        t.picks = {picks_[pick(rng)]};
+        t.drop = drops_[drop(rng)];
+        t.work_time = 3.0 * u01(rng);
+      }
+      return BuildPlan(*map_, *routes_, parks_[park(rng)], start, 1.0 + u01(rng), tasks).value();
+    }
+    Plan plan;
+    const int n = 1 + static_cast<int>(rng() % 6);
+    double t = start;
+    for (int i = 0; i < n; ++i) {
+      Waypoint w;
+      w.seq = i;
+      if (i > 0 && u01(rng) < 0.2) {
+        w.xy = plan.waypoints.back().xy;  // standing still
+      } else {
+        w.xy = {-4.0 + 43.0 * u01(rng), -3.0 + 30.0 * u01(rng)};
+      }
+      if (i > 0) t += 0.01 + 20.0 * u01(rng);
+      w.eta = t;
+      w.dwell = u01(rng) < 0.5 ? 0.0 : 10.0 * u01(rng);
+      t += w.dwell;
+      plan.waypoints.push_back(w);
+    }
+    return plan;
+  }
+
+  // Recount from scratch by the documented rule: a plan counts at every s_b in
+  // [start_time, end_time], in the zone BruteForceZone(PositionAt(s_b)).
+  static void ExpectCountsMatch(const TrafficPredictor& pred,
+                                const std::map<std::string, Plan>& plans, std::mt19937& rng) {
+    const std::size_t n_zones = map_->zones().size();
+    const std::size_t n_buckets = pred.bucket_count();
+    const double origin = pred.config().origin_time, dt = pred.config().bucket_seconds;
+    std::vector<int> expected(n_buckets * n_zones, 0);
+    std::map<std::string, std::vector<ZoneId>> own;  // per robot, zone at each bucket or -1
+    for (const auto& [robot, plan] : plans) {
+      std::vector<ZoneId>& z_of = own[robot];
+      z_of.assign(n_buckets, -1);
+      for (std::size_t b = 0; b < n_buckets; ++b) {
+        const double s = origin + static_cast<double>(b) * dt;
+        if (s < plan.start_time() || s > plan.end_time()) continue;
+        const ZoneId z = BruteForceZone(*map_, plan.PositionAt(s));
+        z_of[b] = z;
+        if (z >= 0) ++expected[b * n_zones + static_cast<std::size_t>(z)];
+      }
+      // Storage must reach the plan's last bucket start.
+      if (plan.end_time() >= origin) {
+        EXPECT_GT(origin + static_cast<double>(n_buckets) * dt, plan.end_time()) << robot;
+      }
+    }
+    std::vector<std::string> robots = {"", "nobody"};
+    for (const auto& [robot, plan] : plans) robots.push_back(robot);
+    const std::string& excluded = robots[rng() % robots.size()];
+    int mismatches = 0;
+    for (std::size_t b = 0; b < n_buckets; ++b) {
+      const double s = origin + static_cast<double>(b) * dt;
+      for (std::size_t z = 0; z < n_zones; ++z) {
+        const ZoneId zone = static_cast<ZoneId>(z);
+        const int want = expected[b * n_zones + z];
+        int want_excl = want;
+        if (auto it = own.find(excluded); it != own.end() && it->second[b] == zone) --want_excl;
+        // At the bucket start, inside the bucket, and excluding one robot.
+        if (pred.CountAt(zone, s) != want || pred.CountAt(zone, s + 0.6 * dt) != want ||
+            pred.CountAt(zone, s, excluded) != want_excl) {
+          if (++mismatches <= 5) {
+            ADD_FAILURE() << "bucket " << b << " zone " << z << ": " << pred.CountAt(zone, s)
+                          << " want " << want << "; excluding '" << excluded
+                          << "': " << pred.CountAt(zone, s, excluded) << " want " << want_excl;
+          }
+        }
+      }
+    }
+    EXPECT_EQ(mismatches, 0);
+    // Before the origin: bucket 0. Past the storage: nothing.
+    for (std::size_t z = 0; z < n_zones && n_buckets > 0; ++z) {
+      EXPECT_EQ(pred.CountAt(static_cast<ZoneId>(z), origin - 50.0), expected[z]);
+    }
+    EXPECT_EQ(pred.CountAt(0, origin + static_cast<double>(n_buckets + 1) * dt), 0);
+    EXPECT_EQ(pred.CountAt(-1, origin), 0);
+    EXPECT_EQ(pred.CountAt(static_cast<ZoneId>(n_zones), origin), 0);
+  }
+
+  static std::shared_ptr<const WarehouseMap> map_;
+  static std::shared_ptr<const RouteTable> routes_;
+  static std::vector<PointId> picks_, drops_, parks_;
+};
+std::shared_ptr<const WarehouseMap> TrafficPredictionModelTest::map_;
+std::shared_ptr<const RouteTable> TrafficPredictionModelTest::routes_;
+std::vector<PointId> TrafficPredictionModelTest::picks_;
+std::vector<PointId> TrafficPredictionModelTest::drops_;
+std::vector<PointId> TrafficPredictionModelTest::parks_;
+
+TEST_F(TrafficPredictionModelTest, CountsEqualRecountAfterRandomSetReplaceRemove) {
+  // A bucket length that is not a binary fraction and an origin that plans start before.
+  const std::pair<double, double> settings[] = {{0.7, 3.1}, {0.5, 0.0}, {2.3, -7.0}};
+  for (const auto& [dt, origin] : settings) {
+    TrafficPredictionConfig config;
+    config.bucket_seconds = dt;
+    config.origin_time = origin;
+    TrafficPredictor pred(*map_, config);
+    std::map<std::string, Plan> model;
+    std::mt19937 rng(static_cast<std::uint32_t>(1000 * dt));
+    std::uniform_real_distribution<double> u01(0.0, 1.0);
+    for (int op = 0; op < 120; ++op) {
+      const std::string robot = "R" + std::to_string(rng() % 8);
+      const double r = u01(rng);
+      if (r < 0.65) {
+        Plan plan = RandomPlan(rng);
+        if (u01(rng) < 0.3) {  // start exactly on a bucket start (rounding of the first bucket)
+          const double target = origin + static_cast<double>(rng() % 150) * dt;
+          const double shift = target - plan.start_time();
+          for (Waypoint& w : plan.waypoints) w.eta += shift;
+          plan.waypoints.front().eta = target;
+        }
+        pred.SetPlan(robot, plan);
+        model[robot] = std::move(plan);
+      } else if (r < 0.9) {
+        pred.RemovePlan(robot);
+        model.erase(robot);
+      } else {
+        pred.SetPlan(robot, Plan{});  // an empty plan removes
+        model.erase(robot);
+      }
+      ASSERT_EQ(pred.robot_count(), model.size());
+      ExpectCountsMatch(pred, model, rng);
+      if (HasFailure()) return;
+    }
+  }
+}
+
+TEST_F(TrafficPredictionModelTest, PlanCountsAtEveryBucketStartWithinItsSpan) {
+  TrafficPredictionConfig config;
+  config.bucket_seconds = 1.0;
+  TrafficPredictor pred(*map_, config);
+  Plan plan;
+  plan.waypoints = {{0, kNoPoint, {5, 5}, 2.0, WaypointAction::kPark, 1.0},  // Z1, 2 .. 3
+                    {1, kNoPoint, {30, 5}, 8.0, WaypointAction::kMove, 0.0}};  // Z3 at 8
+  pred.SetPlan("R1", plan);
+  const ZoneId z1 = map_->FindZone("Z1").value(), z3 = map_->FindZone("Z3").value();
+  EXPECT_EQ(pred.bucket_count(), 9u);  // buckets 2 .. 8
+  EXPECT_EQ(pred.CountAt(z1, 1.99), 0);  // bucket 1 starts before the plan
+  EXPECT_EQ(pred.CountAt(z1, 2.0), 1);
+  EXPECT_EQ(pred.CountAt(z1, 3.5), 1);   // bucket 3, still standing at (5, 5)
+  EXPECT_EQ(pred.CountAt(z3, 8.0), 1);
+  EXPECT_EQ(pred.CountAt(z3, 8.9), 1);   // bucket 8 holds the position at s_8 = 8
+  EXPECT_EQ(pred.CountAt(z3, 9.0), 0);   // after the end
+  EXPECT_EQ(pred.CountAt(z1, 2.0, "R1"), 0);
+
+  // A plan inside one bucket (no bucket start in its span) predicts nothing.
+  Plan blip;
+  blip.waypoints = {{0, kNoPoint, {5, 5}, 20.2, WaypointAction::kPark, 0.5}};
+  pred.SetPlan("R2", blip);
+  EXPECT_EQ(pred.CountAt(z1, 20.5), 0);
+  EXPECT_EQ(pred.bucket_count(), 9u);
+
+  Plan bad = plan;
+  bad.waypoints.back().eta = std::numeric_limits<double>::infinity();
+  EXPECT_THROW(pred.SetPlan("R3", bad), std::invalid_argument);
+  EXPECT_THROW(pred.SetPlan("", plan), std::invalid_argument);
+  EXPECT_EQ(pred.CountAt(z1, 2.0), 1);  // unchanged by the rejected calls
+}
+
+// --- Density ------------------------------------------------------------------------------
+
+Plan ParkedPlan(const Eigen::Vector2d& xy, double from, double until) {
+  Plan plan;
+  plan.waypoints = {{0, kNoPoint, xy, from, WaypointAction::kPark, until - from}};
+  return plan;
+}
+
+TEST(TrafficPredictionDensityTest, PeaksPerZoneOverOtherRobotsOnly) {
+  const WarehouseMap map = BuildChu2024Floor().value();
+  TrafficPredictor pred(map, {});
+  const ZoneId z1 = map.FindZone("Z1").value(), z2 = map.FindZone("Z2").value();
+  const ZoneId z3 = map.FindZone("Z3").value();
+  // By hand from chu2024_floor.md: floor x in [-2.5, 37], y in [-2, 25.5], cuts at x = 12.25,
+  // 22.25 and y = 11.75.
+  const double s1 = (12.25 + 2.5) * (11.75 + 2.0);    // 202.8125 m^2
+  const double s2 = (22.25 - 12.25) * (11.75 + 2.0);  // 137.5 m^2
+  ASSERT_NEAR(map.zones()[static_cast<std::size_t>(z1)].area, s1, 1e-9);
+  ASSERT_NEAR(map.zones()[static_cast<std::size_t>(z2)].area, s2, 1e-9);
+
+  // R1 and R2 park in Z1 (R1 leaves for Z4 at t = 200), R4 parks in Z2, and the bidder R3
+  // itself parks in Z1: it must not count itself.
+  Plan r1 = ParkedPlan({5, 5}, 0.0, 200.0);
+  r1.waypoints.push_back({1, kNoPoint, {5, 20}, 210.0, WaypointAction::kPark, 790.0});
+  pred.SetPlan("R1", r1);
+  pred.SetPlan("R2", ParkedPlan({6, 5}, 0.0, 1000.0));
+  pred.SetPlan("R3", ParkedPlan({7, 5}, 0.0, 1000.0));
+  pred.SetPlan("R4", ParkedPlan({15, 5}, 0.0, 1000.0));
+
+  // The candidate route: Z1 at 100 (R1, R2), Z2 at 110 (R4), Z3 at 120 (nobody), Z1 again at
+  // 300 (R2 only), and a sample off the floor (no zone).
+  const std::vector<RouteSample> route = {
+      {{4, 4}, 100.0}, {{15, 4}, 110.0}, {{30, 4}, 120.0}, {{4, 6}, 300.0}, {{50, 50}, 310.0}};
+  const DensityTerm d = pred.Density(route, "R3");
+  const std::vector<std::pair<ZoneId, int>> want_peaks = {{z1, 2}, {z2, 1}, {z3, 0}};
+  EXPECT_EQ(d.peaks, want_peaks);
+  EXPECT_NEAR(d.flow, 2.0 / s1 + 1.0 / s2, 1e-12);  // eqs. (6)-(8)
+
+  // Without excluding anyone R3 counts too.
+  const DensityTerm all = pred.Density(route, "");
+  EXPECT_EQ(all.peaks.front(), (std::pair<ZoneId, int>{z1, 3}));
+  EXPECT_NEAR(all.flow, 3.0 / s1 + 1.0 / s2, 1e-12);
+
+  // An hour later every plan has ended: the same zones with 0, F = 0.
+  std::vector<RouteSample> later = route;
+  for (RouteSample& s : later) s.t += 3600.0;
+  const DensityTerm empty = pred.Density(later, "R3");
+  const std::vector<std::pair<ZoneId, int>> zero_peaks = {{z1, 0}, {z2, 0}, {z3, 0}};
+  EXPECT_EQ(empty.peaks, zero_peaks);
+  EXPECT_EQ(empty.flow, 0.0);
+
+  // No samples: nothing.
+  EXPECT_TRUE(pred.Density({}, "R3").peaks.empty());
+
+  // Removing R2 drops Z1's peak to R1's 1.
+  pred.RemovePlan("R2");
+  EXPECT_EQ(pred.Density(route, "R3").peaks.front(), (std::pair<ZoneId, int>{z1, 1}));
+}
+
+TEST(TrafficPredictionDensityTest, SampledPlanThroughACrowdedZone) {
+  const WarehouseMap map = BuildChu2024Floor().value();
+  TrafficPredictor pred(map, {});
+  const ZoneId z1 = map.FindZone("Z1").value(), z2 = map.FindZone("Z2").value();
+  pred.SetPlan("A", ParkedPlan({5, 5}, 0.0, 100.0));
+  pred.SetPlan("B", ParkedPlan({6, 5}, 0.0, 100.0));
+  // The bidder drives from (2, 4) in Z1 to (20, 4) in Z2, 1 m/s from t = 10.
+  Plan candidate;
+  candidate.waypoints = {{0, kNoPoint, {2, 4}, 10.0, WaypointAction::kMove, 0.0},
+                         {1, kNoPoint, {20, 4}, 28.0, WaypointAction::kDrop, 5.0}};
+  const DensityTerm d = pred.Density(SamplePlan(candidate, 1.0), "C");
+  const std::vector<std::pair<ZoneId, int>> want = {{z1, 2}, {z2, 0}};
+  EXPECT_EQ(d.peaks, want);
+  EXPECT_NEAR(d.flow, 2.0 / map.zones()[static_cast<std::size_t>(z1)].area, 1e-12);
+}
+
+// --- SamplePlan ---------------------------------------------------------------------------
+
+Plan ThreeWaypointPlan() {
+  Plan plan;
+  // 3 m east at 1 m/s after a 2 s dwell, a 4 s pick, 4 m north at 0.5 m/s, a 1 s drop.
+  plan.waypoints = {{0, kNoPoint, {0, 0}, 10.0, WaypointAction::kMove, 2.0},
+                    {1, kNoPoint, {3, 0}, 15.0, WaypointAction::kPick, 4.0},
+                    {2, kNoPoint, {3, 4}, 27.0, WaypointAction::kDrop, 1.0}};
+  return plan;
+}
+
+void ExpectSample(const RouteSample& s, double x, double y, double t) {
+  EXPECT_NEAR(s.xy.x(), x, 1e-12);
+  EXPECT_NEAR(s.xy.y(), y, 1e-12);
+  EXPECT_NEAR(s.t, t, 1e-12);
+}
+
+TEST(SamplePlanTest, SpacingFirstLastAndDwellAwareTimes) {
+  const Plan plan = ThreeWaypointPlan();
+  const std::vector<RouteSample> s = SamplePlan(plan, 2.0);
+  ASSERT_EQ(s.size(), 5u);
+  ExpectSample(s[0], 0, 0, 10.0);  // first waypoint at its eta
+  ExpectSample(s[1], 2, 0, 14.0);  // departs at 12, 2 m at 1 m/s
+  ExpectSample(s[2], 3, 1, 21.0);  // the pick's dwell: departs at 19, 1 m at 0.5 m/s
+  ExpectSample(s[3], 3, 3, 25.0);
+  ExpectSample(s[4], 3, 4, 27.0);  // last waypoint at its eta
+
+  // A sample landing on a waypoint takes its arrival time; the next one is after the dwell.
+  const std::vector<RouteSample> u = SamplePlan(plan, 1.0);
+  ASSERT_EQ(u.size(), 8u);  // 0..7 m; the last sample is the last waypoint, not repeated
+  ExpectSample(u[3], 3, 0, 15.0);
+  ExpectSample(u[4], 3, 1, 21.0);
+  ExpectSample(u[7], 3, 4, 27.0);
+
+  // A step longer than the path: first and last only.
+  const std::vector<RouteSample> v = SamplePlan(plan, 100.0);
+  ASSERT_EQ(v.size(), 2u);
+  ExpectSample(v[0], 0, 0, 10.0);
+  ExpectSample(v[1], 3, 4, 27.0);
+}
+
+TEST(SamplePlanTest, DegeneratePlans) {
+  EXPECT_TRUE(SamplePlan(Plan{}, 1.0).empty());
+  Plan one;
+  one.waypoints = {{0, kNoPoint, {1, 2}, 5.0, WaypointAction::kPark, 10.0}};
+  const std::vector<RouteSample> s = SamplePlan(one, 0.5);
+  ASSERT_EQ(s.size(), 1u);
+  ExpectSample(s[0], 1, 2, 5.0);
+
+  // Standing still between two waypoints (same xy): no extra samples, time keeps moving.
+  Plan still = ThreeWaypointPlan();
+  still.waypoints.insert(still.waypoints.begin() + 2,
+                         {2, kNoPoint, {3, 0}, 20.0, WaypointAction::kWait, 0.0});
+  still.waypoints[3].eta = 28.0;  // departs the wait at 20, 4 m in 8 s
+  const std::vector<RouteSample> w = SamplePlan(still, 2.0);
+  ASSERT_EQ(w.size(), 5u);
+  ExpectSample(w[2], 3, 1, 22.0);
+  ExpectSample(w[4], 3, 4, 28.0);
+
+  EXPECT_THROW(SamplePlan(one, 0.0), std::invalid_argument);
+  EXPECT_THROW(SamplePlan(one, std::nan("")), std::invalid_argument);
+}
+
+TEST(SamplePlanTest, ReusesTheCallersBuffer) {
+  const Plan plan = ThreeWaypointPlan();
+  std::vector<RouteSample> out;
+  SamplePlan(plan, 0.5, &out);
+  ASSERT_EQ(out.size(), 15u);
+  const RouteSample* data = out.data();
+  const std::size_t capacity = out.capacity();
+  SamplePlan(plan, 1.0, &out);
+  EXPECT_EQ(out.size(), 8u);
+  EXPECT_EQ(out.data(), data);  // no reallocation
+  EXPECT_EQ(out.capacity(), capacity);
+}
+
+// Every sample is where the plan is at the sample's time; consecutive samples are `step`
+// apart along the path (so at most `step` in a straight line); the count is
+// floor(length / step) + 1 plus the last waypoint unless a sample already landed on it.
+TEST_F(TrafficPredictionModelTest, SamplesLieOnThePlanAtTheirTimes) {
+  std::mt19937 rng(99);
+  for (int trial = 0; trial < 300; ++trial) {
+    Plan plan = RandomPlan(rng);
+    // Legs with movement need time for PositionAt to be defined along them.
+    for (std::size_t i = 1; i < plan.waypoints.size(); ++i) {
+      Waypoint& w = plan.waypoints[i];
+      const double dep = plan.waypoints[i - 1].departure();
+      if (w.eta <= dep) {
+        const double shift = dep + 0.5 - w.eta;
+        for (std::size_t j = i; j < plan.waypoints.size(); ++j) plan.waypoints[j].eta += shift;
+      }
+    }
+    const double step = 0.3 + 3.0 * (rng() % 100) / 100.0;
+    const std::vector<RouteSample> s = SamplePlan(plan, step);
+    double length = 0.0;
+    for (std::size_t i = 0; i + 1 < plan.waypoints.size(); ++i) {
+      length += (plan.waypoints[i + 1].xy - plan.waypoints[i].xy).norm();
+    }
+    const std::size_t on_grid = static_cast<std::size_t>(std::floor(length / step + 1e-9)) + 1;
+    ASSERT_GE(s.size(), on_grid);
+    ASSERT_LE(s.size(), on_grid + 1);
+    ExpectSample(s.front(), plan.waypoints.front().xy.x(), plan.waypoints.front().xy.y(),
+                 plan.start_time());
+    ExpectSample(s.back(), plan.waypoints.back().xy.x(), plan.waypoints.back().xy.y(),
+                 plan.waypoints.back().eta);
+    for (std::size_t k = 0; k < s.size(); ++k) {
+      EXPECT_LT((plan.PositionAt(s[k].t) - s[k].xy).norm(), 1e-9) << "trial " << trial;
+      if (k > 0) {
+        EXPECT_GE(s[k].t, s[k - 1].t);
+        EXPECT_LE((s[k].xy - s[k - 1].xy).norm(), step + 1e-9);
+      }
+    }
+    if (HasFailure()) return;
+  }
+}
+
+}  // namespace
+}  // namespace dispatch::engine
