@@ -1,0 +1,38 @@
+#include "engine/allocation/allocation_config.h"
+
+#include <cmath>
+#include <string>
+
+namespace dispatch::engine {
+
+Status ValidateAllocationConfig(const AllocationConfig& config) {
+  auto non_negative = [](const char* name, double v) -> Status {
+    if (!std::isfinite(v) || v < 0.0) {
+      return InvalidArgument(std::string("allocation config: ") + name +
+                             " must be finite and >= 0, got " + std::to_string(v));
+    }
+    return Ok{};
+  };
+  auto positive = [](const char* name, double v) -> Status {
+    if (!std::isfinite(v) || v <= 0.0) {
+      return InvalidArgument(std::string("allocation config: ") + name +
+                             " must be finite and > 0, got " + std::to_string(v));
+    }
+    return Ok{};
+  };
+  for (Status s : {non_negative("alpha", config.alpha), non_negative("beta", config.beta),
+                   non_negative("zeta", config.zeta), positive("sample_step h", config.sample_step),
+                   positive("speed v", config.speed), non_negative("hold_seconds", config.hold_seconds),
+                   positive("traffic bucket_seconds", config.traffic.bucket_seconds),
+                   positive("traffic zone_cell_size", config.traffic.zone_cell_size)}) {
+    if (!s.ok()) return s;
+  }
+  if (config.work_time_override) {
+    if (Status s = non_negative("work_time_override", *config.work_time_override); !s.ok()) {
+      return s;
+    }
+  }
+  return Ok{};
+}
+
+}  // namespace dispatch::engine

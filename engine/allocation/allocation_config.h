@@ -1,0 +1,50 @@
+// Settings of the allocation strategies (SPEC §3.2, Chu2024 §2): the bid weights of eqs.
+// (1)-(5), the sampling step h of eq. (6), the robot speed v of eq. (3), the work time t_w,
+// and the settings of the components the allocator drives (traffic prediction, formations).
+//
+// Defaults and why:
+//  - alpha = beta = 0.5: the paper's values (seed 000 §4.2, "权重设定为 0.5").
+//  - zeta = 100: the paper's traffic weight (seed 000 §4.2, Table 4). zeta = 0 gives the
+//    plain auction of eq. (1).
+//  - sample_step h = 0.5 m: the paper gives no value. Half a metre is a little more than one
+//    robot diameter (0.4 m), so no zone crossed by a route is skipped on the Chu2024 floor
+//    (its narrowest zone is metres wide), and at v = 1 m/s consecutive samples are 0.5 s
+//    apart, the traffic predictor's default time bucket.
+//  - speed v = 1 m/s: the paper gives no value; typical for warehouse robots. It must equal
+//    the RouteTable's speed (RouteTableOptions::speed), because T_d is read off the table's
+//    travel-time costs (Floyd distances / v).
+//  - hold_seconds = 300 s: the traffic predictor sees nothing of a plan after its end, but a
+//    robot does not vanish when its queue is done: it stands where its plan ends (an idle
+//    robot at its parking station). FleetState publishes each plan to the predictor with a
+//    final wait of hold_seconds there. 300 s is longer than any Chu2024 task (< 100 s), so
+//    robots stay visible over a batch; 0 disables it.
+//  - work_time_override: unset = every order's own t_w (Order::work_time, 5 s by default,
+//    see kDefaultWorkTime); set = one t_w for every order, as in the paper.
+// Plain value; validate with ValidateAllocationConfig. Thread-safe to share.
+#pragma once
+
+#include <optional>
+
+#include "engine/allocation/traffic_prediction.h"
+#include "engine/common/result.h"
+#include "engine/fleet/formation.h"
+
+namespace dispatch::engine {
+
+struct AllocationConfig {
+  double alpha = 0.5;        // weight of T_t, total time (Chu2024 eq. (1))
+  double beta = 0.5;         // weight of T_d, travel time (Chu2024 eq. (1))
+  double zeta = 100.0;       // weight of the flow F (Chu2024 eq. (5)); >= 0
+  double sample_step = 0.5;  // h, metres between route samples (Chu2024 eq. (6))
+  double speed = 1.0;        // v, m/s (Chu2024 eq. (3))
+  double hold_seconds = 300.0;  // predicted stay at a plan's end, seconds; >= 0
+  std::optional<double> work_time_override;  // t_w for every order, seconds; unset = per order
+  TrafficPredictionConfig traffic;
+  FormationOptions formation;
+};
+
+// kInvalidArgument naming the field: weights must be finite and >= 0, h and v finite and > 0,
+// a work-time override finite and >= 0.
+Status ValidateAllocationConfig(const AllocationConfig& config);
+
+}  // namespace dispatch::engine

@@ -1,0 +1,179 @@
+#include "engine/allocation/auction_allocator.h"
+
+#include <cmath>
+#include <cstdio>
+#include <limits>
+
+#include "engine/allocation/route_sampler.h"
+
+namespace dispatch::engine {
+namespace {
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+Bid UnreachableBid(const std::string& robot, double ready_time) {
+  Bid b;
+  b.robot = robot;
+  b.reachable = false;
+  b.t_d = b.t_w = b.t_t = b.bid = kInf;
+  b.ready_time = ready_time;
+  return b;
+}
+
+void FillBid(const AllocationConfig& c, const DensityTerm& density, Bid& b) {
+  b.t_t = b.t_d + b.t_w;                      // Chu2024 eq. (2)
+  b.flow = density.flow;                      // Chu2024 eqs. (6)-(8)
+  b.peaks = density.peaks;
+  b.x = c.zeta * b.flow;                      // Chu2024 eq. (5)
+  b.bid = BidValue(c.alpha, c.beta, b.t_t, b.t_d, b.x);  // Chu2024 eq. (4)
+}
+
+// Indices of the `k` lowest reachable bids (ties: robot order), skipping `skip`.
+std::vector<std::size_t> Lowest(const std::vector<Bid>& bids, std::size_t k,
+                                std::size_t skip = static_cast<std::size_t>(-1)) {
+  std::vector<std::size_t> best;
+  for (std::size_t i = 0; i < bids.size(); ++i) {
+    if (i == skip || !bids[i].reachable) continue;
+    std::size_t pos = best.size();
+    while (pos > 0 && bids[i].bid < bids[best[pos - 1]].bid) --pos;
+    if (pos < k) {
+      best.insert(best.begin() + static_cast<std::ptrdiff_t>(pos), i);
+      if (best.size() > k) best.pop_back();
+    }
+  }
+  return best;
+}
+
+std::string Money(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof(buf), "%.2f", v);
+  return buf;
+}
+
+// "R5: lowest bid 69.50 (next R3 71.20)".
+std::string WhyLowest(const std::vector<Bid>& bids, std::size_t winner, const char* what,
+                      const std::vector<std::size_t>& excluded) {
+  std::string s = bids[winner].robot + ": lowest " + what + " " + Money(bids[winner].bid);
+  std::size_t next = bids.size();
+  for (std::size_t i = 0; i < bids.size(); ++i) {
+    bool skip = i == winner || !bids[i].reachable;
+    for (std::size_t e : excluded) skip = skip || i == e;
+    if (!skip && (next == bids.size() || bids[i].bid < bids[next].bid)) next = i;
+  }
+  if (next == bids.size()) return s + " (no other bidder)";
+  if (bids[next].bid == bids[winner].bid) {
+    return s + " (tied with " + bids[next].robot + "; earlier in robot order)";
+  }
+  return s + " (next " + bids[next].robot + " " + Money(bids[next].bid) + ")";
+}
+
+}  // namespace
+
+std::vector<Bid> AuctionAllocator::ComputeBids(const FleetState& state, const PlanTask& task) {
+  const AllocationConfig& c = state.config();
+  const RouteTable& routes = state.routes();
+  RouteSampler sampler(state.map(), routes, c.speed, c.sample_step);
+  shared_.clear();
+  sampler.AppendTask(task, 0.0, shared_);
+  const double task_travel = state.TaskTravelTime(task);
+  const double task_work = TaskWorkTime(task);
+  const PointId first = task.picks.front();
+  std::vector<Bid> bids;
+  bids.reserve(state.robot_count());
+  for (std::size_t i = 0; i < state.robot_count(); ++i) {
+    const QueueSummary& s = state.summary(i);
+    const double leg = routes.Cost(s.end_point, first);
+    samples_.clear();
+    const double arrival = sampler.AppendLeg(s.end_point, first, s.end_time, samples_);
+    if (!std::isfinite(leg) || !std::isfinite(arrival) || !std::isfinite(task_travel)) {
+      bids.push_back(UnreachableBid(state.robot_id(i), s.end_time));
+      continue;
+    }
+    for (const RouteSample& r : shared_) samples_.push_back({r.xy, r.t + arrival});
+    Bid b;
+    b.robot = state.robot_id(i);
+    b.ready_time = s.end_time;
+    b.t_d = s.travel_time + leg + task_travel;  // Chu2024 eq. (3): S_d / v over the queue
+    b.t_w = s.work_time + task_work;            // Chu2024 eq. (3): n_c * t_w over the queue
+    FillBid(c, state.predictor().Density(samples_, b.robot), b);
+    bids.push_back(std::move(b));
+  }
+  return bids;
+}
+
+std::vector<Bid> AuctionAllocator::ComputeReachBids(const FleetState& state, PointId first_pick) {
+  const AllocationConfig& c = state.config();
+  const RouteTable& routes = state.routes();
+  RouteSampler sampler(state.map(), routes, c.speed, c.sample_step);
+  const Eigen::Vector2d pick_xy = state.map().point(first_pick).position;
+  std::vector<Bid> bids;
+  bids.reserve(state.robot_count());
+  for (std::size_t i = 0; i < state.robot_count(); ++i) {
+    const QueueSummary& s = state.summary(i);
+    const double leg = routes.Cost(s.end_point, first_pick);
+    samples_.clear();
+    const double arrival = sampler.AppendLeg(s.end_point, first_pick, s.end_time, samples_);
+    if (!std::isfinite(leg) || !std::isfinite(arrival)) {
+      bids.push_back(UnreachableBid(state.robot_id(i), s.end_time));
+      continue;
+    }
+    samples_.push_back({pick_xy, arrival});
+    Bid b;
+    b.robot = state.robot_id(i);
+    b.ready_time = s.end_time;
+    b.t_d = s.travel_time + leg;
+    b.t_w = s.work_time;
+    FillBid(c, state.predictor().Density(samples_, b.robot), b);
+    bids.push_back(std::move(b));
+  }
+  return bids;
+}
+
+Result<AwardExplanation> AuctionAllocator::Allocate(const Order& order, FleetState& state) {
+  Result<PlanTask> task = PrepareOrder(order, state);
+  if (!task.ok()) return task.error();
+  const std::string first_name = "'" + state.map().point(task->picks.front()).name + "'";
+  AwardExplanation ex;
+  ex.order_id = order.id;
+  ex.strategy = std::string(name());
+  ex.bids = ComputeBids(state, *task);
+  const std::vector<std::size_t> leader = Lowest(ex.bids, 1);
+  if (leader.empty()) {
+    return Unreachable("order " + order.id + ": no robot can reach the first pick " + first_name);
+  }
+  const std::size_t lead = leader.front();
+  ex.reason = WhyLowest(ex.bids, lead, "bid", {});
+  if (!order.formation) {
+    if (Status s = state.AssignSingle(lead, order.id, *task); !s.ok()) return s.error();
+    ex.winners = {ex.bids[lead].robot};
+    return ex;
+  }
+  // Chu2024 §2.2: the two robots with the lowest cost to reach the first pick join.
+  std::vector<Bid> reach = ComputeReachBids(state, task->picks.front());
+  const std::vector<std::size_t> companions = Lowest(reach, 2, lead);
+  if (companions.size() < 2) {
+    return Unreachable("order " + order.id + ": a formation needs 2 companions for leader " +
+                       ex.bids[lead].robot + ", only " + std::to_string(companions.size()) +
+                       " other robot(s) can reach the first pick " + first_name);
+  }
+  if (Status s = state.AssignFormation({lead, companions[0], companions[1]}, order.id, *task);
+      !s.ok()) {
+    return s.error();
+  }
+  ex.winners = {ex.bids[lead].robot, reach[companions[0]].robot, reach[companions[1]].robot};
+  ex.reason = "leader " + ex.reason + "; companions " + reach[companions[0]].robot + " (" +
+              Money(reach[companions[0]].bid) + ") and " + reach[companions[1]].robot + " (" +
+              Money(reach[companions[1]].bid) + "): lowest costs to reach the first pick " +
+              first_name;
+  {
+    std::string next = WhyLowest(reach, companions[1], "reach cost", {lead, companions[0]});
+    const std::size_t paren = next.find(" (");
+    if (paren != std::string::npos) ex.reason += next.substr(paren);
+  }
+  for (std::size_t i = 0; i < reach.size(); ++i) {
+    if (i != lead) ex.companion_bids.push_back(std::move(reach[i]));
+  }
+  return ex;
+}
+
+}  // namespace dispatch::engine

@@ -1,0 +1,177 @@
+#include "engine/allocation/fleet_state.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "engine/fleet/formation.h"
+
+namespace dispatch::engine {
+
+Result<FleetState> FleetState::Create(std::shared_ptr<const WarehouseMap> map,
+                                      std::shared_ptr<const RouteTable> routes,
+                                      const std::vector<FleetRobot>& robots,
+                                      const AllocationConfig& config) {
+  if (!map) return InvalidArgument("fleet state: null map");
+  if (!routes) return InvalidArgument("fleet state: null route table");
+  if (Status s = ValidateAllocationConfig(config); !s.ok()) return s.error();
+  FleetState state;
+  state.map_ = std::move(map);
+  state.routes_ = std::move(routes);
+  state.config_ = config;
+  state.predictor_ = std::make_unique<TrafficPredictor>(*state.map_, config.traffic);
+  for (const FleetRobot& r : robots) {
+    if (r.id.empty()) return InvalidArgument("fleet state: a robot has an empty id");
+    if (state.index_.count(r.id) != 0) {
+      return InvalidArgument("fleet state: duplicate robot id '" + r.id + "'");
+    }
+    if (r.start < 0 || static_cast<std::size_t>(r.start) >= state.map_->point_count()) {
+      return NotFound("fleet state: robot '" + r.id + "' starts at unknown point id " +
+                      std::to_string(r.start));
+    }
+    if (!std::isfinite(r.ready_time)) {
+      return InvalidArgument("fleet state: robot '" + r.id + "' has a non-finite ready time");
+    }
+    RobotEntry e;
+    e.info = r;
+    e.summary.end_point = r.start;
+    e.summary.end_time = r.ready_time;
+    Waypoint w;
+    w.point = r.start;
+    w.xy = state.map_->point(r.start).position;
+    w.eta = r.ready_time;
+    e.plan.robot_id = r.id;
+    e.plan.waypoints.push_back(w);
+    state.index_.emplace(r.id, state.robots_.size());
+    state.robots_.push_back(std::move(e));
+  }
+  for (const RobotEntry& e : state.robots_) state.Publish(e);
+  return state;
+}
+
+std::optional<std::size_t> FleetState::FindRobot(const std::string& id) const {
+  auto it = index_.find(id);
+  if (it == index_.end()) return std::nullopt;
+  return it->second;
+}
+
+PlanTask FleetState::TaskOf(const std::vector<PointId>& picks, PointId drop,
+                            double order_work_time) const {
+  PlanTask task;
+  task.picks = picks;
+  task.drop = drop;
+  task.work_time = config_.work_time_override.value_or(order_work_time);
+  return task;
+}
+
+double FleetState::TaskTravelTime(const PlanTask& task) const {
+  if (task.picks.empty()) return std::numeric_limits<double>::infinity();
+  double total = 0.0;
+  for (std::size_t k = 0; k + 1 < task.picks.size(); ++k) {
+    total += routes_->Cost(task.picks[k], task.picks[k + 1]);
+  }
+  return total + routes_->Cost(task.picks.back(), task.drop);
+}
+
+void FleetState::AppendSegment(Plan& plan, const std::vector<Waypoint>& segment) {
+  for (std::size_t k = 1; k < segment.size(); ++k) {
+    Waypoint w = segment[k];
+    w.seq = static_cast<int>(plan.waypoints.size());
+    plan.waypoints.push_back(w);
+  }
+}
+
+void FleetState::Publish(const RobotEntry& e) {
+  if (config_.hold_seconds <= 0.0) {
+    predictor_->SetPlan(e.info.id, e.plan);
+    return;
+  }
+  Plan held = e.plan;
+  Waypoint w = held.waypoints.back();
+  w.seq = static_cast<int>(held.waypoints.size());
+  w.eta = w.departure();
+  w.action = WaypointAction::kWait;
+  w.dwell = config_.hold_seconds;
+  held.waypoints.push_back(w);
+  predictor_->SetPlan(e.info.id, held);
+}
+
+Status FleetState::AssignSingle(std::size_t robot, const std::string& order_id,
+                                const PlanTask& task) {
+  if (robot >= robots_.size()) {
+    return NotFound("order " + order_id + ": unknown robot index " + std::to_string(robot));
+  }
+  RobotEntry& e = robots_[robot];
+  const QueueSummary& s = e.summary;
+  Result<Plan> segment = BuildPlan(*map_, *routes_, s.end_point, s.end_time, config_.speed, {task});
+  if (!segment.ok()) {
+    return Error{segment.error().code,
+                 "order " + order_id + " for robot " + e.info.id + ": " + segment.error().message};
+  }
+  const double travel = routes_->Cost(s.end_point, task.picks.front()) + TaskTravelTime(task);
+  QueuedTask q{order_id, task, {e.info.id}, s.end_time, segment->end_time()};
+  AppendSegment(e.plan, segment->waypoints);
+  e.summary.end_point = task.drop;
+  e.summary.end_time = e.plan.end_time();
+  e.summary.travel_time += travel;
+  e.summary.work_time += TaskWorkTime(task);
+  e.queue.push_back(std::move(q));
+  Publish(e);
+  return Ok{};
+}
+
+Status FleetState::AssignFormation(const std::array<std::size_t, 3>& team,
+                                   const std::string& order_id, const PlanTask& task) {
+  for (std::size_t i = 0; i < team.size(); ++i) {
+    if (team[i] >= robots_.size()) {
+      return NotFound("order " + order_id + ": unknown robot index " + std::to_string(team[i]));
+    }
+    for (std::size_t j = 0; j < i; ++j) {
+      if (team[i] == team[j]) {
+        return InvalidArgument("order " + order_id + ": formation member " +
+                               robots_[team[i]].info.id + " appears twice");
+      }
+    }
+  }
+  if (task.picks.empty()) return InvalidArgument("order " + order_id + ": no pick points");
+  std::vector<PointId> starts;
+  for (std::size_t m : team) starts.push_back(robots_[m].summary.end_point);
+  // Built from time 0, then each member's leg is shifted to its own ready time and the
+  // formation part to the common rendezvous time T_r.
+  Result<FormationPlans> f = BuildFormationPlans(*map_, *routes_, starts, 0.0, config_.speed,
+                                                 task, config_.formation);
+  if (!f.ok()) {
+    return Error{f.error().code, "order " + order_id + ": " + f.error().message};
+  }
+  FormationPlans& plans = f.value();
+  double rendezvous = 0.0;
+  for (std::size_t i = 0; i < team.size(); ++i) {
+    const Waypoint& slot = plans.members[i].waypoints[plans.formation_start[i] - 1];
+    rendezvous = std::max(rendezvous, slot.eta + robots_[team[i]].summary.end_time);
+  }
+  const double formation_shift = rendezvous - plans.rendezvous_time;
+  const double task_travel = TaskTravelTime(task);
+  for (std::size_t i = 0; i < team.size(); ++i) {
+    RobotEntry& e = robots_[team[i]];
+    std::vector<Waypoint>& w = plans.members[i].waypoints;
+    const std::size_t fs = plans.formation_start[i];
+    for (std::size_t k = 0; k < fs; ++k) w[k].eta += e.summary.end_time;
+    w[fs - 1].dwell = rendezvous - w[fs - 1].eta;  // the slot: wait for the last member
+    for (std::size_t k = fs; k < w.size(); ++k) w[k].eta += formation_shift;
+    const double travel = routes_->Cost(e.summary.end_point, task.picks.front()) + task_travel;
+    std::vector<std::string> names;
+    for (std::size_t m : team) names.push_back(robots_[m].info.id);
+    QueuedTask q{order_id, task, std::move(names), e.summary.end_time, 0.0};
+    AppendSegment(e.plan, w);
+    e.summary.end_point = task.drop;
+    e.summary.end_time = e.plan.end_time();
+    e.summary.travel_time += travel;
+    e.summary.work_time += TaskWorkTime(task);
+    q.end_time = e.summary.end_time;
+    e.queue.push_back(std::move(q));
+    Publish(e);
+  }
+  return Ok{};
+}
+
+}  // namespace dispatch::engine

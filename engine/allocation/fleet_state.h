@@ -1,0 +1,123 @@
+// FleetState: the allocator's view of the fleet (SPEC §3.2, Chu2024 §2.2 "each robot has a
+// sequence of assigned tasks, updated after every round").
+//
+// Per robot (in the order added, which is the auction's tie-break order): its id, start point
+// and ready time, the queue of awarded tasks, its timed Plan (SPEC §3.4) and a summary of the
+// queue for O(1) bids: where and when the queue ends, and its accumulated travel time T_d
+// (sum of route-table costs between consecutive stops, i.e. Floyd distances / v) and work
+// time T_w (n_c * t_w per task, Chu2024 eq. (3)). The TrafficPredictor holds every robot's
+// current plan followed by a wait of AllocationConfig::hold_seconds where it ends (so idle,
+// parked and finished robots still count; an idle robot's plan is its start waypoint).
+//
+// Tasks are only ever appended. A single task's plan segment is BuildPlan from the queue's
+// end point and end time. A formation task (Chu2024 §3.2) is BuildFormationPlans for its three
+// members, where each member's leg to the first pick starts when that member has finished its
+// own earlier queue, and the formation departs when the last member is in its slot (T_r);
+// members wait in their slots until then (that wait is in the plan's times, not in T_d/T_w).
+//
+// Invariants: every plan is the concatenation of its queue's segments, so a robot never has
+// two overlapping pieces of work (etas non-decreasing along the plan); summaries and the
+// predictor match the plans after every Assign*. An Assign* that fails changes nothing.
+// Not thread-safe: one allocator mutates a FleetState at a time. Move-only (the predictor is
+// not meant to be shared between copies).
+#pragma once
+
+#include <array>
+#include <cstddef>
+#include <memory>
+#include <optional>
+#include <string>
+#include <unordered_map>
+#include <vector>
+
+#include "engine/allocation/allocation_config.h"
+#include "engine/allocation/traffic_prediction.h"
+#include "engine/common/result.h"
+#include "engine/fleet/plan.h"
+#include "engine/map/warehouse_map.h"
+#include "engine/routing/route_table.h"
+
+namespace dispatch::engine {
+
+struct FleetRobot {
+  std::string id;
+  PointId start = kNoPoint;
+  double ready_time = 0.0;  // seconds; when the robot can start its first task
+};
+
+struct QueuedTask {
+  std::string order_id;
+  PlanTask task;
+  std::vector<std::string> team;  // formation: the 3 members, leader first; single: {robot}
+  double start_time = 0.0;        // when the robot leaves for this task
+  double end_time = 0.0;          // departure from the drop (after its work)
+};
+
+struct QueueSummary {
+  PointId end_point = kNoPoint;  // where the queue ends (start point if empty)
+  double end_time = 0.0;         // when it ends (ready time if empty)
+  double travel_time = 0.0;      // T_d of the queue so far, s
+  double work_time = 0.0;        // T_w of the queue so far, s
+};
+
+class FleetState {
+ public:
+  // Errors (kInvalidArgument / kNotFound) name the robot or field: bad config, null map or
+  // routes, empty or duplicate robot ids, unknown start points, non-finite ready times.
+  static Result<FleetState> Create(std::shared_ptr<const WarehouseMap> map,
+                                   std::shared_ptr<const RouteTable> routes,
+                                   const std::vector<FleetRobot>& robots,
+                                   const AllocationConfig& config = {});
+
+  FleetState(FleetState&&) = default;
+  FleetState& operator=(FleetState&&) = default;
+  FleetState(const FleetState&) = delete;
+  FleetState& operator=(const FleetState&) = delete;
+
+  std::size_t robot_count() const { return robots_.size(); }
+  const std::string& robot_id(std::size_t robot) const { return robots_.at(robot).info.id; }
+  std::optional<std::size_t> FindRobot(const std::string& id) const;
+  const FleetRobot& robot(std::size_t robot) const { return robots_.at(robot).info; }
+  const QueueSummary& summary(std::size_t robot) const { return robots_.at(robot).summary; }
+  const std::vector<QueuedTask>& queue(std::size_t robot) const { return robots_.at(robot).queue; }
+  const Plan& plan(std::size_t robot) const { return robots_.at(robot).plan; }
+
+  const WarehouseMap& map() const { return *map_; }
+  const RouteTable& routes() const { return *routes_; }
+  const AllocationConfig& config() const { return config_; }
+  const TrafficPredictor& predictor() const { return *predictor_; }
+
+  // The PlanTask of an order under this config (t_w = override or the order's own).
+  PlanTask TaskOf(const std::vector<PointId>& picks, PointId drop, double order_work_time) const;
+  // Table cost of serving `task` once at its first pick: pick -> pick ... -> drop, seconds
+  // (+infinity if some leg is unreachable).
+  double TaskTravelTime(const PlanTask& task) const;
+
+  // Appends `task` to robot's queue and plan. Errors: unknown robot index, unreachable legs.
+  Status AssignSingle(std::size_t robot, const std::string& order_id, const PlanTask& task);
+  // Appends a formation task to the three distinct members' queues (team[0] leads).
+  Status AssignFormation(const std::array<std::size_t, 3>& team, const std::string& order_id,
+                         const PlanTask& task);
+
+ private:
+  struct RobotEntry {
+    FleetRobot info;
+    std::vector<QueuedTask> queue;
+    Plan plan;
+    QueueSummary summary;
+  };
+  FleetState() = default;
+  // Appends `segment` (its waypoint 0 repeats the plan's end and is dropped) to the plan.
+  static void AppendSegment(Plan& plan, const std::vector<Waypoint>& segment);
+  // Gives the predictor robot e's plan plus a final wait of config_.hold_seconds.
+  void Publish(const RobotEntry& e);
+
+  std::shared_ptr<const WarehouseMap> map_;
+  std::shared_ptr<const RouteTable> routes_;
+  AllocationConfig config_;
+  std::vector<RobotEntry> robots_;
+  std::unordered_map<std::string, std::size_t> index_;
+  std::unique_ptr<TrafficPredictor> predictor_;
+};
+
+}  // namespace dispatch::engine

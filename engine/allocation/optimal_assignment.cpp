@@ -1,0 +1,189 @@
+#include "engine/allocation/optimal_assignment.h"
+
+#include <cmath>
+#include <limits>
+
+#include "engine/allocation/allocator.h"
+
+namespace dispatch::engine {
+namespace {
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+struct BatchTask {
+  PointId first = kNoPoint;
+  PointId drop = kNoPoint;
+  double travel = 0.0;  // pick -> ... -> drop
+  double work = 0.0;    // n_c * t_w
+};
+
+Result<std::vector<BatchTask>> Prepare(const FleetState& state, const std::vector<Order>& orders) {
+  std::vector<BatchTask> tasks;
+  for (const Order& o : orders) {
+    if (o.formation) {
+      return InvalidArgument("order " + o.id + ": optimal assignment handles single-robot orders "
+                             "only, this one needs a formation");
+    }
+    Result<PlanTask> t = PrepareOrder(o, state);
+    if (!t.ok()) return t.error();
+    tasks.push_back({t->picks.front(), t->drop, state.TaskTravelTime(*t), TaskWorkTime(*t)});
+  }
+  return tasks;
+}
+
+// Sum over robots of eq. (1) for the final queues.
+double Total(const FleetState& state, const std::vector<BatchTask>& tasks,
+             const std::vector<std::size_t>& robot_of_order) {
+  const AllocationConfig& c = state.config();
+  double total = 0.0;
+  for (std::size_t r = 0; r < state.robot_count(); ++r) {
+    const QueueSummary& s = state.summary(r);
+    double travel = s.travel_time;
+    double work = s.work_time;
+    PointId at = s.end_point;
+    for (std::size_t k = 0; k < tasks.size(); ++k) {
+      if (robot_of_order[k] != r) continue;
+      travel += state.routes().Cost(at, tasks[k].first) + tasks[k].travel;
+      work += tasks[k].work;
+      at = tasks[k].drop;
+    }
+    total += c.alpha * (travel + work) + c.beta * travel;  // Chu2024 eqs. (1)-(3)
+  }
+  return total;
+}
+
+}  // namespace
+
+Result<double> BatchCost(const FleetState& state, const std::vector<Order>& orders,
+                         const std::vector<std::size_t>& robot_of_order) {
+  if (robot_of_order.size() != orders.size()) {
+    return InvalidArgument("batch cost: " + std::to_string(orders.size()) + " orders but " +
+                           std::to_string(robot_of_order.size()) + " robot indices");
+  }
+  for (std::size_t r : robot_of_order) {
+    if (r >= state.robot_count()) return NotFound("batch cost: unknown robot index " + std::to_string(r));
+  }
+  Result<std::vector<BatchTask>> tasks = Prepare(state, orders);
+  if (!tasks.ok()) return tasks.error();
+  return Total(state, *tasks, robot_of_order);
+}
+
+Result<BatchAssignment> BruteForceAssignment(const FleetState& state,
+                                             const std::vector<Order>& orders,
+                                             const OptimalAssignmentOptions& options) {
+  Result<std::vector<BatchTask>> tasks = Prepare(state, orders);
+  if (!tasks.ok()) return tasks.error();
+  const std::size_t m = state.robot_count();
+  const std::size_t n = orders.size();
+  if (m == 0 && n > 0) return Error{ErrorCode::kFailedPrecondition, "brute force: no robots"};
+  double maps = 1.0;
+  for (std::size_t k = 0; k < n; ++k) maps *= static_cast<double>(m);
+  if (maps > static_cast<double>(options.max_maps)) {
+    return Error{ErrorCode::kFailedPrecondition,
+                 "brute force: " + std::to_string(m) + "^" + std::to_string(n) +
+                     " maps exceed the limit of " + std::to_string(options.max_maps)};
+  }
+  BatchAssignment best{{}, kInf};
+  std::vector<std::size_t> map(n, 0);
+  std::vector<bool> used(m, false);
+  // Lexicographic enumeration: order 0's robot varies slowest.
+  auto visit = [&](auto&& self, std::size_t k) -> void {
+    if (k == n) {
+      const double cost = Total(state, *tasks, map);
+      if (cost < best.cost) best = {map, cost};
+      return;
+    }
+    for (std::size_t r = 0; r < m; ++r) {
+      if (options.one_order_per_robot && used[r]) continue;
+      map[k] = r;
+      used[r] = true;
+      self(self, k + 1);
+      used[r] = false;
+    }
+  };
+  visit(visit, 0);
+  if (!std::isfinite(best.cost)) {
+    return Unreachable("brute force: no assignment of the " + std::to_string(n) +
+                       " orders has a finite cost");
+  }
+  return best;
+}
+
+Result<BatchAssignment> HungarianAssignment(const FleetState& state,
+                                            const std::vector<Order>& orders) {
+  Result<std::vector<BatchTask>> tasks = Prepare(state, orders);
+  if (!tasks.ok()) return tasks.error();
+  const std::size_t n = orders.size();
+  const std::size_t m = state.robot_count();
+  if (n > m) {
+    return Error{ErrorCode::kFailedPrecondition,
+                 "hungarian: " + std::to_string(n) + " orders but only " + std::to_string(m) +
+                     " robots (one order per robot)"};
+  }
+  const AllocationConfig& c = state.config();
+  // Marginal cost of appending order k to robot r's queue; unreachable = a large finite cost.
+  constexpr double kBig = 1e15;
+  std::vector<std::vector<double>> a(n + 1, std::vector<double>(m + 1, 0.0));
+  for (std::size_t k = 0; k < n; ++k) {
+    for (std::size_t r = 0; r < m; ++r) {
+      const BatchTask& t = (*tasks)[k];
+      const double travel = state.routes().Cost(state.summary(r).end_point, t.first) + t.travel;
+      const double cost = c.alpha * (travel + t.work) + c.beta * travel;
+      a[k + 1][r + 1] = std::isfinite(cost) ? cost : kBig;
+    }
+  }
+  // Rows = orders (n), columns = robots (m >= n); potentials u, v; p[j] = row of column j.
+  std::vector<double> u(n + 1, 0.0), v(m + 1, 0.0);
+  std::vector<std::size_t> p(m + 1, 0), way(m + 1, 0);
+  for (std::size_t i = 1; i <= n; ++i) {
+    p[0] = i;
+    std::size_t j0 = 0;
+    std::vector<double> minv(m + 1, kInf);
+    std::vector<bool> used(m + 1, false);
+    do {
+      used[j0] = true;
+      const std::size_t i0 = p[j0];
+      double delta = kInf;
+      std::size_t j1 = 0;
+      for (std::size_t j = 1; j <= m; ++j) {
+        if (used[j]) continue;
+        const double cur = a[i0][j] - u[i0] - v[j];
+        if (cur < minv[j]) {
+          minv[j] = cur;
+          way[j] = j0;
+        }
+        if (minv[j] < delta) {
+          delta = minv[j];
+          j1 = j;
+        }
+      }
+      for (std::size_t j = 0; j <= m; ++j) {
+        if (used[j]) {
+          u[p[j]] += delta;
+          v[j] -= delta;
+        } else {
+          minv[j] -= delta;
+        }
+      }
+      j0 = j1;
+    } while (p[j0] != 0);
+    do {
+      const std::size_t j1 = way[j0];
+      p[j0] = p[j1];
+      j0 = j1;
+    } while (j0 != 0);
+  }
+  BatchAssignment result;
+  result.robot_of_order.assign(n, 0);
+  for (std::size_t j = 1; j <= m; ++j) {
+    if (p[j] != 0) result.robot_of_order[p[j] - 1] = j - 1;
+  }
+  result.cost = Total(state, *tasks, result.robot_of_order);
+  if (!std::isfinite(result.cost)) {
+    return Unreachable("hungarian: no one-order-per-robot assignment of the " +
+                       std::to_string(n) + " orders has a finite cost");
+  }
+  return result;
+}
+
+}  // namespace dispatch::engine

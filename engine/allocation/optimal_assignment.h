@@ -1,0 +1,53 @@
+// Exact optimal assignment of a small batch of single-robot orders: the yardstick for the
+// auction (SPEC §3.2 "an exact optimal assignment for small batches").
+//
+// Batch cost of a map order -> robot (each robot serves its new orders after its current
+// queue, in batch order): the sum over ALL robots of Chu2024 eq. (1),
+// alpha * T_t,i + beta * T_d,i, of the final queues, with T_d from route-table costs and
+// T_w = n_c * t_w exactly as the auction's bids (the traffic term is not part of it). Robots
+// without new orders contribute their current queue's constant cost.
+//
+//  - BruteForceAssignment: the minimum over all robot_count^order_count maps (optionally only
+//    injective ones); ties go to the first map in lexicographic order of robot indices.
+//  - HungarianAssignment: the one-order-per-robot case (orders <= robots) in O(n^2 m) on the
+//    marginal cost matrix; equals BruteForceAssignment with one_order_per_robot.
+// Formation orders are rejected (kInvalidArgument). Pure functions of the FleetState (read
+// only); thread-safe for concurrent const use of one state.
+#pragma once
+
+#include <cstddef>
+#include <vector>
+
+#include "engine/allocation/fleet_state.h"
+#include "engine/common/result.h"
+#include "engine/fleet/order.h"
+
+namespace dispatch::engine {
+
+struct BatchAssignment {
+  std::vector<std::size_t> robot_of_order;  // per order, in batch order: a robot index
+  double cost = 0.0;                        // BatchCost of that map
+};
+
+struct OptimalAssignmentOptions {
+  bool one_order_per_robot = false;
+  // Brute force refuses (kFailedPrecondition) batches with more maps than this.
+  std::size_t max_maps = 1'000'000;
+};
+
+// The batch cost of `robot_of_order` (+infinity if some robot cannot reach its order).
+// Errors: bad orders (see PrepareOrder), formation orders, size mismatch, unknown robot.
+Result<double> BatchCost(const FleetState& state, const std::vector<Order>& orders,
+                         const std::vector<std::size_t>& robot_of_order);
+
+// Errors as BatchCost, plus kUnreachable when no map has a finite cost.
+Result<BatchAssignment> BruteForceAssignment(const FleetState& state,
+                                             const std::vector<Order>& orders,
+                                             const OptimalAssignmentOptions& options = {});
+
+// Errors as BatchCost, plus kFailedPrecondition if orders > robots, kUnreachable if no
+// injective map has a finite cost.
+Result<BatchAssignment> HungarianAssignment(const FleetState& state,
+                                            const std::vector<Order>& orders);
+
+}  // namespace dispatch::engine

@@ -1,1 +1,0 @@
-target_sources(dispatch_engine PRIVATE traffic_prediction.cpp)

@@ -1,0 +1,148 @@
+#include "engine/allocation/fleet_state.h"
+
+#include <gtest/gtest.h>
+
+#include "allocation_test_util.h"
+
+namespace dispatch::engine {
+namespace {
+
+using testing_util::Grid;
+using testing_util::MakeFleet;
+using testing_util::Pt;
+using testing_util::Routes;
+
+// Etas never decrease and every waypoint's arrival is after the previous departure.
+void ExpectMonotone(const Plan& plan) {
+  for (std::size_t k = 1; k < plan.waypoints.size(); ++k) {
+    EXPECT_GE(plan.waypoints[k].eta + 1e-9, plan.waypoints[k - 1].departure()) << k;
+    EXPECT_EQ(plan.waypoints[k].seq, static_cast<int>(k));
+  }
+}
+
+class FleetStateTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    map_ = Grid(6, 4, 1.0, 3, {{2, 0}, {4, 3}, {5, 0}}, {{0, 3}, {5, 3}});
+    routes_ = Routes(map_);
+  }
+  PlanTask Task(const char* pick, const char* drop, double tw = 2.0) {
+    return PlanTask{{Pt(*map_, pick)}, Pt(*map_, drop), tw};
+  }
+  std::shared_ptr<const WarehouseMap> map_;
+  std::shared_ptr<const RouteTable> routes_;
+};
+
+TEST_F(FleetStateTest, CreateRejectsBadRobotsAndConfig) {
+  EXPECT_FALSE(FleetState::Create(map_, routes_, {{"", 0, 0.0}}).ok());
+  EXPECT_FALSE(FleetState::Create(map_, routes_, {{"A", 0, 0.0}, {"A", 1, 0.0}}).ok());
+  Result<FleetState> unknown = FleetState::Create(map_, routes_, {{"A", 999, 0.0}});
+  ASSERT_FALSE(unknown.ok());
+  EXPECT_NE(unknown.error().message.find("'A'"), std::string::npos);
+  AllocationConfig bad;
+  bad.sample_step = 0.0;
+  Result<FleetState> s = FleetState::Create(map_, routes_, {{"A", 0, 0.0}}, bad);
+  ASSERT_FALSE(s.ok());
+  EXPECT_NE(s.error().message.find("sample_step"), std::string::npos);
+  EXPECT_FALSE(FleetState::Create(nullptr, routes_, {}).ok());
+}
+
+TEST_F(FleetStateTest, SecondTaskStartsWhenTheFirstEnds) {
+  FleetState s = MakeFleet(map_, routes_, {{"A", Pt(*map_, "0,0"), 1.0}});
+  EXPECT_EQ(s.summary(0).end_time, 1.0);
+  ASSERT_TRUE(s.AssignSingle(0, "o1", Task("2,0", "0,3")).ok());
+  // 0,0 -> 2,0 (2 m) work 2 s, -> 0,3 (5 m) work 2 s.
+  EXPECT_DOUBLE_EQ(s.summary(0).end_time, 1.0 + 2 + 2 + 5 + 2);
+  EXPECT_DOUBLE_EQ(s.summary(0).travel_time, 7.0);
+  EXPECT_DOUBLE_EQ(s.summary(0).work_time, 4.0);
+  EXPECT_EQ(s.summary(0).end_point, Pt(*map_, "0,3"));
+  const double first_end = s.summary(0).end_time;
+  ASSERT_TRUE(s.AssignSingle(0, "o2", Task("5,0", "5,3", 1.0)).ok());
+  ASSERT_EQ(s.queue(0).size(), 2u);
+  EXPECT_DOUBLE_EQ(s.queue(0)[1].start_time, first_end);
+  EXPECT_DOUBLE_EQ(s.queue(0)[0].end_time, first_end);
+  EXPECT_DOUBLE_EQ(s.summary(0).travel_time, 7.0 + 8.0 + 3.0);
+  EXPECT_DOUBLE_EQ(s.summary(0).work_time, 4.0 + 2.0);
+  ExpectMonotone(s.plan(0));
+  // The plan equals BuildPlan over the whole queue.
+  Result<Plan> whole = BuildPlan(*map_, *routes_, Pt(*map_, "0,0"), 1.0, 1.0,
+                                 {Task("2,0", "0,3"), Task("5,0", "5,3", 1.0)});
+  ASSERT_TRUE(whole.ok());
+  ASSERT_EQ(whole->waypoints.size(), s.plan(0).waypoints.size());
+  for (std::size_t k = 0; k < whole->waypoints.size(); ++k) {
+    EXPECT_EQ(whole->waypoints[k].point, s.plan(0).waypoints[k].point);
+    EXPECT_NEAR(whole->waypoints[k].eta, s.plan(0).waypoints[k].eta, 1e-9);
+  }
+}
+
+TEST_F(FleetStateTest, PredictionFollowsEveryAward) {
+  AllocationConfig c;
+  c.hold_seconds = 100.0;
+  FleetState s = MakeFleet(map_, routes_, {{"A", Pt(*map_, "0,0"), 0.0}, {"B", Pt(*map_, "5,3"), 0.0}}, c);
+  const TrafficPredictor& p = s.predictor();
+  const ZoneId z00 = p.ZoneAt(map_->point(Pt(*map_, "0,0")).position);
+  const ZoneId z11 = p.ZoneAt(map_->point(Pt(*map_, "5,3")).position);
+  ASSERT_NE(z00, z11);
+  // Idle robots are seen where they stand (hold_seconds).
+  EXPECT_EQ(p.CountAt(z00, 50.0), 1);
+  EXPECT_EQ(p.CountAt(z11, 50.0), 1);
+  ASSERT_TRUE(s.AssignSingle(0, "o1", Task("4,3", "5,3", 1.0)).ok());
+  // A drives to the far zone and stays there.
+  EXPECT_EQ(p.CountAt(z00, 50.0), 0);
+  EXPECT_EQ(p.CountAt(z11, 50.0), 2);
+  EXPECT_EQ(p.CountAt(z11, 50.0, "A"), 1);
+  EXPECT_EQ(p.CountAt(z00, 0.0), 1);
+}
+
+TEST_F(FleetStateTest, FormationMembersStartAfterTheirOwnQueues) {
+  FleetState s = MakeFleet(map_, routes_,
+                           {{"A", Pt(*map_, "0,0"), 0.0}, {"B", Pt(*map_, "5,3"), 0.0},
+                            {"C", Pt(*map_, "0,3"), 0.0}});
+  ASSERT_TRUE(s.AssignSingle(1, "o1", Task("4,3", "0,3", 1.0)).ok());
+  const double b_free = s.summary(1).end_time;  // 1 + 1 + 4 + 1 = 7
+  EXPECT_DOUBLE_EQ(b_free, 7.0);
+  ASSERT_TRUE(s.AssignFormation({0, 1, 2}, "f1", Task("2,0", "5,3", 1.0)).ok());
+  for (std::size_t r = 0; r < 3; ++r) {
+    ExpectMonotone(s.plan(r));
+    ASSERT_FALSE(s.queue(r).empty());
+    const QueuedTask& q = s.queue(r).back();
+    EXPECT_EQ(q.order_id, "f1");
+    EXPECT_EQ(q.team, (std::vector<std::string>{"A", "B", "C"}));
+    EXPECT_EQ(s.summary(r).end_point, Pt(*map_, "5,3"));
+  }
+  // B's leg starts at 7 from 0,3: 5 m to 2,0 plus the slot distance D_f; A and C wait for it.
+  const double d_f = FormationRadius();
+  const double rendezvous = 7.0 + 5.0 + d_f;
+  EXPECT_DOUBLE_EQ(s.queue(1).back().start_time, 7.0);
+  // All members share the formation's end.
+  EXPECT_NEAR(s.summary(0).end_time, s.summary(1).end_time, 1e-9);
+  EXPECT_NEAR(s.summary(2).end_time, s.summary(1).end_time, 1e-9);
+  EXPECT_GT(s.summary(0).end_time, rendezvous);
+  // A's slot wait ends at the rendezvous.
+  bool found = false;
+  for (const Waypoint& w : s.plan(0).waypoints) {
+    if (w.action == WaypointAction::kWait) {
+      EXPECT_NEAR(w.departure(), rendezvous, 1e-9);
+      found = true;
+    }
+  }
+  EXPECT_TRUE(found);
+  // T_d of a member: its leg to the first pick + the centre's route pick -> drop (6 m).
+  EXPECT_DOUBLE_EQ(s.summary(0).travel_time, 2.0 + 6.0);
+  EXPECT_DOUBLE_EQ(s.summary(2).travel_time, 5.0 + 6.0);
+}
+
+TEST_F(FleetStateTest, FailedAssignChangesNothing) {
+  FleetState s = MakeFleet(map_, routes_, {{"A", 0, 0.0}, {"B", 1, 0.0}, {"C", 2, 0.0}});
+  EXPECT_FALSE(s.AssignFormation({0, 0, 1}, "f", Task("2,0", "5,3")).ok());
+  EXPECT_FALSE(s.AssignSingle(7, "o", Task("2,0", "5,3")).ok());
+  PlanTask bad{{}, Pt(*map_, "5,3"), 1.0};
+  EXPECT_FALSE(s.AssignSingle(0, "o", bad).ok());
+  for (std::size_t r = 0; r < 3; ++r) {
+    EXPECT_TRUE(s.queue(r).empty());
+    EXPECT_EQ(s.plan(r).waypoints.size(), 1u);
+  }
+}
+
+}  // namespace
+}  // namespace dispatch::engine

@@ -1,0 +1,145 @@
+#include "engine/allocation/optimal_assignment.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+
+#include "allocation_test_util.h"
+#include "engine/allocation/auction_allocator.h"
+
+namespace dispatch::engine {
+namespace {
+
+using testing_util::Grid;
+using testing_util::MakeFleet;
+using testing_util::MakeOrder;
+using testing_util::Pt;
+using testing_util::Routes;
+
+// Independent model of the batch cost: each robot's final queue timed by BuildPlan; with no
+// waiting, T_t = plan duration, T_w = sum n_c t_w, T_d = T_t - T_w (Chu2024 eqs. (1)-(3)).
+double ModelCost(const FleetState& s, const std::vector<Order>& orders,
+                 const std::vector<std::size_t>& map, const AllocationConfig& c) {
+  double total = 0.0;
+  for (std::size_t r = 0; r < s.robot_count(); ++r) {
+    std::vector<PlanTask> tasks;
+    double work = 0.0;
+    for (std::size_t k = 0; k < orders.size(); ++k) {
+      if (map[k] != r) continue;
+      tasks.push_back({orders[k].picks, orders[k].drop, orders[k].work_time});
+      work += (orders[k].picks.size() + 1) * orders[k].work_time;
+    }
+    Result<Plan> plan = BuildPlan(s.map(), s.routes(), s.robot(r).start, 0.0, c.speed, tasks);
+    if (!plan.ok()) return INFINITY;
+    const double t_t = plan->end_time();
+    total += c.alpha * t_t + c.beta * (t_t - work);
+  }
+  return total;
+}
+
+TEST(OptimalAssignmentTest, RandomTinyInstances) {
+  auto map = Grid(5, 5, 1.0, 5, {{0, 4}, {4, 4}, {2, 2}, {4, 0}}, {{0, 0}, {2, 4}});
+  auto routes = Routes(map);
+  const std::vector<PointId> picks = {Pt(*map, "0,4"), Pt(*map, "4,4"), Pt(*map, "2,2"),
+                                      Pt(*map, "4,0")};
+  const std::vector<PointId> drops = {Pt(*map, "0,0"), Pt(*map, "2,4")};
+  int hungarian_checked = 0, auction_above = 0;
+  for (int seed = 0; seed < 60; ++seed) {
+    std::mt19937 rng(seed);
+    const int m = 2 + static_cast<int>(rng() % 3);
+    const int n = 2 + static_cast<int>(rng() % 3);
+    AllocationConfig c;
+    c.zeta = 0.0;
+    c.alpha = 0.5;
+    c.beta = 0.5;
+    std::vector<FleetRobot> robots;
+    for (int i = 0; i < m; ++i) {
+      robots.push_back({"R" + std::to_string(i), static_cast<PointId>(rng() % map->point_count()), 0.0});
+    }
+    std::vector<Order> orders;
+    for (int k = 0; k < n; ++k) {
+      std::vector<PointId> p = {picks[rng() % picks.size()]};
+      if (rng() % 3 == 0) p.push_back(picks[rng() % picks.size()]);
+      Order o = MakeOrder("o" + std::to_string(k), p, drops[rng() % drops.size()], false, k);
+      o.work_time = 1.0 + static_cast<double>(rng() % 4);
+      orders.push_back(o);
+    }
+    FleetState s = MakeFleet(map, routes, robots, c);
+    Result<BatchAssignment> brute = BruteForceAssignment(s, orders);
+    ASSERT_TRUE(brute.ok()) << brute.error().message;
+    // Independent enumeration of every map with the BuildPlan model.
+    double best = INFINITY;
+    std::vector<std::size_t> map_k(static_cast<std::size_t>(n), 0);
+    for (int code = 0; code < static_cast<int>(std::pow(m, n)); ++code) {
+      int x = code;
+      for (int k = n - 1; k >= 0; --k) {
+        map_k[static_cast<std::size_t>(k)] = static_cast<std::size_t>(x % m);
+        x /= m;
+      }
+      best = std::min(best, ModelCost(s, orders, map_k, c));
+    }
+    EXPECT_NEAR(brute->cost, best, 1e-6) << "seed " << seed;
+    EXPECT_NEAR(ModelCost(s, orders, brute->robot_of_order, c), brute->cost, 1e-6);
+    Result<double> again = BatchCost(s, orders, brute->robot_of_order);
+    ASSERT_TRUE(again.ok());
+    EXPECT_DOUBLE_EQ(*again, brute->cost);
+
+    if (n <= m) {
+      OptimalAssignmentOptions one;
+      one.one_order_per_robot = true;
+      Result<BatchAssignment> b1 = BruteForceAssignment(s, orders, one);
+      Result<BatchAssignment> h = HungarianAssignment(s, orders);
+      ASSERT_TRUE(b1.ok() && h.ok());
+      EXPECT_NEAR(h->cost, b1->cost, 1e-6) << "seed " << seed;
+      EXPECT_GE(h->cost, brute->cost - 1e-9);
+      std::vector<bool> used(static_cast<std::size_t>(m), false);
+      for (std::size_t r : h->robot_of_order) {
+        EXPECT_FALSE(used[r]);
+        used[r] = true;
+      }
+      ++hungarian_checked;
+    } else {
+      EXPECT_FALSE(HungarianAssignment(s, orders).ok());
+    }
+
+    // The auction (zeta = 0) on a fresh fleet: its total is never below the optimum.
+    FleetState fresh = MakeFleet(map, routes, robots, c);
+    AuctionAllocator auction;
+    const std::vector<OrderAllocation> out = AllocateAll(auction, orders, fresh);
+    std::vector<std::size_t> auction_map;
+    for (const OrderAllocation& a : out) {
+      ASSERT_TRUE(a.award.ok());
+      auction_map.push_back(*fresh.FindRobot(a.award->winners[0]));
+    }
+    double total = 0.0;
+    for (std::size_t r = 0; r < fresh.robot_count(); ++r) {
+      const QueueSummary& q = fresh.summary(r);
+      total += c.alpha * (q.travel_time + q.work_time) + c.beta * q.travel_time;
+    }
+    Result<double> auction_cost = BatchCost(s, orders, auction_map);
+    ASSERT_TRUE(auction_cost.ok());
+    EXPECT_NEAR(total, *auction_cost, 1e-9);
+    EXPECT_GE(total, brute->cost - 1e-9) << "seed " << seed;
+    if (total > brute->cost + 1e-9) ++auction_above;
+  }
+  EXPECT_GT(hungarian_checked, 10);
+  std::cout << "auction above the optimum on " << auction_above << " of 60 instances\n";
+}
+
+TEST(OptimalAssignmentTest, RejectsFormationsAndHugeBatches) {
+  auto map = Grid(3, 1, 1.0, 3, {{1, 0}}, {{2, 0}});
+  auto routes = Routes(map);
+  FleetState s = MakeFleet(map, routes, {{"R0", 0, 0.0}, {"R1", 0, 0.0}, {"R2", 0, 0.0}});
+  const Order f = MakeOrder("f", {Pt(*map, "1,0")}, Pt(*map, "2,0"), true);
+  Result<BatchAssignment> r = BruteForceAssignment(s, {f});
+  ASSERT_FALSE(r.ok());
+  EXPECT_NE(r.error().message.find("order f"), std::string::npos);
+  std::vector<Order> many(20, MakeOrder("o", {Pt(*map, "1,0")}, Pt(*map, "2,0")));
+  Result<BatchAssignment> big = BruteForceAssignment(s, many);
+  ASSERT_FALSE(big.ok());
+  EXPECT_EQ(big.error().code, ErrorCode::kFailedPrecondition);
+}
+
+}  // namespace
+}  // namespace dispatch::engine

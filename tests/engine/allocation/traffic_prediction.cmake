@@ -1,1 +1,0 @@
-dispatch_add_test(traffic_prediction_test SOURCES traffic_prediction_test.cpp LIBS dispatch_engine)
