@@ -278,8 +278,11 @@ DensityTerm TrafficPredictor::Density(const std::vector<RouteSample>& samples,
     auto it = robots_.find(robot);
     if (it != robots_.end()) own = &it->second;
   }
+  // Eq. (6): N_p,max(i) = max over the samples in zone p. A route visits few zones and
+  // consecutive samples mostly share one, so a short list with a last-zone shortcut beats
+  // sorting every sample (this runs for every robot of every auction round).
   DensityTerm term;
-  term.peaks.reserve(samples.size());
+  std::size_t last = 0;
   for (const RouteSample& s : samples) {
     const ZoneId z = ZoneAt(s.xy);
     if (z < 0) continue;
@@ -289,15 +292,14 @@ DensityTerm TrafficPredictor::Density(const std::vector<RouteSample>& samples,
       n = counts_[b * zones_.size() + static_cast<std::size_t>(z)];
       if (ZoneOf(own, b) == z) --n;
     }
-    term.peaks.emplace_back(z, n);
+    if (last >= term.peaks.size() || term.peaks[last].first != z) {
+      last = 0;
+      while (last < term.peaks.size() && term.peaks[last].first != z) ++last;
+      if (last == term.peaks.size()) term.peaks.emplace_back(z, n);
+    }
+    term.peaks[last].second = std::max(term.peaks[last].second, n);
   }
-  // Eq. (6): N_p,max(i) = max over the samples in zone p; sort by zone, highest count first.
-  std::sort(term.peaks.begin(), term.peaks.end(), [](const auto& a, const auto& b) {
-    return a.first != b.first ? a.first < b.first : a.second > b.second;
-  });
-  term.peaks.erase(std::unique(term.peaks.begin(), term.peaks.end(),
-                               [](const auto& a, const auto& b) { return a.first == b.first; }),
-                   term.peaks.end());
+  std::sort(term.peaks.begin(), term.peaks.end());
   for (const auto& [z, n_max] : term.peaks) {
     term.flow += n_max / zones_[static_cast<std::size_t>(z)].area;  // eqs. (7)-(8)
   }

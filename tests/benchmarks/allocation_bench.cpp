@@ -1,6 +1,7 @@
 // allocation_bench: one auction round (Chu2024 §2, eqs. (1)-(8), traffic prediction on) per
 // iteration: every robot bids for a new order appended to its queue, the winner (or the
-// formation team) is awarded, and queues, plans and the prediction are updated.
+// formation team, every 4th order) is awarded, and queues, plans and the prediction are
+// updated. Every robot holds 2 queued tasks when an auction starts.
 //
 //   BM_Auction/R          R robots on a 100 x 100 grid floor (1 m cells, 10 x 10 m zones,
 //                         lazy route table), each robot starting with 2 queued tasks;
@@ -11,6 +12,7 @@
 
 #include <memory>
 #include <random>
+#include <stdexcept>
 #include <string>
 
 #include "engine/allocation/auction_allocator.h"
@@ -70,27 +72,40 @@ Order RandomOrder(const Scenario& s, std::mt19937& rng, int k) {
   return o;
 }
 
-void RunAuctions(benchmark::State& state, const Scenario& s, std::vector<FleetRobot> robots) {
+// A fleet in which every robot has 2 queued tasks (the same tasks for the same seed).
+FleetState QueuedFleet(const Scenario& s, const std::vector<FleetRobot>& robots) {
   std::mt19937 rng(11);
   auto fleet = FleetState::Create(s.map, s.routes, robots).value();
   for (std::size_t r = 0; r < fleet.robot_count(); ++r) {
     for (int k = 0; k < 2; ++k) {
       const Order o = RandomOrder(s, rng, k);
       if (!fleet.AssignSingle(r, "q", fleet.TaskOf(o.picks, o.drop, o.work_time)).ok()) {
-        state.SkipWithError("queue setup failed");
-        return;
+        throw std::runtime_error("allocation_bench: queue setup failed");
       }
     }
   }
+  return fleet;
+}
+
+// Each iteration auctions one order (every 4th a formation) among robots that all hold
+// exactly 2 queued tasks: the fleet is rebuilt, untimed, after every award.
+void RunAuctions(benchmark::State& state, const Scenario& s, const std::vector<FleetRobot>& robots) {
+  std::mt19937 rng(5);
+  FleetState fleet = QueuedFleet(s, robots);
   AuctionAllocator auction;
   int k = 0;
   for (auto _ : state) {
-    auto award = auction.Allocate(RandomOrder(s, rng, ++k), fleet);
+    Order order = RandomOrder(s, rng, ++k);
+    order.formation = k % 4 == 0;
+    auto award = auction.Allocate(order, fleet);
     if (!award.ok()) {
       state.SkipWithError(award.error().message.c_str());
       return;
     }
     benchmark::DoNotOptimize(award.value().winners.data());
+    state.PauseTiming();
+    fleet = QueuedFleet(s, robots);
+    state.ResumeTiming();
   }
   state.counters["robots"] = static_cast<double>(robots.size());
   state.counters["points"] = static_cast<double>(s.map->point_count());
