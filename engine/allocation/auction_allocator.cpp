@@ -75,6 +75,11 @@ std::vector<Bid> AuctionAllocator::ComputeBids(const FleetState& state, const Pl
   RouteSampler sampler(state.map(), routes, c.speed, c.sample_step);
   shared_.clear();
   sampler.AppendTask(task, 0.0, shared_);
+  // The order's own route is the same for every bidder, only shifted in time: its zones are
+  // looked up once.
+  const TrafficPredictor& predictor = state.predictor();
+  shared_zones_.clear();
+  for (const RouteSample& r : shared_) shared_zones_.push_back(predictor.ZoneAt(r.xy));
   const double task_travel = state.TaskTravelTime(task);
   const double task_work = TaskWorkTime(task);
   const PointId first = task.picks.front();
@@ -89,13 +94,17 @@ std::vector<Bid> AuctionAllocator::ComputeBids(const FleetState& state, const Pl
       bids.push_back(UnreachableBid(state.robot_id(i), s.end_time));
       continue;
     }
-    for (const RouteSample& r : shared_) samples_.push_back({r.xy, r.t + arrival});
     Bid b;
     b.robot = state.robot_id(i);
     b.ready_time = s.end_time;
     b.t_d = s.travel_time + leg + task_travel;  // Chu2024 eq. (3): S_d / v over the queue
     b.t_w = s.work_time + task_work;            // Chu2024 eq. (3): n_c * t_w over the queue
-    FillBid(c, state.predictor().Density(samples_, b.robot), b);
+    TrafficPredictor::DensityAccumulator density(predictor, b.robot);
+    for (const RouteSample& r : samples_) density.Add(r.xy, r.t);
+    for (std::size_t k = 0; k < shared_.size(); ++k) {
+      density.Add(shared_zones_[k], shared_[k].t + arrival);
+    }
+    FillBid(c, density.Finish(), b);
     bids.push_back(std::move(b));
   }
   return bids;

@@ -41,6 +41,7 @@ class AuctionAllocator final : public Allocator {
 
  private:
   std::vector<RouteSample> shared_;   // the order's samples from its first pick, from t = 0
+  std::vector<ZoneId> shared_zones_;  // ZoneAt of each shared_ sample
   std::vector<RouteSample> samples_;  // one robot's candidate route
 };
 

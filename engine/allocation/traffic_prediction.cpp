@@ -57,6 +57,7 @@ TrafficPredictor::TrafficPredictor(const WarehouseMap& map, TrafficPredictionCon
     throw std::invalid_argument("TrafficPredictionConfig: bucket_seconds and zone_cell_size "
                                 "must be positive and finite, origin_time finite");
   }
+  inv_bucket_seconds_ = 1.0 / config_.bucket_seconds;
   BuildZoneGrid(map.floor_min(), map.floor_max());
 }
 
@@ -85,6 +86,7 @@ void TrafficPredictor::BuildZoneGrid(const Eigen::Vector2d& floor_min,
     while (cells_for(cell) > max_cells) cell *= 1.01;
   }
   cell_size_ = cell;
+  inv_cell_size_ = 1.0 / cell;
   grid_origin_ = lo - Eigen::Vector2d::Constant(cell);
   grid_cols_ = static_cast<std::int64_t>(std::floor(size.x() / cell)) + 3;
   grid_rows_ = static_cast<std::int64_t>(std::floor(size.y() / cell)) + 3;
@@ -154,8 +156,8 @@ void TrafficPredictor::BuildZoneGrid(const Eigen::Vector2d& floor_min,
 }
 
 ZoneId TrafficPredictor::ZoneAt(const Eigen::Vector2d& xy) const {
-  const double fx = (xy.x() - grid_origin_.x()) / cell_size_;
-  const double fy = (xy.y() - grid_origin_.y()) / cell_size_;
+  const double fx = (xy.x() - grid_origin_.x()) * inv_cell_size_;
+  const double fy = (xy.y() - grid_origin_.y()) * inv_cell_size_;
   // Also rejects NaN.
   if (!(fx >= 0.0 && fy >= 0.0 && fx < static_cast<double>(grid_cols_) &&
         fy < static_cast<double>(grid_rows_))) {
@@ -180,11 +182,11 @@ double TrafficPredictor::BucketStart(std::size_t b) const {
 }
 
 bool TrafficPredictor::StoredBucketOf(double t, std::size_t* bucket) const {
-  if (std::isnan(t) || bucket_count_ == 0) return false;
-  const double q = std::floor((t - config_.origin_time) / config_.bucket_seconds);
-  if (!(q < static_cast<double>(bucket_count_) + 1.0)) return false;
-  std::size_t b = q > 0.0 ? static_cast<std::size_t>(q) : 0;
-  // Snap to the exact rule (largest b with s_b <= t) against rounding of the division.
+  // Hot path (every route sample of every bid): a multiply and a truncation, no libm call.
+  const double q = (t - config_.origin_time) * inv_bucket_seconds_;
+  if (!(q < static_cast<double>(bucket_count_) + 1.0)) return false;  // also NaN
+  std::size_t b = q > 0.0 ? static_cast<std::size_t>(q) : 0;  // floor for q >= 0
+  // Snap to the exact rule (largest b with s_b <= t) against rounding of the product.
   while (b > 0 && BucketStart(b) > t) --b;
   while (BucketStart(b + 1) <= t) ++b;
   if (b >= bucket_count_) return false;
@@ -273,35 +275,44 @@ int TrafficPredictor::CountAt(ZoneId zone, double t, const std::string& exclude_
 // Chu2024 eqs. (6)-(8).
 DensityTerm TrafficPredictor::Density(const std::vector<RouteSample>& samples,
                                       const std::string& robot) const {
-  const Contribution* own = nullptr;
+  DensityAccumulator acc(*this, robot);
+  for (const RouteSample& s : samples) acc.Add(s.xy, s.t);
+  return acc.Finish();
+}
+
+TrafficPredictor::DensityAccumulator::DensityAccumulator(const TrafficPredictor& predictor,
+                                                         const std::string& robot)
+    : predictor_(&predictor) {
   if (!robot.empty()) {
-    auto it = robots_.find(robot);
-    if (it != robots_.end()) own = &it->second;
+    auto it = predictor.robots_.find(robot);
+    if (it != predictor.robots_.end()) own_ = &it->second;
+  }
+}
+
+void TrafficPredictor::DensityAccumulator::Add(ZoneId z, double t) {
+  if (z < 0) return;
+  int n = 0;  // N_p^k(i): other robots in a_p when robot i is at sample k
+  std::size_t b = 0;
+  if (predictor_->StoredBucketOf(t, &b)) {
+    n = predictor_->counts_[b * predictor_->zones_.size() + static_cast<std::size_t>(z)];
+    if (ZoneOf(own_, b) == z) --n;
   }
   // Eq. (6): N_p,max(i) = max over the samples in zone p. A route visits few zones and
-  // consecutive samples mostly share one, so a short list with a last-zone shortcut beats
-  // sorting every sample (this runs for every robot of every auction round).
-  DensityTerm term;
-  std::size_t last = 0;
-  for (const RouteSample& s : samples) {
-    const ZoneId z = ZoneAt(s.xy);
-    if (z < 0) continue;
-    int n = 0;  // N_p^k(i): other robots in a_p when robot i is at sample k
-    std::size_t b = 0;
-    if (StoredBucketOf(s.t, &b)) {
-      n = counts_[b * zones_.size() + static_cast<std::size_t>(z)];
-      if (ZoneOf(own, b) == z) --n;
-    }
-    if (last >= term.peaks.size() || term.peaks[last].first != z) {
-      last = 0;
-      while (last < term.peaks.size() && term.peaks[last].first != z) ++last;
-      if (last == term.peaks.size()) term.peaks.emplace_back(z, n);
-    }
-    term.peaks[last].second = std::max(term.peaks[last].second, n);
+  // consecutive samples mostly share one: a short list with a last-zone shortcut.
+  if (last_ >= peaks_.size() || peaks_[last_].first != z) {
+    last_ = 0;
+    while (last_ < peaks_.size() && peaks_[last_].first != z) ++last_;
+    if (last_ == peaks_.size()) peaks_.emplace_back(z, n);
   }
+  peaks_[last_].second = std::max(peaks_[last_].second, n);
+}
+
+DensityTerm TrafficPredictor::DensityAccumulator::Finish() const {
+  DensityTerm term;
+  term.peaks = peaks_;
   std::sort(term.peaks.begin(), term.peaks.end());
   for (const auto& [z, n_max] : term.peaks) {
-    term.flow += n_max / zones_[static_cast<std::size_t>(z)].area;  // eqs. (7)-(8)
+    term.flow += n_max / predictor_->zones_[static_cast<std::size_t>(z)].area;  // eqs. (7)-(8)
   }
   return term;
 }

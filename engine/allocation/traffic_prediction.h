@@ -83,8 +83,13 @@ class TrafficPredictor {
   // metres by the caller, e.g. SamplePlan): for each sample the zone ZoneAt(xy) and the count
   // of other robots CountAt(zone, t, robot); N_p,max = the peak over the samples in zone p
   // (eq. 6); F = sum_p N_p,max / S_p (eqs. 7-8). Samples in no zone are skipped; zones the
-  // route never visits are not in `peaks`. O(samples log samples).
+  // route never visits are not in `peaks`. O(samples x zones visited).
   DensityTerm Density(const std::vector<RouteSample>& samples, const std::string& robot) const;
+
+  // The same computation fed one sample at a time, for callers that already know a sample's
+  // zone (the auction reuses the zones of an order's route for every bidder). Holds pointers
+  // into the predictor: use it only while the predictor is not modified.
+  class DensityAccumulator;
 
   // Buckets with storage: one past the last bucket any plan has reached (never shrinks).
   std::size_t bucket_count() const { return bucket_count_; }
@@ -108,6 +113,8 @@ class TrafficPredictor {
   static ZoneId ZoneOf(const Contribution* c, std::size_t bucket);
 
   TrafficPredictionConfig config_;
+  double inv_bucket_seconds_ = 2.0;  // 1 / bucket_seconds
+  double inv_cell_size_ = 4.0;       // 1 / cell_size_
   std::vector<Zone> zones_;  // copies of the map's zones: polygons (Contains) and areas S_p
 
   // Zone grid: cell (cx, cy) covers origin + [cx, cx+1] x [cy, cy+1] * cell_size_. cells_ holds
@@ -125,6 +132,23 @@ class TrafficPredictor {
   std::size_t bucket_count_ = 0;
   std::vector<std::int32_t> counts_;
   std::unordered_map<std::string, Contribution> robots_;
+};
+
+class TrafficPredictor::DensityAccumulator {
+ public:
+  // Counts exclude robot `robot`'s own plan (none when empty or unknown).
+  DensityAccumulator(const TrafficPredictor& predictor, const std::string& robot);
+  // A sample in `zone` (skipped when < 0) at time t.
+  void Add(ZoneId zone, double t);
+  void Add(const Eigen::Vector2d& xy, double t) { Add(predictor_->ZoneAt(xy), t); }
+  // Eqs. (6)-(8) over the samples added so far; peaks sorted by zone id.
+  DensityTerm Finish() const;
+
+ private:
+  const TrafficPredictor* predictor_;
+  const Contribution* own_ = nullptr;
+  std::vector<std::pair<ZoneId, int>> peaks_;  // N_p,max so far, in order of first visit
+  std::size_t last_ = 0;                       // index of the last zone added
 };
 
 // Samples a timed plan every `step` metres of travelled distance along its path (the

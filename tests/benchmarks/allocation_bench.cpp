@@ -123,6 +123,26 @@ void BM_Auction(benchmark::State& state) {
 }
 BENCHMARK(BM_Auction)->Arg(18)->Arg(100)->Arg(1000)->Unit(benchmark::kMillisecond);
 
+// Only the bidding of one round (every robot's B_i with F_i), no award: the auction's core.
+void BM_AuctionBids(benchmark::State& state) {
+  static const Scenario s = GridScenario();
+  std::mt19937 rng(3);
+  std::vector<FleetRobot> robots;
+  for (int i = 0; i < state.range(0); ++i) {
+    robots.push_back({"R" + std::to_string(i + 1),
+                      static_cast<PointId>(rng() % s.map->point_count()), 0.0});
+  }
+  FleetState fleet = QueuedFleet(s, robots);
+  AuctionAllocator auction;
+  int k = 0;
+  for (auto _ : state) {
+    const Order order = RandomOrder(s, rng, ++k);
+    auto bids = auction.ComputeBids(fleet, fleet.TaskOf(order.picks, order.drop, order.work_time));
+    benchmark::DoNotOptimize(bids.data());
+  }
+}
+BENCHMARK(BM_AuctionBids)->Arg(1000)->Unit(benchmark::kMillisecond);
+
 void BM_AuctionChu2024(benchmark::State& state) {
   static const Scenario s = Chu2024Scenario();
   std::vector<FleetRobot> robots;
