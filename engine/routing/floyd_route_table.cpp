@@ -6,16 +6,6 @@
 #include "engine/routing/dijkstra.h"
 
 namespace dispatch::engine {
-namespace {
-
-std::string Describe(const WarehouseMap& map, PointId p) {
-  if (p < 0 || static_cast<std::size_t>(p) >= map.point_count()) {
-    return "unknown point " + std::to_string(p);
-  }
-  return "point '" + map.point(p).name + "' (" + std::to_string(p) + ")";
-}
-
-}  // namespace
 
 Result<std::unique_ptr<FloydRouteTable>> FloydRouteTable::Build(
     std::shared_ptr<const WarehouseMap> map, const RouteTableOptions& options,
@@ -86,14 +76,13 @@ PointId FloydRouteTable::NextHop(PointId from, PointId to) const {
 
 Result<Route> FloydRouteTable::Path(PointId from, PointId to) const {
   if (!Known(from) || !Known(to)) {
-    return NotFound("no route from " + Describe(*map_, from) + " to " + Describe(*map_, to) +
-                    ": unknown point");
+    return NoRouteError(*map_, from, to);
   }
   const VertexId arrival = Arrival(from, to);
   std::vector<VertexId> path;
   if (arrival != kNoVertex) path = WalkNext(table_, from, arrival);
   if (path.empty()) {
-    return Unreachable("no route from " + Describe(*map_, from) + " to " + Describe(*map_, to));
+    return NoRouteError(*map_, from, to);
   }
   return RouteFromVertexPath(*map_, graph_, path);
 }

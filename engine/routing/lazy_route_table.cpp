@@ -6,16 +6,6 @@
 #include "engine/routing/dijkstra.h"
 
 namespace dispatch::engine {
-namespace {
-
-std::string Describe(const WarehouseMap& map, PointId p) {
-  if (p < 0 || static_cast<std::size_t>(p) >= map.point_count()) {
-    return "unknown point " + std::to_string(p);
-  }
-  return "point '" + map.point(p).name + "' (" + std::to_string(p) + ")";
-}
-
-}  // namespace
 
 Result<std::unique_ptr<LazyRouteTable>> LazyRouteTable::Build(
     std::shared_ptr<const WarehouseMap> map, const RouteTableOptions& options) {
@@ -74,13 +64,12 @@ PointId LazyRouteTable::NextHop(PointId from, PointId to) const {
 
 Result<Route> LazyRouteTable::Path(PointId from, PointId to) const {
   if (!Known(from) || !Known(to)) {
-    return NotFound("no route from " + Describe(*map_, from) + " to " + Describe(*map_, to) +
-                    ": unknown point");
+    return NoRouteError(*map_, from, to);
   }
   if (from == to) return Route{{from}, {}, 0.0, 0.0};
   const std::shared_ptr<const Entry> entry = Lookup(to);
   if (entry->via[static_cast<std::size_t>(from)] < 0) {
-    return Unreachable("no route from " + Describe(*map_, from) + " to " + Describe(*map_, to));
+    return NoRouteError(*map_, from, to);
   }
   // Follow the first-arc pointers; they form a tree rooted at the destination's vertices.
   std::vector<VertexId> path{from};

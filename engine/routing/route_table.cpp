@@ -15,7 +15,24 @@ namespace {
 constexpr double kFloydNsPerRelax = 0.15;
 constexpr double kDijkstraNsPerOp = 3.0;
 
+std::string Describe(const WarehouseMap& map, PointId p) {
+  if (p < 0 || static_cast<std::size_t>(p) >= map.point_count()) {
+    return "unknown point " + std::to_string(p);
+  }
+  return "point '" + map.point(p).name + "' (" + std::to_string(p) + ")";
+}
+
+bool Known(const WarehouseMap& map, PointId p) {
+  return p >= 0 && static_cast<std::size_t>(p) < map.point_count();
+}
+
 }  // namespace
+
+Error NoRouteError(const WarehouseMap& map, PointId from, PointId to) {
+  const std::string what = "no route from " + Describe(map, from) + " to " + Describe(map, to);
+  if (!Known(map, from) || !Known(map, to)) return NotFound(what + ": unknown point");
+  return Unreachable(what);
+}
 
 RouteTableMethod ChooseDenseMethod(std::size_t vertices, std::size_t arcs) {
   const double n = static_cast<double>(vertices);

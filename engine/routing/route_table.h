@@ -87,6 +87,10 @@ struct RouteTableOptions {
 // dense graphs.
 RouteTableMethod ChooseDenseMethod(std::size_t vertices, std::size_t arcs);
 
+// The error Path() returns when there is no route: kNotFound naming the unknown point(s), or
+// kUnreachable naming both points ("no route from point 'a' (3) to point 'b' (7)").
+Error NoRouteError(const WarehouseMap& map, PointId from, PointId to);
+
 // Builds the table chosen by `options` (see lazy_threshold_points). `cancelled` is polled on
 // the calling thread during dense builds; a cancelled build returns kFailedPrecondition.
 // Errors: kInvalidArgument for a null map or bad options.

@@ -4,8 +4,8 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
-#include <array>
-#include <cstdio>
+#include "tests/engine/cli/run_command.h"
+
 #include <regex>
 #include <set>
 #include <sstream>
@@ -14,20 +14,10 @@ namespace {
 
 using ::testing::HasSubstr;
 
-struct CliRun {
-  int status;
-  std::string output;
-};
+using CliRun = dispatch::testing::CommandRun;
 
 CliRun RunAlloc(const std::string& args) {
-  const std::string cmd = std::string(DISPATCH_ALLOC_BIN) + " " + args + " 2>&1";
-  FILE* pipe = ::popen(cmd.c_str(), "r");
-  EXPECT_NE(pipe, nullptr);
-  std::string out;
-  std::array<char, 4096> buf{};
-  while (std::fgets(buf.data(), buf.size(), pipe)) out += buf.data();
-  const int status = ::pclose(pipe);
-  return {WEXITSTATUS(status), out};
+  return dispatch::testing::RunCommand(std::string(DISPATCH_ALLOC_BIN) + " " + args);
 }
 
 const std::string kTable2 = std::string(DISPATCH_SHARED_DIR) + "/scenarios/chu2024-table2.csv";

@@ -2,8 +2,8 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
-#include <array>
-#include <cstdio>
+#include "tests/engine/cli/run_command.h"
+
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -12,20 +12,10 @@ namespace {
 
 using ::testing::HasSubstr;
 
-struct CliRun {
-  int status;
-  std::string output;
-};
+using CliRun = dispatch::testing::CommandRun;
 
 CliRun RunMap(const std::string& args) {
-  const std::string cmd = std::string(DISPATCH_MAP_BIN) + " " + args + " 2>&1";
-  FILE* pipe = ::popen(cmd.c_str(), "r");
-  EXPECT_NE(pipe, nullptr);
-  std::string out;
-  std::array<char, 4096> buf{};
-  while (std::fgets(buf.data(), buf.size(), pipe)) out += buf.data();
-  const int status = ::pclose(pipe);
-  return {WEXITSTATUS(status), out};
+  return dispatch::testing::RunCommand(std::string(DISPATCH_MAP_BIN) + " " + args);
 }
 
 TEST(DispatchMapCliTest, SummaryOfTheChu2024Floor) {
