@@ -1,5 +1,6 @@
 #include "engine/allocation/auction_allocator.h"
 
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <limits>
@@ -69,17 +70,67 @@ std::string WhyLowest(const std::vector<Bid>& bids, std::size_t winner, const ch
 
 }  // namespace
 
+ZoneId AuctionAllocator::MixedArcZone(const TrafficPredictor& predictor, ArcId arc,
+                                      const Eigen::Vector2d& xa, const Eigen::Vector2d& xb,
+                                      double f) {
+  // The same arc and the same f give the same point, so the same zone: legs towards one pick
+  // cross an arc at few offsets.
+  std::array<MixedSample, 2>& seen = mixed_[static_cast<std::size_t>(arc)];
+  if (seen[0].f == f) return seen[0].zone;
+  if (seen[1].f == f) return seen[1].zone;
+  if (std::isnan(seen[0].f)) mixed_touched_.push_back(arc);
+  const ZoneId zone = predictor.ZoneAt(xa + f * (xb - xa));
+  seen[1] = seen[0];
+  seen[0] = {f, zone};
+  return zone;
+}
+
+void AuctionAllocator::ResetMixedArcs(const WarehouseMap& map) {
+  for (ArcId a : mixed_touched_) mixed_[static_cast<std::size_t>(a)] = {};
+  mixed_touched_.clear();
+  if (mixed_.size() != map.arcs().size()) mixed_.assign(map.arcs().size(), {});
+}
+
+double AuctionAllocator::AddLegSamples(RouteSampler& sampler, const TrafficPredictor& predictor,
+                                       PointId from, PointId to, double depart,
+                                       TrafficPredictor::DensityAccumulator& density) {
+  ArcId last_arc = -1;
+  ZoneId arc_zone = TrafficPredictor::kMixedZone;
+  return sampler.ForEachLegSample(
+      from, to, depart,
+      [&](ArcId arc, const Eigen::Vector2d& xa, const Eigen::Vector2d& xb, double f, double t) {
+        if (arc != last_arc) {
+          last_arc = arc;
+          arc_zone = predictor.ArcZone(arc);
+        }
+        density.Add(arc_zone != TrafficPredictor::kMixedZone
+                        ? arc_zone
+                        : MixedArcZone(predictor, arc, xa, xb, f),
+                    t);
+      });
+}
+
 std::vector<Bid> AuctionAllocator::ComputeBids(const FleetState& state, const PlanTask& task) {
   const AllocationConfig& c = state.config();
   const RouteTable& routes = state.routes();
   RouteSampler sampler(state.map(), routes, c.speed, c.sample_step);
+  ResetMixedArcs(state.map());
   shared_.clear();
   sampler.AppendTask(task, 0.0, shared_);
   // The order's own route is the same for every bidder, only shifted in time: its zones are
   // looked up once.
   const TrafficPredictor& predictor = state.predictor();
-  shared_zones_.clear();
-  for (const RouteSample& r : shared_) shared_zones_.push_back(predictor.ZoneAt(r.xy));
+  // They are kept as runs of consecutive samples in one zone, with the times side by side.
+  shared_times_.clear();
+  shared_runs_.clear();
+  for (const RouteSample& r : shared_) {
+    const ZoneId zone = predictor.ZoneAt(r.xy);
+    if (shared_runs_.empty() || shared_runs_.back().zone != zone) {
+      shared_runs_.push_back({zone, shared_times_.size(), 0});
+    }
+    ++shared_runs_.back().size;
+    shared_times_.push_back(r.t);
+  }
   const double task_travel = state.TaskTravelTime(task);
   const double task_work = TaskWorkTime(task);
   const PointId first = task.picks.front();
@@ -88,8 +139,11 @@ std::vector<Bid> AuctionAllocator::ComputeBids(const FleetState& state, const Pl
   for (std::size_t i = 0; i < state.robot_count(); ++i) {
     const QueueSummary& s = state.summary(i);
     const double leg = routes.Cost(s.end_point, first);
-    samples_.clear();
-    const double arrival = sampler.AppendLeg(s.end_point, first, s.end_time, samples_);
+    // The leg's samples go straight into the density (a sample's order does not change
+    // eqs. (6)-(8)); if the robot cannot reach the pick, they are discarded with it.
+    TrafficPredictor::DensityAccumulator density(predictor, state.robot_id(i));
+    const double arrival = AddLegSamples(sampler, predictor, s.end_point, first, s.end_time,
+                                         density);
     if (!std::isfinite(leg) || !std::isfinite(arrival) || !std::isfinite(task_travel)) {
       bids.push_back(UnreachableBid(state.robot_id(i), s.end_time));
       continue;
@@ -99,10 +153,8 @@ std::vector<Bid> AuctionAllocator::ComputeBids(const FleetState& state, const Pl
     b.ready_time = s.end_time;
     b.t_d = s.travel_time + leg + task_travel;  // Chu2024 eq. (3): S_d / v over the queue
     b.t_w = s.work_time + task_work;            // Chu2024 eq. (3): n_c * t_w over the queue
-    TrafficPredictor::DensityAccumulator density(predictor, b.robot);
-    for (const RouteSample& r : samples_) density.Add(r.xy, r.t);
-    for (std::size_t k = 0; k < shared_.size(); ++k) {
-      density.Add(shared_zones_[k], shared_[k].t + arrival);
+    for (const ZoneRun& run : shared_runs_) {
+      density.AddRun(run.zone, shared_times_.data() + run.begin, run.size, arrival);
     }
     FillBid(c, density.Finish(), b);
     bids.push_back(std::move(b));
@@ -114,25 +166,28 @@ std::vector<Bid> AuctionAllocator::ComputeReachBids(const FleetState& state, Poi
   const AllocationConfig& c = state.config();
   const RouteTable& routes = state.routes();
   RouteSampler sampler(state.map(), routes, c.speed, c.sample_step);
-  const Eigen::Vector2d pick_xy = state.map().point(first_pick).position;
+  ResetMixedArcs(state.map());
+  const TrafficPredictor& predictor = state.predictor();
+  const ZoneId pick_zone = predictor.ZoneAt(state.map().point(first_pick).position);
   std::vector<Bid> bids;
   bids.reserve(state.robot_count());
   for (std::size_t i = 0; i < state.robot_count(); ++i) {
     const QueueSummary& s = state.summary(i);
     const double leg = routes.Cost(s.end_point, first_pick);
-    samples_.clear();
-    const double arrival = sampler.AppendLeg(s.end_point, first_pick, s.end_time, samples_);
+    TrafficPredictor::DensityAccumulator density(predictor, state.robot_id(i));
+    const double arrival = AddLegSamples(sampler, predictor, s.end_point, first_pick,
+                                         s.end_time, density);
     if (!std::isfinite(leg) || !std::isfinite(arrival)) {
       bids.push_back(UnreachableBid(state.robot_id(i), s.end_time));
       continue;
     }
-    samples_.push_back({pick_xy, arrival});
+    density.Add(pick_zone, arrival);  // the first pick on arrival
     Bid b;
     b.robot = state.robot_id(i);
     b.ready_time = s.end_time;
     b.t_d = s.travel_time + leg;
     b.t_w = s.work_time;
-    FillBid(c, state.predictor().Density(samples_, b.robot), b);
+    FillBid(c, density.Finish(), b);
     bids.push_back(std::move(b));
   }
   return bids;

@@ -21,10 +21,13 @@
 // Not thread-safe (scratch buffers are reused between calls to avoid per-robot allocation).
 #pragma once
 
+#include <array>
+#include <limits>
 #include <string_view>
 #include <vector>
 
 #include "engine/allocation/allocator.h"
+#include "engine/allocation/route_sampler.h"
 #include "engine/allocation/traffic_prediction.h"
 
 namespace dispatch::engine {
@@ -40,9 +43,32 @@ class AuctionAllocator final : public Allocator {
   std::vector<Bid> ComputeReachBids(const FleetState& state, PointId first_pick);
 
  private:
+  // Feeds the samples of the leg from -> to (leaving at `depart`: RouteSampler::AppendLeg's
+  // samples) to `density`; returns the arrival time (+infinity if unreachable). A sample on
+  // an arc lying in one zone takes it without a grid lookup (ArcZone = ZoneAt there).
+  double AddLegSamples(RouteSampler& sampler, const TrafficPredictor& predictor, PointId from,
+                       PointId to, double depart, TrafficPredictor::DensityAccumulator& density);
+  // ZoneAt(xa + f (xb - xa)) on arc `arc` (from xa to xb), remembering the last two f per arc.
+  ZoneId MixedArcZone(const TrafficPredictor& predictor, ArcId arc, const Eigen::Vector2d& xa,
+                      const Eigen::Vector2d& xb, double f);
+  // Forgets the remembered zones (they hold for one map and one predictor: one call).
+  void ResetMixedArcs(const WarehouseMap& map);
+
+  struct MixedSample {
+    double f = std::numeric_limits<double>::quiet_NaN();  // NaN: empty (never equal)
+    ZoneId zone = -1;
+  };
+  std::vector<std::array<MixedSample, 2>> mixed_;  // per arc id
+  std::vector<ArcId> mixed_touched_;               // arcs with a remembered zone
   std::vector<RouteSample> shared_;   // the order's samples from its first pick, from t = 0
-  std::vector<ZoneId> shared_zones_;  // ZoneAt of each shared_ sample
-  std::vector<RouteSample> samples_;  // one robot's candidate route
+  // shared_ as runs of consecutive samples in one zone (ZoneAt), over shared_times_.
+  struct ZoneRun {
+    ZoneId zone = -1;
+    std::size_t begin = 0;
+    std::size_t size = 0;
+  };
+  std::vector<ZoneRun> shared_runs_;
+  std::vector<double> shared_times_;  // shared_[k].t
 };
 
 }  // namespace dispatch::engine

@@ -5,69 +5,53 @@
 
 namespace dispatch::engine {
 namespace {
-constexpr ArcId kUnknown = -2;
 constexpr double kInf = std::numeric_limits<double>::infinity();
 }  // namespace
 
 RouteSampler::RouteSampler(const WarehouseMap& map, const RouteTable& routes, double speed,
                            double step)
-    : map_(map), routes_(routes), speed_(speed), step_(step), memo_(map.point_count(), kUnknown) {}
+    : map_(map), routes_(routes), speed_(speed), step_(step), memo_(map.point_count()) {}
 
 double RouteSampler::ArcTime(const Arc& arc) const {
   return arc.length / (arc.max_speed > 0.0 ? std::min(speed_, arc.max_speed) : speed_);
 }
 
-ArcId RouteSampler::NextArc(PointId p) {
-  ArcId& slot = memo_[static_cast<std::size_t>(p)];
-  if (slot != kUnknown) return slot;
+const RouteSampler::Hop& RouteSampler::FindHop(PointId p) {
+  Hop& hop = memo_[static_cast<std::size_t>(p)];
   touched_.push_back(p);
+  hop.arc = -1;
   const PointId q = routes_.NextHop(p, memo_target_);
-  slot = -1;
-  if (q == kNoPoint) return slot;
+  if (q == kNoPoint) return hop;
   // The fastest arc p -> q (maps may hold parallel arcs).
   double best = kInf;
   for (ArcId a : map_.out_arcs(p)) {
     const Arc& arc = map_.arc(a);
     if (arc.to == q && ArcTime(arc) < best) {
       best = ArcTime(arc);
-      slot = a;
+      hop.arc = a;
     }
   }
-  return slot;
+  if (hop.arc >= 0) {
+    const Arc& arc = map_.arc(hop.arc);
+    hop.to = arc.to;
+    hop.length = arc.length;
+    hop.dt = ArcTime(arc);
+  }
+  return hop;
+}
+
+void RouteSampler::SetTarget(PointId to) {
+  if (to == memo_target_) return;
+  for (PointId p : touched_) memo_[static_cast<std::size_t>(p)] = Hop{};
+  touched_.clear();
+  memo_target_ = to;
 }
 
 double RouteSampler::AppendLeg(PointId from, PointId to, double depart,
                                std::vector<RouteSample>& out) {
-  if (to != memo_target_) {
-    for (PointId p : touched_) memo_[static_cast<std::size_t>(p)] = kUnknown;
-    touched_.clear();
-    memo_target_ = to;
-  }
-  double t = depart;
-  double s0 = 0.0;      // distance driven at the start of the current arc
-  double next_s = 0.0;  // distance of the next sample
-  PointId p = from;
-  std::size_t hops = 0;
-  while (p != to) {
-    const ArcId a = NextArc(p);
-    if (a < 0 || ++hops > map_.point_count()) return kInf;
-    const Arc& arc = map_.arc(a);
-    const Eigen::Vector2d& xa = map_.point(p).position;
-    const Eigen::Vector2d& xb = map_.point(arc.to).position;
-    const double dt = ArcTime(arc);
-    const double s1 = s0 + arc.length;
-    // Samples strictly inside the leg; the arrival point belongs to the next stop.
-    const double last = arc.to == to ? s1 - 1e-9 : s1;
-    while (next_s < last) {
-      const double f = (next_s - s0) / arc.length;
-      out.push_back({xa + f * (xb - xa), t + f * dt});
-      next_s += step_;
-    }
-    t += dt;
-    s0 = s1;
-    p = arc.to;
-  }
-  return t;
+  return ForEachLegSample(from, to, depart,
+                          [&out](ArcId, const Eigen::Vector2d& xa, const Eigen::Vector2d& xb,
+                                 double f, double t) { out.push_back({xa + f * (xb - xa), t}); });
 }
 
 double RouteSampler::AppendTask(const PlanTask& task, double arrival,

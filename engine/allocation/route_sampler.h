@@ -15,6 +15,7 @@
 // RouteTable. Not thread-safe (the memo is mutable state); cheap to construct per order.
 #pragma once
 
+#include <limits>
 #include <vector>
 
 #include "engine/allocation/traffic_prediction.h"
@@ -33,14 +34,33 @@ class RouteSampler {
   // appended so far are then meaningless).
   double AppendLeg(PointId from, PointId to, double depart, std::vector<RouteSample>& out);
 
+  // The same samples as AppendLeg, handed one at a time to visit(arc, xa, xb, f, t) instead
+  // of stored: the sample lies on arc `arc` from xa to xb at xy = xa + f * (xb - xa) (compute
+  // it with exactly this expression to get AppendLeg's bits) with 0 <= f < 1 (f is at most
+  // rounding above 1), at time t. Returns what AppendLeg returns.
+  template <typename Visit>
+  double ForEachLegSample(PointId from, PointId to, double depart, Visit&& visit);
+
   // Appends the samples of serving `task` for a robot arriving at its first pick at
   // `arrival`: every stop at its arrival, the legs between them, t_w at each stop. Returns the
   // departure time from the drop; +infinity if a leg is unreachable.
   double AppendTask(const PlanTask& task, double arrival, std::vector<RouteSample>& out);
 
  private:
-  // The arc the robot takes out of `p` towards memo_target_, or -1 if unreachable.
-  ArcId NextArc(PointId p);
+  // The step out of a point towards memo_target_: the arc taken (-1 if unreachable), where it
+  // ends, its length and its travel time ArcTime.
+  struct Hop {
+    ArcId arc = -2;  // -2: not yet known
+    PointId to = kNoPoint;
+    double length = 0.0;
+    double dt = 0.0;
+  };
+  // The hop the robot takes out of `p` towards memo_target_ (memoised).
+  const Hop& NextHop(PointId p) {
+    const Hop& hop = memo_[static_cast<std::size_t>(p)];
+    return hop.arc != -2 ? hop : FindHop(p);
+  }
+  const Hop& FindHop(PointId p);
   double ArcTime(const Arc& arc) const;
 
   const WarehouseMap& map_;
@@ -48,8 +68,41 @@ class RouteSampler {
   double speed_;
   double step_;
   PointId memo_target_ = kNoPoint;
-  std::vector<ArcId> memo_;  // per point: -2 unknown, -1 unreachable, else the arc
+  std::vector<Hop> memo_;  // per point
   std::vector<PointId> touched_;
+
+  void SetTarget(PointId to);
 };
+
+template <typename Visit>
+double RouteSampler::ForEachLegSample(PointId from, PointId to, double depart, Visit&& visit) {
+  SetTarget(to);
+  double t = depart;
+  double s0 = 0.0;      // distance driven at the start of the current arc
+  double next_s = 0.0;  // distance of the next sample
+  PointId p = from;
+  std::size_t hops = 0;
+  const std::size_t n_points = map_.point_count();
+  const Point* points = map_.points().data();
+  while (p != to) {
+    const Hop& hop = NextHop(p);
+    if (hop.arc < 0 || ++hops > n_points) return std::numeric_limits<double>::infinity();
+    const Eigen::Vector2d& xa = points[p].position;
+    const Eigen::Vector2d& xb = points[hop.to].position;
+    const double dt = hop.dt;
+    const double s1 = s0 + hop.length;
+    // Samples strictly inside the leg; the arrival point belongs to the next stop.
+    const double last = hop.to == to ? s1 - 1e-9 : s1;
+    while (next_s < last) {
+      const double f = (next_s - s0) / hop.length;
+      visit(hop.arc, xa, xb, f, t + f * dt);
+      next_s += step_;
+    }
+    t += dt;
+    s0 = s1;
+    p = hop.to;
+  }
+  return t;
+}
 
 }  // namespace dispatch::engine

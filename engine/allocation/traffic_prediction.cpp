@@ -58,7 +58,9 @@ TrafficPredictor::TrafficPredictor(const WarehouseMap& map, TrafficPredictionCon
                                 "must be positive and finite, origin_time finite");
   }
   inv_bucket_seconds_ = 1.0 / config_.bucket_seconds;
+  bucket_starts_ = {BucketStart(0)};
   BuildZoneGrid(map.floor_min(), map.floor_max());
+  BuildArcZones(map);
 }
 
 // --- Zone grid ------------------------------------------------------------------------------
@@ -175,37 +177,54 @@ ZoneId TrafficPredictor::ZoneAt(const Eigen::Vector2d& xy) const {
   return -1;
 }
 
+ZoneId TrafficPredictor::UniformZoneIn(const Eigen::Vector2d& lo,
+                                       const Eigen::Vector2d& hi) const {
+  // The cell of a coordinate is monotone in it (rounded subtraction and multiplication by a
+  // positive factor, then truncation, are all monotone), so every point of [lo, hi] lies in a
+  // cell of the range computed from the corners, as ZoneAt computes it.
+  const double fx0 = (lo.x() - grid_origin_.x()) * inv_cell_size_;
+  const double fy0 = (lo.y() - grid_origin_.y()) * inv_cell_size_;
+  const double fx1 = (hi.x() - grid_origin_.x()) * inv_cell_size_;
+  const double fy1 = (hi.y() - grid_origin_.y()) * inv_cell_size_;
+  if (!(fx0 >= 0.0 && fy0 >= 0.0 && fx1 < static_cast<double>(grid_cols_) &&
+        fy1 < static_cast<double>(grid_rows_))) {
+    return kMixedZone;  // partly off the grid (or NaN): leave it to ZoneAt
+  }
+  const std::int64_t cx0 = static_cast<std::int64_t>(fx0), cx1 = static_cast<std::int64_t>(fx1);
+  const std::int64_t cy0 = static_cast<std::int64_t>(fy0), cy1 = static_cast<std::int64_t>(fy1);
+  constexpr std::int64_t kMaxCells = 4096;  // long diagonal arcs: not worth the scan
+  if ((cx1 - cx0 + 1) * (cy1 - cy0 + 1) > kMaxCells) return kMixedZone;
+  const std::int32_t v = cells_[static_cast<std::size_t>(cy0 * grid_cols_ + cx0)];
+  if (v < -1) return kMixedZone;
+  for (std::int64_t cy = cy0; cy <= cy1; ++cy) {
+    for (std::int64_t cx = cx0; cx <= cx1; ++cx) {
+      if (cells_[static_cast<std::size_t>(cy * grid_cols_ + cx)] != v) return kMixedZone;
+    }
+  }
+  return v;
+}
+
+void TrafficPredictor::BuildArcZones(const WarehouseMap& map) {
+  arc_zones_.assign(map.arcs().size(), kMixedZone);
+  for (std::size_t i = 0; i < map.arcs().size(); ++i) {
+    const Arc& arc = map.arcs()[i];
+    const Eigen::Vector2d& a = map.point(arc.from).position;
+    const Eigen::Vector2d& b = map.point(arc.to).position;
+    if (!a.allFinite() || !b.allFinite()) continue;
+    // A point a + f (b - a) computed in doubles strays from the box by a few ulps of the
+    // coordinates; the margin is far above that.
+    const double scale = std::max({1.0, a.cwiseAbs().maxCoeff(), b.cwiseAbs().maxCoeff()});
+    const Eigen::Vector2d margin = Eigen::Vector2d::Constant(1e-6 * scale);
+    arc_zones_[i] = UniformZoneIn(a.cwiseMin(b) - margin, a.cwiseMax(b) + margin);
+  }
+}
+
 // --- Buckets and counts ---------------------------------------------------------------------
 
-double TrafficPredictor::BucketStart(std::size_t b) const {
-  return config_.origin_time + static_cast<double>(b) * config_.bucket_seconds;
-}
-
-bool TrafficPredictor::StoredBucketOf(double t, std::size_t* bucket) const {
-  // Hot path (every route sample of every bid): a multiply and a truncation, no libm call.
-  const double q = (t - config_.origin_time) * inv_bucket_seconds_;
-  if (!(q < static_cast<double>(bucket_count_) + 1.0)) return false;  // also NaN
-  std::size_t b = q > 0.0 ? static_cast<std::size_t>(q) : 0;  // floor for q >= 0
-  // Snap to the exact rule (largest b with s_b <= t) against rounding of the product.
-  while (b > 0 && BucketStart(b) > t) --b;
-  while (BucketStart(b + 1) <= t) ++b;
-  if (b >= bucket_count_) return false;
-  *bucket = b;
-  return true;
-}
-
-ZoneId TrafficPredictor::ZoneOf(const Contribution* c, std::size_t bucket) {
-  if (c == nullptr || bucket < c->first_bucket || bucket - c->first_bucket >= c->zones.size()) {
-    return -1;
-  }
-  return c->zones[bucket - c->first_bucket];
-}
-
 void TrafficPredictor::Apply(const Contribution& c, int sign) {
-  const std::size_t n_zones = zones_.size();
   for (std::size_t k = 0; k < c.zones.size(); ++k) {
     if (c.zones[k] < 0) continue;
-    counts_[(c.first_bucket + k) * n_zones + static_cast<std::size_t>(c.zones[k])] += sign;
+    counts_[static_cast<std::size_t>(c.zones[k]) * bucket_stride_ + c.first_bucket + k] += sign;
   }
 }
 
@@ -241,10 +260,23 @@ void TrafficPredictor::SetPlan(const std::string& robot, const Plan& plan) {
       for (std::size_t b = first; b < last_plus_one; ++b) {
         next.zones.push_back(ZoneAt(plan.PositionAt(BucketStart(b))));
       }
-      if (last_plus_one > bucket_count_) {
-        counts_.resize(last_plus_one * zones_.size(), 0);
-        bucket_count_ = last_plus_one;
+      next.tail = next.zones.size();
+      while (next.tail > 0 && next.zones[next.tail - 1] == next.zones.back()) --next.tail;
+      if (last_plus_one > bucket_stride_) {
+        // Zone-major rows grow by doubling (amortised O(1) per bucket); the tail stays 0.
+        const std::size_t stride = std::max(last_plus_one, 2 * bucket_stride_);
+        std::vector<std::int32_t> grown(stride * zones_.size(), 0);
+        for (std::size_t z = 0; z < zones_.size(); ++z) {
+          std::copy_n(counts_.begin() + static_cast<std::ptrdiff_t>(z * bucket_stride_),
+                      bucket_count_, grown.begin() + static_cast<std::ptrdiff_t>(z * stride));
+        }
+        counts_ = std::move(grown);
+        bucket_stride_ = stride;
       }
+      for (std::size_t b = bucket_count_ + 1; b <= last_plus_one; ++b) {
+        bucket_starts_.push_back(BucketStart(b));
+      }
+      bucket_count_ = std::max(bucket_count_, last_plus_one);
     }
   }
   auto [it, inserted] = robots_.try_emplace(robot);
@@ -264,7 +296,7 @@ int TrafficPredictor::CountAt(ZoneId zone, double t, const std::string& exclude_
   if (zone < 0 || static_cast<std::size_t>(zone) >= zones_.size()) return 0;
   std::size_t b = 0;
   if (!StoredBucketOf(t, &b)) return 0;
-  int n = counts_[b * zones_.size() + static_cast<std::size_t>(zone)];
+  int n = counts_[static_cast<std::size_t>(zone) * bucket_stride_ + b];
   if (!exclude_robot.empty()) {
     auto it = robots_.find(exclude_robot);
     if (it != robots_.end() && ZoneOf(&it->second, b) == zone) --n;
@@ -287,24 +319,38 @@ TrafficPredictor::DensityAccumulator::DensityAccumulator(const TrafficPredictor&
     auto it = predictor.robots_.find(robot);
     if (it != predictor.robots_.end()) own_ = &it->second;
   }
+  if (own_ != nullptr && !own_->zones.empty()) {
+    own_first_ = own_->first_bucket;
+    own_tail_ = own_first_ + own_->tail;
+    own_end_ = own_first_ + own_->zones.size();
+    own_zones_ = own_->zones.data();
+    tail_zone_ = own_->zones.back();
+  }
 }
 
-void TrafficPredictor::DensityAccumulator::Add(ZoneId z, double t) {
-  if (z < 0) return;
-  int n = 0;  // N_p^k(i): other robots in a_p when robot i is at sample k
-  std::size_t b = 0;
-  if (predictor_->StoredBucketOf(t, &b)) {
-    n = predictor_->counts_[b * predictor_->zones_.size() + static_cast<std::size_t>(z)];
-    if (ZoneOf(own_, b) == z) --n;
+void TrafficPredictor::DensityAccumulator::NewZone(ZoneId zone, int n) {
+  last_ = 0;
+  while (last_ < peaks_.size() && peaks_[last_].first != zone) ++last_;
+  if (last_ == peaks_.size()) peaks_.emplace_back(zone, n);
+}
+
+void TrafficPredictor::DensityAccumulator::AddRun(ZoneId zone, const double* times,
+                                                  std::size_t n, double shift) {
+  if (zone < 0 || n == 0) return;
+  const TrafficPredictor& p = *predictor_;
+  const std::int32_t* row = p.counts_.data() + static_cast<std::size_t>(zone) * p.bucket_stride_;
+  int peak = std::numeric_limits<int>::min();
+  for (std::size_t k = 0; k < n; ++k) {
+    int c = 0;
+    std::size_t b = 0;
+    if (Locate(times[k] + shift, &b)) {
+      c = row[b];
+      if (OwnZone(b) == zone) --c;
+    }
+    peak = std::max(peak, c);
   }
-  // Eq. (6): N_p,max(i) = max over the samples in zone p. A route visits few zones and
-  // consecutive samples mostly share one: a short list with a last-zone shortcut.
-  if (last_ >= peaks_.size() || peaks_[last_].first != z) {
-    last_ = 0;
-    while (last_ < peaks_.size() && peaks_[last_].first != z) ++last_;
-    if (last_ == peaks_.size()) peaks_.emplace_back(z, n);
-  }
-  peaks_[last_].second = std::max(peaks_[last_].second, n);
+  if (last_ >= peaks_.size() || peaks_[last_].first != zone) NewZone(zone, peak);
+  peaks_[last_].second = std::max(peaks_[last_].second, peak);
 }
 
 DensityTerm TrafficPredictor::DensityAccumulator::Finish() const {

@@ -17,6 +17,11 @@
 // that lies (with a 1 mm margin) inside the lowest zone touching it answers directly; other
 // cells keep the ids of the few zones touching them and test Contains on those in id order.
 //
+// Arcs: for every arc of the map the predictor also keeps ArcZone(arc), the one zone ZoneAt
+// answers for every point of the arc's segment (within a margin far above the rounding of a
+// point computed on it), or kMixedZone when that is not known to hold; route samples strictly
+// on such an arc skip the grid lookup.
+//
 // Invariant: after SetPlan/RemovePlan the counts equal a recount from scratch over the current
 // plans (a model test checks this). The predictor copies the zones it needs; it keeps no
 // reference to the map. Not thread-safe: one writer (the allocator) at a time; const methods
@@ -25,6 +30,7 @@
 
 #include <Eigen/Core>
 
+#include <algorithm>
 #include <cstddef>
 #include <cstdint>
 #include <string>
@@ -75,6 +81,17 @@ class TrafficPredictor {
 
   // The zone holding xy (lowest id on shared borders): O(1); -1 outside every zone.
   ZoneId ZoneAt(const Eigen::Vector2d& xy) const;
+  // ArcZone's answer when ZoneAt may differ along the arc.
+  static constexpr ZoneId kMixedZone = -2;
+  // For an arc of the map given to the constructor: z (>= -1) if ZoneAt(p) == z for every
+  // point p within 1e-6 m (more for far-off coordinates) of the box spanned by the arc's end
+  // points, so also for every point a + f (b - a), 0 <= f <= 1, computed in floating point;
+  // kMixedZone otherwise, and for an unknown arc id. O(1).
+  ZoneId ArcZone(ArcId arc) const {
+    return arc >= 0 && static_cast<std::size_t>(arc) < arc_zones_.size()
+               ? arc_zones_[static_cast<std::size_t>(arc)]
+               : kMixedZone;
+  }
   // Robots predicted in `zone` at time t (see the bucket rule above), not counting
   // `exclude_robot` (may be empty). 0 for an unknown zone, a NaN time or a time past the
   // last stored bucket. O(1) (one hash lookup when `exclude_robot` is given).
@@ -103,14 +120,42 @@ class TrafficPredictor {
   struct Contribution {
     std::size_t first_bucket = 0;
     std::vector<ZoneId> zones;
+    std::size_t tail = 0;  // zones[k] == zones.back() for every k >= tail (a plan's final wait)
   };
 
   void BuildZoneGrid(const Eigen::Vector2d& floor_min, const Eigen::Vector2d& floor_max);
-  double BucketStart(std::size_t b) const;
-  // bucket(t) as above; false for NaN or a bucket >= bucket_count_.
-  bool StoredBucketOf(double t, std::size_t* bucket) const;
+  void BuildArcZones(const WarehouseMap& map);
+  // The direct answer shared by every grid cell meeting the box [lo, hi], or kMixedZone.
+  ZoneId UniformZoneIn(const Eigen::Vector2d& lo, const Eigen::Vector2d& hi) const;
+  double BucketStart(std::size_t b) const {
+    return config_.origin_time + static_cast<double>(b) * config_.bucket_seconds;
+  }
+  // bucket(t) as above; false for NaN or a bucket >= bucket_count_. Inline: the hot path.
+  bool StoredBucketOf(double t, std::size_t* bucket) const {
+    // A multiply and a truncation, no libm call.
+    const double q = (t - config_.origin_time) * inv_bucket_seconds_;
+    if (!(q < static_cast<double>(bucket_count_) + 1.0)) return false;  // also NaN
+    std::size_t b = q > 0.0 ? static_cast<std::size_t>(q) : 0;  // floor for q >= 0, <= count
+    // Snap to the exact rule (largest b with s_b <= t) against rounding of the product, with
+    // s_b read from bucket_starts_ (b <= bucket_count_ here). b only grows in the second
+    // loop, so once it reaches bucket_count_ the answer is "not stored".
+    const double* starts = bucket_starts_.data();
+    while (b > 0 && starts[b] > t) --b;
+    for (;;) {
+      if (b >= bucket_count_) return false;
+      if (starts[b + 1] > t) break;
+      ++b;
+    }
+    *bucket = b;
+    return true;
+  }
   void Apply(const Contribution& c, int sign);
-  static ZoneId ZoneOf(const Contribution* c, std::size_t bucket);
+  static ZoneId ZoneOf(const Contribution* c, std::size_t bucket) {
+    if (c == nullptr || bucket < c->first_bucket || bucket - c->first_bucket >= c->zones.size()) {
+      return -1;
+    }
+    return c->zones[bucket - c->first_bucket];
+  }
 
   TrafficPredictionConfig config_;
   double inv_bucket_seconds_ = 2.0;  // 1 / bucket_seconds
@@ -128,8 +173,14 @@ class TrafficPredictor {
   std::vector<std::uint32_t> candidate_begin_;
   std::vector<ZoneId> candidates_;
 
-  // counts_[b * zones_.size() + p]: robots in zone p at s_b, over all robots' plans.
+  std::vector<ZoneId> arc_zones_;  // ArcZone per arc id
+
+  // counts_[p * bucket_stride_ + b]: robots in zone p at s_b, over all robots' plans (zone
+  // major, so the consecutive buckets a route spends in one zone are adjacent); buckets in
+  // [bucket_count_, bucket_stride_) are 0.
   std::size_t bucket_count_ = 0;
+  std::size_t bucket_stride_ = 0;
+  std::vector<double> bucket_starts_ = {0.0};  // BucketStart(b) for b <= bucket_count_
   std::vector<std::int32_t> counts_;
   std::unordered_map<std::string, Contribution> robots_;
 };
@@ -138,17 +189,71 @@ class TrafficPredictor::DensityAccumulator {
  public:
   // Counts exclude robot `robot`'s own plan (none when empty or unknown).
   DensityAccumulator(const TrafficPredictor& predictor, const std::string& robot);
-  // A sample in `zone` (skipped when < 0) at time t.
-  void Add(ZoneId zone, double t);
+  // A sample in `zone` (skipped when < 0) at time t. Inline: every route sample comes here.
+  void Add(ZoneId zone, double t) {
+    if (zone < 0) return;
+    int n = 0;  // N_p^k(i): other robots in a_p when robot i is at sample k
+    std::size_t b = 0;
+    if (Locate(t, &b)) {
+      n = predictor_->counts_[static_cast<std::size_t>(zone) * predictor_->bucket_stride_ + b];
+      if (OwnZone(b) == zone) --n;
+    }
+    // Eq. (6): N_p,max(i) = max over the samples in zone p. A route visits few zones and
+    // consecutive samples mostly share one: a short list with a last-zone shortcut.
+    if (last_ >= peaks_.size() || peaks_[last_].first != zone) NewZone(zone, n);
+    peaks_[last_].second = std::max(peaks_[last_].second, n);
+  }
   void Add(const Eigen::Vector2d& xy, double t) { Add(predictor_->ZoneAt(xy), t); }
+  // n samples in `zone` (none when < 0) at times times[k] + shift: the same as
+  // Add(zone, times[k] + shift) for each k, in one tight loop.
+  void AddRun(ZoneId zone, const double* times, std::size_t n, double shift);
   // Eqs. (6)-(8) over the samples added so far; peaks sorted by zone id.
   DensityTerm Finish() const;
 
  private:
   const TrafficPredictor* predictor_;
   const Contribution* own_ = nullptr;
+  // own_ as bucket ranges: its zone at b in [own_first_, own_end_) is own_zones_[b -
+  // own_first_], which is tail_zone_ from own_tail_ on (no memory access on the hot path).
+  std::size_t own_first_ = 0, own_tail_ = 0, own_end_ = 0;
+  const ZoneId* own_zones_ = nullptr;
+  ZoneId tail_zone_ = -1;
   std::vector<std::pair<ZoneId, int>> peaks_;  // N_p,max so far, in order of first visit
   std::size_t last_ = 0;                       // index of the last zone added
+
+  std::size_t cursor_ = 0;  // the bucket of the last sample located (or 0)
+
+  // ZoneOf(own_, b).
+  ZoneId OwnZone(std::size_t b) const {
+    if (b >= own_end_) return -1;
+    if (b >= own_tail_) return tail_zone_;
+    return b >= own_first_ ? own_zones_[b - own_first_] : -1;
+  }
+
+  // Points last_ at zone's entry, appending (zone, n) if the zone is new.
+  void NewZone(ZoneId zone, int n);
+  // StoredBucketOf(t), walking from the last sample's bucket when t is at most two buckets
+  // past it (a route's samples come in time order, about one bucket apart). bucket(t) is
+  // the largest b with s_b <= t and s_b is non-decreasing in b, so s_c <= t < s_(c+1) pins
+  // bucket(t) = c whichever way c was found.
+  bool Locate(double t, std::size_t* bucket) {
+    const TrafficPredictor& p = *predictor_;
+    const std::size_t count = p.bucket_count_;
+    const double* starts = p.bucket_starts_.data();  // count + 1 entries
+    std::size_t b = cursor_;
+    if (t >= starts[b]) {  // false for NaN
+      if (b < count && starts[b + 1] <= t) ++b;
+      if (!(b < count && starts[b + 1] <= t)) {
+        cursor_ = b;
+        if (b >= count) return false;  // bucket(t) >= count: not stored
+        *bucket = b;
+        return true;
+      }
+    }
+    if (!p.StoredBucketOf(t, bucket)) return false;
+    cursor_ = *bucket;
+    return true;
+  }
 };
 
 // Samples a timed plan every `step` metres of travelled distance along its path (the
