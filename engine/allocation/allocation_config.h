@@ -18,11 +18,18 @@
 //    robot at its parking station). FleetState publishes each plan to the predictor with a
 //    final wait of hold_seconds there. 300 s is longer than any Chu2024 task (< 100 s), so
 //    robots stay visible over a batch; 0 disables it.
+//  - price_every_bid_up_to = 64 robots: in fleets up to this size every robot's F_i is
+//    evaluated, so an award explains every bid in full (the paper's Tables 3 and 4). In
+//    larger fleets the auction prices robots in order of alpha T_t + beta T_d (a lower bound
+//    of B_i, since x_i >= 0) and stops once that bound exceeds the bids that decide the award
+//    (winner and runner-up; for formations the companions and the next one): the same award,
+//    without sampling routes that could not win.
 //  - work_time_override: unset = every order's own t_w (Order::work_time, 5 s by default,
 //    see kDefaultWorkTime); set = one t_w for every order, as in the paper.
 // Plain value; validate with ValidateAllocationConfig. Thread-safe to share.
 #pragma once
 
+#include <cstddef>
 #include <optional>
 
 #include "engine/allocation/traffic_prediction.h"
@@ -38,6 +45,7 @@ struct AllocationConfig {
   double sample_step = 0.5;  // h, metres between route samples (Chu2024 eq. (6))
   double speed = 1.0;        // v, m/s (Chu2024 eq. (3))
   double hold_seconds = 300.0;  // predicted stay at a plan's end, seconds; >= 0
+  std::size_t price_every_bid_up_to = 64;  // robots; larger fleets skip bids that cannot win
   std::optional<double> work_time_override;  // t_w for every order, seconds; unset = per order
   TrafficPredictionConfig traffic;
   FormationOptions formation;

@@ -1,5 +1,6 @@
 #include "engine/allocation/auction_allocator.h"
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdio>
@@ -68,7 +69,50 @@ std::string WhyLowest(const std::vector<Bid>& bids, std::size_t winner, const ch
   return s + " (next " + bids[next].robot + " " + Money(bids[next].bid) + ")";
 }
 
+// The time terms of a reachable bid and its lower bound alpha T_t + beta T_d (x = 0).
+void SetTimes(const AllocationConfig& c, double t_d, double t_w, Bid& b) {
+  b.t_d = t_d;
+  b.t_w = t_w;
+  b.t_t = t_d + t_w;
+  b.bid = BidValue(c.alpha, c.beta, b.t_t, b.t_d, 0.0);
+}
+
+// How many lowest bids an award must know exactly: 0 (all) for small fleets.
+std::size_t Keep(const FleetState& state, std::size_t k) {
+  return state.robot_count() <= state.config().price_every_bid_up_to ? 0 : k;
+}
+
 }  // namespace
+
+template <typename Price>
+void AuctionAllocator::PriceLowest(std::vector<Bid>& bids, std::size_t keep, Price&& price) {
+  if (keep == 0) {
+    for (std::size_t i = 0; i < bids.size(); ++i) {
+      if (bids[i].reachable) price(i);
+    }
+    return;
+  }
+  order_.clear();
+  for (std::size_t i = 0; i < bids.size(); ++i) {
+    if (bids[i].reachable) order_.push_back(i);
+  }
+  std::sort(order_.begin(), order_.end(), [&](std::size_t a, std::size_t b) {
+    return bids[a].bid < bids[b].bid || (bids[a].bid == bids[b].bid && a < b);
+  });
+  kept_.clear();
+  std::size_t k = 0;
+  for (; k < order_.size(); ++k) {
+    Bid& b = bids[order_[k]];
+    // Full bids are >= their bound: once the bound passes the keep-th lowest full bid, this
+    // robot and every later one are out of the lowest `keep` (ties still priced).
+    if (kept_.size() == keep && b.bid > kept_.back()) break;
+    price(order_[k]);
+    if (!b.reachable) continue;
+    kept_.insert(std::upper_bound(kept_.begin(), kept_.end(), b.bid), b.bid);
+    if (kept_.size() > keep) kept_.pop_back();
+  }
+  for (; k < order_.size(); ++k) bids[order_[k]].priced = false;
+}
 
 ZoneId AuctionAllocator::MixedArcZone(const TrafficPredictor& predictor, ArcId arc,
                                       const Eigen::Vector2d& xa, const Eigen::Vector2d& xb,
@@ -110,7 +154,8 @@ double AuctionAllocator::AddLegSamples(RouteSampler& sampler, const TrafficPredi
       });
 }
 
-std::vector<Bid> AuctionAllocator::ComputeBids(const FleetState& state, const PlanTask& task) {
+std::vector<Bid> AuctionAllocator::ComputeBids(const FleetState& state, const PlanTask& task,
+                                               std::size_t keep) {
   const AllocationConfig& c = state.config();
   const RouteTable& routes = state.routes();
   RouteSampler sampler(state.map(), routes, c.speed, c.sample_step);
@@ -139,30 +184,38 @@ std::vector<Bid> AuctionAllocator::ComputeBids(const FleetState& state, const Pl
   for (std::size_t i = 0; i < state.robot_count(); ++i) {
     const QueueSummary& s = state.summary(i);
     const double leg = routes.Cost(s.end_point, first);
-    // The leg's samples go straight into the density (a sample's order does not change
-    // eqs. (6)-(8)); if the robot cannot reach the pick, they are discarded with it.
-    TrafficPredictor::DensityAccumulator density(predictor, state.robot_id(i));
-    const double arrival = AddLegSamples(sampler, predictor, s.end_point, first, s.end_time,
-                                         density);
-    if (!std::isfinite(leg) || !std::isfinite(arrival) || !std::isfinite(task_travel)) {
+    if (!std::isfinite(leg) || !std::isfinite(task_travel)) {
       bids.push_back(UnreachableBid(state.robot_id(i), s.end_time));
       continue;
     }
     Bid b;
     b.robot = state.robot_id(i);
     b.ready_time = s.end_time;
-    b.t_d = s.travel_time + leg + task_travel;  // Chu2024 eq. (3): S_d / v over the queue
-    b.t_w = s.work_time + task_work;            // Chu2024 eq. (3): n_c * t_w over the queue
+    // Chu2024 eq. (3): T_d = S_d / v and T_w = n_c * t_w over the queue and the order.
+    SetTimes(c, s.travel_time + leg + task_travel, s.work_time + task_work, b);
+    bids.push_back(std::move(b));
+  }
+  PriceLowest(bids, keep, [&](std::size_t i) {
+    const QueueSummary& s = state.summary(i);
+    // The leg's samples go straight into the density (a sample's order does not change
+    // eqs. (6)-(8)); if the robot cannot reach the pick, they are discarded with it.
+    TrafficPredictor::DensityAccumulator density(predictor, state.robot_id(i));
+    const double arrival = AddLegSamples(sampler, predictor, s.end_point, first, s.end_time,
+                                         density);
+    if (!std::isfinite(arrival)) {
+      bids[i] = UnreachableBid(state.robot_id(i), s.end_time);
+      return;
+    }
     for (const ZoneRun& run : shared_runs_) {
       density.AddRun(run.zone, shared_times_.data() + run.begin, run.size, arrival);
     }
-    FillBid(c, density.Finish(), b);
-    bids.push_back(std::move(b));
-  }
+    FillBid(c, density.Finish(), bids[i]);
+  });
   return bids;
 }
 
-std::vector<Bid> AuctionAllocator::ComputeReachBids(const FleetState& state, PointId first_pick) {
+std::vector<Bid> AuctionAllocator::ComputeReachBids(const FleetState& state, PointId first_pick,
+                                                    std::size_t keep) {
   const AllocationConfig& c = state.config();
   const RouteTable& routes = state.routes();
   RouteSampler sampler(state.map(), routes, c.speed, c.sample_step);
@@ -174,22 +227,28 @@ std::vector<Bid> AuctionAllocator::ComputeReachBids(const FleetState& state, Poi
   for (std::size_t i = 0; i < state.robot_count(); ++i) {
     const QueueSummary& s = state.summary(i);
     const double leg = routes.Cost(s.end_point, first_pick);
-    TrafficPredictor::DensityAccumulator density(predictor, state.robot_id(i));
-    const double arrival = AddLegSamples(sampler, predictor, s.end_point, first_pick,
-                                         s.end_time, density);
-    if (!std::isfinite(leg) || !std::isfinite(arrival)) {
+    if (!std::isfinite(leg)) {
       bids.push_back(UnreachableBid(state.robot_id(i), s.end_time));
       continue;
     }
-    density.Add(pick_zone, arrival);  // the first pick on arrival
     Bid b;
     b.robot = state.robot_id(i);
     b.ready_time = s.end_time;
-    b.t_d = s.travel_time + leg;
-    b.t_w = s.work_time;
-    FillBid(c, density.Finish(), b);
+    SetTimes(c, s.travel_time + leg, s.work_time, b);
     bids.push_back(std::move(b));
   }
+  PriceLowest(bids, keep, [&](std::size_t i) {
+    const QueueSummary& s = state.summary(i);
+    TrafficPredictor::DensityAccumulator density(predictor, state.robot_id(i));
+    const double arrival = AddLegSamples(sampler, predictor, s.end_point, first_pick,
+                                         s.end_time, density);
+    if (!std::isfinite(arrival)) {
+      bids[i] = UnreachableBid(state.robot_id(i), s.end_time);
+      return;
+    }
+    density.Add(pick_zone, arrival);  // the first pick on arrival
+    FillBid(c, density.Finish(), bids[i]);
+  });
   return bids;
 }
 
@@ -200,7 +259,7 @@ Result<AwardExplanation> AuctionAllocator::Allocate(const Order& order, FleetSta
   AwardExplanation ex;
   ex.order_id = order.id;
   ex.strategy = std::string(name());
-  ex.bids = ComputeBids(state, *task);
+  ex.bids = ComputeBids(state, *task, Keep(state, 2));
   const std::vector<std::size_t> leader = Lowest(ex.bids, 1);
   if (leader.empty()) {
     return Unreachable("order " + order.id + ": no robot can reach the first pick " + first_name);
@@ -213,7 +272,7 @@ Result<AwardExplanation> AuctionAllocator::Allocate(const Order& order, FleetSta
     return ex;
   }
   // Chu2024 §2.2: the two robots with the lowest cost to reach the first pick join.
-  std::vector<Bid> reach = ComputeReachBids(state, task->picks.front());
+  std::vector<Bid> reach = ComputeReachBids(state, task->picks.front(), Keep(state, 4));
   const std::vector<std::size_t> companions = Lowest(reach, 2, lead);
   if (companions.size() < 2) {
     return Unreachable("order " + order.id + ": a formation needs 2 companions for leader " +

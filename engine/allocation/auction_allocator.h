@@ -8,8 +8,13 @@
 //   sampled every h metres (RouteSampler) at the times the robot would be there, counting
 //   the other robots' predicted positions (eqs. (6)-(8));  B = alpha T_t + beta T_d + zeta F
 //   (eqs. (4), (5)).
-// The candidate route starts where and when the robot's queue ends. F is computed for every
-// robot (no pruning), so the explanation holds every robot's full terms.
+// The candidate route starts where and when the robot's queue ends. In fleets up to
+// AllocationConfig::price_every_bid_up_to robots F is computed for every robot, so the
+// explanation holds every robot's full terms. Larger fleets price robots in increasing order
+// of alpha T_t + beta T_d (<= B, since zeta F >= 0) and stop when that bound exceeds the k-th
+// lowest full bid so far (k = 2 for the leader: winner and runner-up of the explanation; 4
+// for reach costs: the leader, 2 companions and the next one): the award and its reason are
+// the same as with every bid priced; the unpriced bids say so (Bid::priced).
 // Lowest B wins; ties go to the earlier robot in FleetState order.
 //
 // Formation orders (§2.2): the lowest bidder leads; then every other robot's cost to reach the
@@ -38,9 +43,14 @@ class AuctionAllocator final : public Allocator {
   Result<AwardExplanation> Allocate(const Order& order, FleetState& state) override;
 
   // Every robot's bid for `task` appended to its queue, in robot order; commits nothing.
-  std::vector<Bid> ComputeBids(const FleetState& state, const PlanTask& task);
+  // keep = 0 prices every bid; keep = k > 0 only those that can be among the k lowest (the
+  // others get priced = false and their lower bound).
+  std::vector<Bid> ComputeBids(const FleetState& state, const PlanTask& task,
+                               std::size_t keep = 0);
   // Every robot's cost to reach `first_pick` after its queue, in robot order; commits nothing.
-  std::vector<Bid> ComputeReachBids(const FleetState& state, PointId first_pick);
+  // keep as for ComputeBids.
+  std::vector<Bid> ComputeReachBids(const FleetState& state, PointId first_pick,
+                                    std::size_t keep = 0);
 
  private:
   // Feeds the samples of the leg from -> to (leaving at `depart`: RouteSampler::AppendLeg's
@@ -53,6 +63,15 @@ class AuctionAllocator final : public Allocator {
                       const Eigen::Vector2d& xb, double f);
   // Forgets the remembered zones (they hold for one map and one predictor: one call).
   void ResetMixedArcs(const WarehouseMap& map);
+
+  // Calls price(i) for the robots that can be among the `keep` lowest bids (all when keep is
+  // 0), in increasing order of their lower bound bids[i].bid, and marks the others unpriced.
+  // bids holds every robot's time terms and bound on entry; price(i) completes bids[i].
+  template <typename Price>
+  void PriceLowest(std::vector<Bid>& bids, std::size_t keep, Price&& price);
+
+  std::vector<std::size_t> order_;  // PriceLowest's robot order
+  std::vector<double> kept_;        // PriceLowest's k lowest full bids, ascending
 
   struct MixedSample {
     double f = std::numeric_limits<double>::quiet_NaN();  // NaN: empty (never equal)

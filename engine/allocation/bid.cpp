@@ -7,6 +7,12 @@ namespace dispatch::engine {
 std::string DescribeBid(const Bid& bid) {
   if (!bid.reachable) return bid.robot + " cannot reach the order";
   char buf[200];
+  if (!bid.priced) {
+    std::snprintf(buf, sizeof(buf),
+                  " B>=%.2f (T_t=%.2f, T_d=%.2f, T_w=%.2f, F not evaluated: could not win)",
+                  bid.bid, bid.t_t, bid.t_d, bid.t_w);
+    return bid.robot + buf;
+  }
   std::snprintf(buf, sizeof(buf), " B=%.2f (T_t=%.2f, T_d=%.2f, T_w=%.2f, F=%.4f, x=%.2f)",
                 bid.bid, bid.t_t, bid.t_d, bid.t_w, bid.flow, bid.x);
   return bid.robot + buf;

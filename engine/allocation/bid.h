@@ -4,7 +4,10 @@
 //
 // Invariant of a reachable Bid from an allocator: bid == BidValue(alpha, beta, t_t, t_d, x),
 // t_t == t_d + t_w, x == zeta * flow. An unreachable robot (no route to the order) has
-// reachable = false and every time term +infinity. Plain values; thread-safe to share.
+// reachable = false and every time term +infinity. A bid that was not priced (priced = false:
+// large fleets, see AllocationConfig::price_every_bid_up_to) has its time terms, flow = x = 0,
+// and bid = alpha * T_t + beta * T_d: a lower bound of its full bid that already exceeds the
+// bids that decided the award. Plain values; thread-safe to share.
 #pragma once
 
 #include <string>
@@ -18,6 +21,7 @@ namespace dispatch::engine {
 struct Bid {
   std::string robot;
   bool reachable = true;
+  bool priced = true;  // F_i evaluated; false: bid is the lower bound alpha T_t + beta T_d
   double t_d = 0.0;   // T_d,i: travel time of the whole queue + this order, s (eq. (3))
   double t_w = 0.0;   // T_w,i: work time n_c * t_w of the whole queue + this order, s (eq. (3))
   double t_t = 0.0;   // T_t,i = T_d,i + T_w,i (eq. (2))

@@ -111,37 +111,46 @@ void RunAuctions(benchmark::State& state, const Scenario& s, const std::vector<F
   state.counters["points"] = static_cast<double>(s.map->point_count());
 }
 
-void BM_Auction(benchmark::State& state) {
-  static const Scenario s = GridScenario();
+std::vector<FleetRobot> RandomRobots(const Scenario& s, int count) {
   std::mt19937 rng(3);
   std::vector<FleetRobot> robots;
-  for (int i = 0; i < state.range(0); ++i) {
+  for (int i = 0; i < count; ++i) {
     robots.push_back({"R" + std::to_string(i + 1),
                       static_cast<PointId>(rng() % s.map->point_count()), 0.0});
   }
-  RunAuctions(state, s, robots);
+  return robots;
+}
+
+void BM_Auction(benchmark::State& state) {
+  static const Scenario s = GridScenario();
+  RunAuctions(state, s, RandomRobots(s, static_cast<int>(state.range(0))));
 }
 BENCHMARK(BM_Auction)->Arg(18)->Arg(100)->Arg(1000)->Unit(benchmark::kMillisecond);
 
-// Only the bidding of one round (every robot's B_i with F_i), no award: the auction's core.
-void BM_AuctionBids(benchmark::State& state) {
+// Only the bidding of one round, no award: the auction's core. keep = 0 prices every bid
+// (F_i for every robot, as fleets up to AllocationConfig::price_every_bid_up_to get);
+// keep = 2 prices only the bids that can be the winner or the runner-up (larger fleets).
+void RunBids(benchmark::State& state, std::size_t keep) {
   static const Scenario s = GridScenario();
-  std::mt19937 rng(3);
-  std::vector<FleetRobot> robots;
-  for (int i = 0; i < state.range(0); ++i) {
-    robots.push_back({"R" + std::to_string(i + 1),
-                      static_cast<PointId>(rng() % s.map->point_count()), 0.0});
-  }
-  FleetState fleet = QueuedFleet(s, robots);
+  FleetState fleet = QueuedFleet(s, RandomRobots(s, static_cast<int>(state.range(0))));
   AuctionAllocator auction;
+  std::mt19937 rng(3);
   int k = 0;
+  std::size_t priced = 0;
   for (auto _ : state) {
     const Order order = RandomOrder(s, rng, ++k);
-    auto bids = auction.ComputeBids(fleet, fleet.TaskOf(order.picks, order.drop, order.work_time));
+    auto bids = auction.ComputeBids(fleet, fleet.TaskOf(order.picks, order.drop, order.work_time),
+                                    keep);
+    for (const Bid& b : bids) priced += b.priced;
     benchmark::DoNotOptimize(bids.data());
   }
+  state.counters["priced"] =
+      benchmark::Counter(static_cast<double>(priced), benchmark::Counter::kAvgIterations);
 }
+void BM_AuctionBids(benchmark::State& state) { RunBids(state, 0); }
 BENCHMARK(BM_AuctionBids)->Arg(1000)->Unit(benchmark::kMillisecond);
+void BM_AuctionPricedBids(benchmark::State& state) { RunBids(state, 2); }
+BENCHMARK(BM_AuctionPricedBids)->Arg(1000)->Unit(benchmark::kMillisecond);
 
 void BM_AuctionChu2024(benchmark::State& state) {
   static const Scenario s = Chu2024Scenario();

@@ -241,6 +241,54 @@ TEST_F(AuctionGridTest, FormationLeaderIsTheLowestBidderAndCompanionsReachFirst)
   }
 }
 
+// Large fleets price only the bids that can decide the award (price_every_bid_up_to): the
+// winners, the reason and every priced bid equal those of pricing every bid, and each
+// unpriced bid's lower bound already exceeds the bids that decided.
+TEST_F(AuctionGridTest, PricingOnlyBidsThatCanWinGivesTheSameAward) {
+  std::size_t unpriced = 0;
+  for (double zeta : {0.0, 100.0}) {
+    for (int seed = 0; seed < 12; ++seed) {
+      std::mt19937 rng(300 + seed);
+      const std::vector<FleetRobot> robots = RandomRobots(rng, 6 + seed % 7);
+      AllocationConfig full_config;
+      full_config.zeta = zeta;
+      AllocationConfig pruned_config = full_config;
+      pruned_config.price_every_bid_up_to = 1;
+      FleetState full = MakeFleet(map_, routes_, robots, full_config);
+      FleetState pruned = MakeFleet(map_, routes_, robots, pruned_config);
+      AuctionAllocator a_full, a_pruned;
+      for (int k = 0; k < 8; ++k) {
+        const Order o = RandomOrder(rng, k, /*formation=*/k % 3 == 2);
+        Result<AwardExplanation> f = a_full.Allocate(o, full);
+        Result<AwardExplanation> p = a_pruned.Allocate(o, pruned);
+        ASSERT_TRUE(f.ok()) << f.error().message;
+        ASSERT_TRUE(p.ok()) << p.error().message;
+        EXPECT_EQ(p->winners, f->winners) << "seed " << seed << " order " << k;
+        EXPECT_EQ(p->reason, f->reason);
+        ASSERT_EQ(p->bids.size(), f->bids.size());
+        const double winning = f->bids[*full.FindRobot(f->winners[0])].bid;
+        for (std::size_t i = 0; i < p->bids.size(); ++i) {
+          const Bid& b = p->bids[i];
+          EXPECT_EQ(b.t_d, f->bids[i].t_d);
+          EXPECT_EQ(b.t_w, f->bids[i].t_w);
+          if (b.priced) {
+            EXPECT_EQ(b.bid, f->bids[i].bid);
+            EXPECT_EQ(b.flow, f->bids[i].flow);
+          } else {
+            ++unpriced;
+            EXPECT_TRUE(f->bids[i].priced);
+            EXPECT_EQ(b.bid, full_config.alpha * b.t_t + full_config.beta * b.t_d);
+            EXPECT_LE(b.bid, f->bids[i].bid);  // a lower bound
+            EXPECT_GT(b.bid, winning);
+            EXPECT_NE(DescribeBid(b).find("not evaluated"), std::string::npos);
+          }
+        }
+      }
+    }
+  }
+  EXPECT_GT(unpriced, 100u);  // the pruning is exercised
+}
+
 TEST(AuctionErrorTest, BadOrdersFailAndOthersStillAllocate) {
   MapBuilder b("trap");
   b.SetFloor({-1, -1}, {9, 5});
