@@ -1,0 +1,260 @@
+// fleet-sim: N simulated robots in one process, each with its own FleetService.Connect
+// stream (SPEC §5). Robots start at the map's parking stations in station order, then at
+// lane points spread over the map (the rule of engine/sim/fleet_placement.h), named R1..RN.
+// Each robot follows its released timed waypoints (clients/sim_robot.h) on the dispatcher's
+// clock: the server's time and time scale come in Welcome, so both clocks agree.
+//
+//   fleet-sim --server 127.0.0.1:50051 --robots 18
+//   fleet-sim --server ... --robots 18 --drop-every 20 --stall R3 --slow R5:0.5 --delay-ms 50
+//
+// Faults: --drop-every S closes one robot's stream every S wall seconds (round robin) and
+// reconnects it, saying its last applied sequence; --stall and --slow change a robot's
+// motion; --delay-ms delays every robot -> server message. Runs until SIGINT/SIGTERM or
+// --duration wall seconds.
+#include <grpcpp/grpcpp.h>
+
+#include <CLI/CLI.hpp>
+
+#include <atomic>
+#include <chrono>
+#include <csignal>
+#include <cstdio>
+#include <map>
+#include <memory>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "clients/robot_stream.h"
+#include "clients/sim_robot.h"
+#include "warehouse/dispatch/v1/map.grpc.pb.h"
+
+namespace dispatch::clients {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+std::atomic<bool> g_stop{false};
+void OnSignal(int) { g_stop = true; }
+
+double Seconds(Clock::duration d) { return std::chrono::duration<double>(d).count(); }
+
+struct Slot {
+  std::unique_ptr<SimRobot> robot;
+  std::unique_ptr<RobotStream> stream;
+  bool welcomed = false;
+  double welcome_server_time = 0.0;
+  double time_scale = 1.0;
+  double heartbeat_interval = 1.0;
+  Clock::time_point welcome_wall;
+  Clock::time_point last_sent;
+  Clock::time_point last_report;
+  Clock::time_point next_connect;
+  std::uint64_t acked = 0;
+  int connects = 0;
+  std::string last_error;
+
+  double Now(Clock::time_point wall) const {
+    return welcome_server_time + Seconds(wall - welcome_wall) * time_scale;
+  }
+};
+
+// Robot start points: stations first, then lane points spread evenly (fleet_placement.h).
+std::vector<v1::MapPoint> StartPoints(const v1::Map& map, std::size_t count, std::string* error) {
+  std::vector<v1::MapPoint> out;
+  for (const v1::MapStation& s : map.stations()) {
+    if (out.size() == count) break;
+    if (s.point_id() < 0 || s.point_id() >= map.points_size()) continue;
+    out.push_back(map.points(s.point_id()));
+  }
+  if (out.size() == count) return out;
+  std::vector<int> lanes;
+  for (const v1::MapPoint& p : map.points()) {
+    if (p.kind() == v1::POINT_KIND_LANE) lanes.push_back(p.id());
+  }
+  const std::size_t need = count - out.size();
+  if (lanes.size() < need) {
+    *error = "map '" + map.name() + "' has room for " + std::to_string(out.size() + lanes.size()) +
+             " robots, not " + std::to_string(count);
+    return {};
+  }
+  for (std::size_t i = 0; i < need; ++i) out.push_back(map.points(lanes[i * lanes.size() / need]));
+  return out;
+}
+
+int Main(int argc, char** argv) {
+  CLI::App app{"fleet-sim: simulated robots on real gRPC streams"};
+  std::string server = "127.0.0.1:50051";
+  std::size_t count = 18;
+  double speed = 1.0, report_hz = 10.0, tick_hz = 50.0, duration = 0.0, drop_every = 0.0;
+  int delay_ms = 0;
+  std::vector<std::string> stall, slow;
+  app.add_option("--server", server, "dispatchd gRPC address HOST:PORT")->capture_default_str();
+  app.add_option("--robots", count, "Number of robots")->capture_default_str()
+      ->check(CLI::Range(std::size_t{1}, std::size_t{100000}));
+  app.add_option("--speed", speed, "Robot speed, m/s")->capture_default_str()
+      ->check(CLI::PositiveNumber);
+  app.add_option("--report-hz", report_hz, "State reports per wall second")->capture_default_str()
+      ->check(CLI::PositiveNumber);
+  app.add_option("--tick-hz", tick_hz, "Motion steps per wall second")->capture_default_str()
+      ->check(CLI::PositiveNumber);
+  app.add_option("--duration", duration, "Stop after this many wall seconds (0: until a signal)");
+  app.add_option("--drop-every", drop_every, "Fault: drop and reconnect one stream every S s");
+  app.add_option("--delay-ms", delay_ms, "Fault: delay every robot message by this many ms")
+      ->check(CLI::NonNegativeNumber);
+  app.add_option("--stall", stall, "Fault: these robots never move (ids, repeat)");
+  app.add_option("--slow", slow, "Fault: ID:FACTOR drives at FACTOR x speed (repeat)");
+  CLI11_PARSE(app, argc, argv);
+
+  std::signal(SIGINT, OnSignal);
+  std::signal(SIGTERM, OnSignal);
+  auto channel = grpc::CreateChannel(server, grpc::InsecureChannelCredentials());
+  v1::GetMapResponse map;
+  {
+    grpc::ClientContext ctx;
+    ctx.set_wait_for_ready(true);
+    ctx.set_deadline(std::chrono::system_clock::now() + std::chrono::seconds(30));
+    const grpc::Status s = v1::MapService::NewStub(channel)->GetMap(&ctx, {}, &map);
+    if (!s.ok()) {
+      std::fprintf(stderr, "fleet-sim: GetMap from %s failed: %s\n", server.c_str(),
+                   s.error_message().c_str());
+      return 1;
+    }
+  }
+  std::string error;
+  const std::vector<v1::MapPoint> starts = StartPoints(map.map(), count, &error);
+  if (!error.empty()) {
+    std::fprintf(stderr, "fleet-sim: %s\n", error.c_str());
+    return 1;
+  }
+  auto fleet_stub = v1::FleetService::NewStub(channel);
+  std::vector<Slot> slots(count);
+  std::map<std::string, std::size_t> by_id;
+  for (std::size_t i = 0; i < count; ++i) {
+    const std::string id = "R" + std::to_string(i + 1);
+    slots[i].robot = std::make_unique<SimRobot>(
+        id, Eigen::Vector2d(starts[i].position().x(), starts[i].position().y()), speed);
+    by_id[id] = i;
+  }
+  for (const std::string& id : stall) {
+    if (!by_id.count(id)) return std::fprintf(stderr, "fleet-sim: --stall: no robot %s\n", id.c_str()), 1;
+    slots[by_id[id]].robot->set_stalled(true);
+  }
+  for (const std::string& spec : slow) {
+    const auto colon = spec.find(':');
+    const std::string id = spec.substr(0, colon);
+    double factor = 0.0;
+    try {
+      factor = colon == std::string::npos ? 0.0 : std::stod(spec.substr(colon + 1));
+    } catch (const std::exception&) {
+    }
+    if (!by_id.count(id) || !(factor > 0.0)) {
+      std::fprintf(stderr, "fleet-sim: --slow wants ID:FACTOR with a known id and FACTOR > 0, got '%s'\n",
+                   spec.c_str());
+      return 1;
+    }
+    slots[by_id[id]].robot->set_slow_factor(factor);
+  }
+  std::printf("fleet-sim: %zu robots on map '%s' (version %s), server %s\n", count,
+              map.map().name().c_str(), map.version().c_str(), server.c_str());
+  std::fflush(stdout);
+
+  const auto tick = std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(1.0 / tick_hz));
+  const auto report_every = std::chrono::duration<double>(1.0 / report_hz);
+  const Clock::time_point start = Clock::now();
+  Clock::time_point next_tick = start, next_drop = start + std::chrono::duration_cast<Clock::duration>(
+                                                                std::chrono::duration<double>(drop_every));
+  std::size_t drop_cursor = 0;
+  std::vector<v1::RobotMessage> events;
+  std::size_t connected_reported = 0;
+  while (!g_stop) {
+    const Clock::time_point now = Clock::now();
+    if (duration > 0.0 && Seconds(now - start) >= duration) break;
+    if (drop_every > 0.0 && now >= next_drop) {
+      Slot& s = slots[drop_cursor++ % count];
+      if (s.stream && !s.stream->done()) {
+        std::printf("fleet-sim: fault: dropping %s's stream\n", s.robot->id().c_str());
+        s.stream->Close();
+      }
+      next_drop = now + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(drop_every));
+    }
+    std::size_t connected = 0;
+    for (Slot& s : slots) {
+      if (s.stream && s.stream->done()) {
+        const grpc::Status st = s.stream->status();
+        if (!st.ok() && st.error_code() != grpc::StatusCode::CANCELLED &&
+            st.error_message() != s.last_error) {
+          std::fprintf(stderr, "fleet-sim: %s: stream ended: %s\n", s.robot->id().c_str(),
+                       st.error_message().c_str());
+          s.last_error = st.error_message();
+        }
+        s.stream.reset();
+        s.welcomed = false;
+        s.next_connect = now + std::chrono::milliseconds(200);  // reconnect pacing
+      }
+      if (!s.stream) {
+        if (now < s.next_connect) continue;
+        s.stream = std::make_unique<RobotStream>(*fleet_stub, s.robot->Hello(),
+                                                 std::chrono::milliseconds(delay_ms));
+        s.last_sent = now;
+        ++s.connects;
+      }
+      for (const v1::ServerMessage& m : s.stream->TakeReceived()) {
+        if (m.has_welcome()) {
+          s.welcomed = true;
+          s.welcome_server_time = m.welcome().server_time();
+          s.time_scale = m.welcome().time_scale() > 0.0 ? m.welcome().time_scale() : 1.0;
+          s.heartbeat_interval = m.welcome().heartbeat_interval() > 0.0 ? m.welcome().heartbeat_interval() : 1.0;
+          s.welcome_wall = now;
+        }
+        s.robot->Apply(m);
+      }
+      if (!s.welcomed) continue;
+      ++connected;
+      if (s.robot->last_applied_sequence() > s.acked) {
+        v1::RobotMessage ack;
+        ack.mutable_ack()->set_sequence(s.robot->last_applied_sequence());
+        s.stream->Send(ack);
+        s.acked = s.robot->last_applied_sequence();
+        s.last_sent = now;
+      }
+      events.clear();
+      s.robot->Step(s.Now(now), events);
+      for (const v1::RobotMessage& e : events) s.stream->Send(e);
+      if (!events.empty()) s.last_sent = now;
+      if (now - s.last_report >= report_every) {
+        s.stream->Send(s.robot->Report());
+        s.last_report = s.last_sent = now;
+      } else if (Seconds(now - s.last_sent) >= s.heartbeat_interval / 2) {
+        v1::RobotMessage hb;
+        hb.mutable_heartbeat()->set_robot_unix_ms(
+            std::chrono::duration_cast<std::chrono::milliseconds>(
+                std::chrono::system_clock::now().time_since_epoch()).count());
+        s.stream->Send(hb);
+        s.last_sent = now;
+      }
+      s.stream->Pump();
+    }
+    if (connected != connected_reported && (connected == count || connected == 0)) {
+      std::printf("fleet-sim: %zu of %zu robots connected\n", connected, count);
+      std::fflush(stdout);
+      connected_reported = connected;
+    }
+    next_tick += tick;
+    if (next_tick < Clock::now()) next_tick = Clock::now();  // overloaded: do not spiral
+    std::this_thread::sleep_until(next_tick);  // pacing of the motion loop
+  }
+  for (Slot& s : slots) {
+    if (s.stream) s.stream->Close();
+  }
+  for (Slot& s : slots) {
+    if (s.stream) s.stream->WaitDone();
+  }
+  std::printf("fleet-sim: stopped\n");
+  return 0;
+}
+
+}  // namespace
+}  // namespace dispatch::clients
+
+int main(int argc, char** argv) { return dispatch::clients::Main(argc, argv); }

@@ -1,0 +1,95 @@
+// One simulated robot of fleet-sim (SPEC §5): the robot side of FleetService.Connect without
+// the network, so it is tested on its own.
+//
+// Model. The robot stands on or drives between the waypoints of its current plan, in
+// dispatcher time (seconds; the server's clock). It drives straight towards the next
+// waypoint at up to `speed` m/s, never past the last released waypoint (VDA 5050 horizon),
+// and never leaves a waypoint before that waypoint's planned departure (eta + dwell): ahead
+// of plan it waits, behind plan it goes at full speed. At pick and drop waypoints it stands
+// `dwell` seconds after arriving, then reports the TaskEvent (picked / dropped). It reports
+// WaypointReached once per waypoint, in order.
+//
+// Server messages (Apply): a message whose sequence is not above the last applied one is
+// ignored (repeats after a reconnect are harmless); Assignment replaces the plan; PlanUpdate
+// replaces its tail; Grant and Resume raise the release horizon; Hold stops the robot at once
+// (or at a waypoint) until Resume; Cancel voids the named orders' waypoints (all when none
+// are named): the robot stops at its next waypoint and keeps what remains.
+//
+// Faults for tests of the server: a stalled robot does not move (it still talks); a slow
+// robot drives at speed * slow_factor.
+//
+// Not thread-safe: one owner (fleet-sim's loop) drives it.
+#pragma once
+
+#include <Eigen/Core>
+
+#include <cstdint>
+#include <deque>
+#include <string>
+#include <vector>
+
+#include "warehouse/dispatch/v1/fleet.pb.h"
+
+namespace dispatch::clients {
+
+namespace v1 = ::warehouse::dispatch::v1;
+
+class SimRobot {
+ public:
+  SimRobot(std::string id, const Eigen::Vector2d& position, double speed);
+
+  const std::string& id() const { return id_; }
+  const Eigen::Vector2d& position() const { return position_; }
+  double heading() const { return heading_; }
+  double speed() const { return current_speed_; }
+  std::uint64_t last_applied_sequence() const { return last_applied_; }
+  bool held() const { return held_; }
+  // No plan left: standing on its last waypoint (or never given one), not working.
+  bool idle() const;
+  std::size_t pending_waypoints() const { return waypoints_.size(); }
+
+  void set_stalled(bool stalled) { stalled_ = stalled; }
+  void set_slow_factor(double factor) { slow_factor_ = factor; }
+
+  // The first message of a stream.
+  v1::RobotMessage Hello() const;
+  // Applies one server message (see the file comment). Returns false for a message it
+  // ignored as already applied.
+  bool Apply(const v1::ServerMessage& message);
+  // Advances to dispatcher time `now` (>= the previous call's); appends the events that
+  // happened (WaypointReached, TaskEvent) to `out`.
+  void Step(double now, std::vector<v1::RobotMessage>& out);
+  // A state report for now.
+  v1::RobotMessage Report() const;
+
+ private:
+  struct Waypoint {
+    v1::TimedWaypoint wp;
+    bool arrived = false;
+  };
+  void AdoptWaypoints(const google::protobuf::RepeatedPtrField<v1::TimedWaypoint>& wps);
+  void ArriveAt(Waypoint& w, double time, std::vector<v1::RobotMessage>& out);
+  bool MayDriveTo(const Waypoint& w) const;
+
+  std::string id_;
+  Eigen::Vector2d position_;
+  double heading_ = 0.0;
+  double speed_;
+  double current_speed_ = 0.0;
+  double now_ = 0.0;
+  bool started_ = false;
+
+  std::uint64_t last_applied_ = 0;
+  std::deque<Waypoint> waypoints_;  // the front is the one being driven to (or stood on)
+  std::uint64_t released_up_to_ = 0;
+  std::uint64_t last_reached_ = 0;
+  bool held_ = false;
+  std::uint64_t hold_at_ = 0;  // stop at this waypoint (0: at once)
+  bool dwelling_ = false;
+  double dwell_until_ = 0.0;
+  v1::TimedWaypoint dwell_wp_;
+  bool stalled_ = false;
+  double slow_factor_ = 1.0;
+};
+
+}  // namespace dispatch::clients

@@ -1,0 +1,176 @@
+#include "clients/sim_robot.h"
+
+#include <gtest/gtest.h>
+
+#include <vector>
+
+namespace dispatch::clients {
+namespace {
+
+v1::TimedWaypoint Wp(std::uint64_t seq, double x, double y, double eta,
+                     v1::WaypointAction action = v1::WAYPOINT_ACTION_MOVE, double dwell = 0,
+                     bool released = true, const std::string& order = "") {
+  v1::TimedWaypoint w;
+  w.set_sequence(seq);
+  w.set_point_id(static_cast<int>(seq));
+  w.set_x(x);
+  w.set_y(y);
+  w.set_eta(eta);
+  w.set_action(action);
+  w.set_dwell(dwell);
+  w.set_released(released);
+  w.set_order_id(order);
+  return w;
+}
+
+// Start (0,0) -> (2,0) -> pick at (4,0), 3 s -> drop at (4,3), 1 s; all released, v = 1 m/s.
+v1::ServerMessage Plan(std::uint64_t seq, bool release_all = true) {
+  v1::ServerMessage m;
+  m.set_sequence(seq);
+  v1::Assignment* a = m.mutable_assignment();
+  a->set_plan_id(1);
+  a->add_order_ids("o1");
+  *a->add_waypoints() = Wp(1, 0, 0, 0);
+  *a->add_waypoints() = Wp(2, 2, 0, 2);
+  *a->add_waypoints() = Wp(3, 4, 0, 4, v1::WAYPOINT_ACTION_PICK, 3, release_all, "o1");
+  *a->add_waypoints() = Wp(4, 4, 3, 10, v1::WAYPOINT_ACTION_DROP, 1, release_all, "o1");
+  a->set_released_up_to_sequence(release_all ? 4 : 2);
+  return m;
+}
+
+struct Events {
+  std::vector<v1::RobotMessage> events;
+  std::vector<std::string> Names() const {
+    std::vector<std::string> n;
+    for (const auto& e : events) {
+      if (e.has_waypoint_reached()) n.push_back("wp" + std::to_string(e.waypoint_reached().sequence()));
+      if (e.has_task_event()) {
+        n.push_back(e.task_event().type() == v1::TASK_EVENT_TYPE_PICKED ? "picked" : "dropped");
+      }
+    }
+    return n;
+  }
+};
+
+void StepTo(SimRobot& r, double from, double to, double dt, Events& run) {
+  for (double t = from; t <= to + 1e-9; t += dt) r.Step(t, run.events);
+}
+
+TEST(SimRobotTest, FollowsTheTimedPlanAndReportsInOrder) {
+  SimRobot r("R1", {0, 0}, 1.0);
+  ASSERT_TRUE(r.Apply(Plan(1)));
+  Events run;
+  StepTo(r, 0.0, 3.0, 0.1, run);
+  EXPECT_NEAR(r.position().x(), 3.0, 1e-6);  // 1 m/s along x
+  StepTo(r, 3.1, 6.9, 0.1, run);
+  EXPECT_NEAR(r.position().x(), 4.0, 1e-9);  // picking (arrived at 4 s, 3 s of work)
+  EXPECT_EQ(run.Names(), (std::vector<std::string>{"wp1", "wp2", "wp3"}));
+  EXPECT_EQ(r.Report().state_report().state(), v1::ROBOT_STATE_WORKING);
+  StepTo(r, 7.0, 9.9, 0.1, run);
+  // Picked at 7 s; the drop point (3 m on) is reached at 10 s, its eta.
+  EXPECT_EQ(run.Names(), (std::vector<std::string>{"wp1", "wp2", "wp3", "picked"}));
+  EXPECT_NEAR(r.position().y(), 2.9, 1e-6);
+  StepTo(r, 10.05, 12.0, 0.1, run);
+  EXPECT_EQ(run.Names(),
+            (std::vector<std::string>{"wp1", "wp2", "wp3", "picked", "wp4", "dropped"}));
+  EXPECT_TRUE(r.idle());
+  EXPECT_EQ(r.Report().state_report().state(), v1::ROBOT_STATE_IDLE);
+  EXPECT_EQ(r.Report().state_report().last_waypoint_sequence(), 4u);
+}
+
+TEST(SimRobotTest, WaitsForPlannedDepartureWhenAhead) {
+  SimRobot r("R1", {0, 0}, 1.0);
+  v1::ServerMessage m = Plan(1);
+  m.mutable_assignment()->mutable_waypoints(0)->set_eta(5.0);  // leave the start at 5 s
+  r.Apply(m);
+  Events run;
+  StepTo(r, 0.0, 4.9, 0.1, run);
+  EXPECT_EQ(r.position().x(), 0.0);
+  StepTo(r, 5.0, 6.0, 0.1, run);
+  EXPECT_NEAR(r.position().x(), 1.0, 1e-6);
+}
+
+TEST(SimRobotTest, StopsAtTheReleaseHorizonUntilAGrant) {
+  SimRobot r("R1", {0, 0}, 1.0);
+  r.Apply(Plan(1, /*release_all=*/false));
+  Events run;
+  StepTo(r, 0.0, 20.0, 0.5, run);
+  EXPECT_EQ(r.position().x(), 2.0);  // waypoint 2 is the last released one
+  EXPECT_EQ(run.Names(), (std::vector<std::string>{"wp1", "wp2"}));
+  EXPECT_EQ(r.Report().state_report().state(), v1::ROBOT_STATE_WAITING);
+  v1::ServerMessage g;
+  g.set_sequence(2);
+  g.mutable_grant()->set_release_up_to_sequence(4);
+  r.Apply(g);
+  StepTo(r, 20.5, 21.0, 0.5, run);
+  EXPECT_NEAR(r.position().x(), 3.0, 1e-9);
+}
+
+TEST(SimRobotTest, HoldStopsAtOnceAndResumeContinues) {
+  SimRobot r("R1", {0, 0}, 1.0);
+  r.Apply(Plan(1));
+  Events run;
+  StepTo(r, 0.0, 1.0, 0.5, run);
+  v1::ServerMessage h;
+  h.set_sequence(2);
+  h.mutable_hold()->set_reason("test");
+  r.Apply(h);
+  StepTo(r, 1.5, 5.0, 0.5, run);
+  EXPECT_NEAR(r.position().x(), 1.0, 1e-9);
+  EXPECT_TRUE(r.held());
+  v1::ServerMessage res;
+  res.set_sequence(3);
+  res.mutable_resume();
+  r.Apply(res);
+  StepTo(r, 5.5, 6.0, 0.5, run);
+  EXPECT_NEAR(r.position().x(), 2.0, 1e-9);
+}
+
+TEST(SimRobotTest, RepeatedMessagesAreHarmless) {
+  SimRobot r("R1", {0, 0}, 1.0);
+  EXPECT_TRUE(r.Apply(Plan(1)));
+  Events run;
+  StepTo(r, 0.0, 3.0, 0.1, run);
+  EXPECT_FALSE(r.Apply(Plan(1)));  // the same sequence again: ignored
+  EXPECT_EQ(r.last_applied_sequence(), 1u);
+  // The server re-sends the plan under a new sequence after a reconnect: reached
+  // waypoints are not driven or reported again.
+  EXPECT_TRUE(r.Apply(Plan(7)));
+  StepTo(r, 3.1, 12.0, 0.1, run);
+  EXPECT_EQ(run.Names(),
+            (std::vector<std::string>{"wp1", "wp2", "wp3", "picked", "wp4", "dropped"}));
+  EXPECT_EQ(r.Hello().hello().last_acked_sequence(), 7u);
+}
+
+TEST(SimRobotTest, CancelStopsAtTheNextWaypointWithoutWorking) {
+  SimRobot r("R1", {0, 0}, 1.0);
+  r.Apply(Plan(1));
+  Events run;
+  StepTo(r, 0.0, 2.5, 0.1, run);  // past waypoint 2, driving to the pick
+  v1::ServerMessage c;
+  c.set_sequence(2);
+  c.mutable_cancel()->add_order_ids("o1");
+  r.Apply(c);
+  StepTo(r, 2.6, 20.0, 0.1, run);
+  EXPECT_NEAR(r.position().x(), 4.0, 1e-9);
+  EXPECT_NEAR(r.position().y(), 0.0, 1e-9);
+  EXPECT_EQ(run.Names(), (std::vector<std::string>{"wp1", "wp2", "wp3"}));
+  EXPECT_TRUE(r.idle());
+}
+
+TEST(SimRobotTest, StalledRobotDoesNotMoveSlowRobotLags) {
+  SimRobot stalled("R1", {0, 0}, 1.0), slow("R2", {0, 0}, 1.0);
+  stalled.Apply(Plan(1));
+  slow.Apply(Plan(1));
+  stalled.set_stalled(true);
+  slow.set_slow_factor(0.5);
+  Events run;
+  StepTo(stalled, 0.0, 2.0, 0.1, run);
+  StepTo(slow, 0.0, 2.0, 0.1, run);
+  EXPECT_EQ(stalled.position().x(), 0.0);
+  EXPECT_EQ(stalled.Report().state_report().state(), v1::ROBOT_STATE_FAULT);
+  EXPECT_NEAR(slow.position().x(), 1.0, 1e-6);
+}
+
+}  // namespace
+}  // namespace dispatch::clients
