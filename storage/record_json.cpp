@@ -1,0 +1,195 @@
+#include "storage/record_json.h"
+
+#include <nlohmann/json.hpp>
+
+#include <cmath>
+#include <cstdint>
+#include <cstdio>
+
+namespace dispatch::storage {
+namespace {
+
+using nlohmann::json;
+
+Error Corrupt(const char* what, const std::string& detail) {
+  return engine::IoError(std::string("stored ") + what + " is corrupt: " + detail);
+}
+
+bool AllFinite(std::initializer_list<double> values) {
+  for (double v : values) {
+    if (!std::isfinite(v)) return false;
+  }
+  return true;
+}
+
+// Parses `text` and runs `read` on it, turning any JSON error into a Corrupt() error.
+template <class F>
+Status ReadJson(const char* what, const std::string& text, F&& read) {
+  try {
+    const json j = json::parse(text);
+    return read(j);
+  } catch (const json::exception& e) {
+    return Corrupt(what, e.what());
+  }
+}
+
+}  // namespace
+
+const char* OrderEventTypeName(OrderEventType type) {
+  switch (type) {
+    case OrderEventType::kCreated: return "created";
+    case OrderEventType::kStateChanged: return "state_changed";
+    case OrderEventType::kProgress: return "progress";
+  }
+  return "unknown";
+}
+
+std::optional<OrderEventType> ParseOrderEventType(std::string_view name) {
+  for (OrderEventType t :
+       {OrderEventType::kCreated, OrderEventType::kStateChanged, OrderEventType::kProgress}) {
+    if (name == OrderEventTypeName(t)) return t;
+  }
+  return std::nullopt;
+}
+
+std::string OrderContentHash(const engine::Order& order) {
+  // Canonical encoding: a JSON array in a fixed field order; nlohmann prints doubles in
+  // their shortest round-trip form, so equal values give equal text.
+  // The client id goes in length-prefixed and raw (it may be any bytes).
+  json content = json::array();
+  content.push_back(order.priority);
+  content.push_back(order.picks);
+  content.push_back(order.drop);
+  content.push_back(order.formation);
+  content.push_back(order.work_time);
+  content.push_back(order.release_time ? json(*order.release_time) : json(nullptr));
+  const std::string text =
+      std::to_string(order.client_id.size()) + ":" + order.client_id + content.dump();
+  std::uint64_t h = 14695981039346656037ull;  // FNV-1a 64
+  for (unsigned char c : text) {
+    h ^= c;
+    h *= 1099511628211ull;
+  }
+  char hex[17];
+  std::snprintf(hex, sizeof hex, "%016llx", static_cast<unsigned long long>(h));
+  return hex;
+}
+
+Result<std::string> EncodeOrderBody(const engine::Order& order) {
+  if (!AllFinite({order.work_time, order.release_time.value_or(0.0)})) {
+    return engine::InvalidArgument("order '" + order.id +
+                                   "': work_time and release_time must be finite");
+  }
+  json j;
+  j["picks"] = order.picks;
+  j["drop"] = order.drop;
+  j["work_time"] = order.work_time;
+  j["release_time"] = order.release_time ? json(*order.release_time) : json(nullptr);
+  return j.dump();
+}
+
+Status DecodeOrderBody(const std::string& body, engine::Order& order) {
+  return ReadJson("order", body, [&](const json& j) -> Status {
+    order.picks = j.at("picks").get<std::vector<engine::PointId>>();
+    order.drop = j.at("drop").get<engine::PointId>();
+    order.work_time = j.at("work_time").get<double>();
+    const json& release = j.at("release_time");
+    order.release_time =
+        release.is_null() ? std::nullopt : std::optional<double>(release.get<double>());
+    return engine::Ok{};
+  });
+}
+
+Result<std::string> EncodeRobotBody(const engine::Robot& robot) {
+  const engine::Pose& p = robot.pose;
+  if (!AllFinite({robot.diameter, robot.max_speed, p.position.x(), p.position.y(), p.heading,
+                  robot.battery.value_or(0.0)})) {
+    return engine::InvalidArgument("robot '" + robot.id + "': non-finite size, speed or pose");
+  }
+  json j;
+  j["diameter"] = robot.diameter;
+  j["max_speed"] = robot.max_speed;
+  j["pose"] = {p.position.x(), p.position.y(), p.heading};
+  j["current_point"] = robot.current_point;
+  j["task_queue"] = robot.task_queue;
+  j["battery"] = robot.battery ? json(*robot.battery) : json(nullptr);
+  try {
+    return j.dump();
+  } catch (const json::exception& e) {
+    return engine::InvalidArgument("robot '" + robot.id + "': " + e.what());
+  }
+}
+
+Status DecodeRobotBody(const std::string& body, engine::Robot& robot) {
+  return ReadJson("robot", body, [&](const json& j) -> Status {
+    robot.diameter = j.at("diameter").get<double>();
+    robot.max_speed = j.at("max_speed").get<double>();
+    const json& pose = j.at("pose");
+    if (!pose.is_array() || pose.size() != 3) return Corrupt("robot", "pose is not [x, y, heading]");
+    robot.pose.position = {pose[0].get<double>(), pose[1].get<double>()};
+    robot.pose.heading = pose[2].get<double>();
+    robot.current_point = j.at("current_point").get<engine::PointId>();
+    robot.task_queue = j.at("task_queue").get<std::vector<std::string>>();
+    const json& battery = j.at("battery");
+    robot.battery =
+        battery.is_null() ? std::nullopt : std::optional<double>(battery.get<double>());
+    return engine::Ok{};
+  });
+}
+
+Result<std::string> EncodeWaypoints(const std::vector<engine::Waypoint>& waypoints) {
+  json list = json::array();
+  for (const engine::Waypoint& w : waypoints) {
+    if (!AllFinite({w.xy.x(), w.xy.y(), w.eta, w.dwell})) {
+      return engine::InvalidArgument("waypoint " + std::to_string(w.seq) +
+                                     ": non-finite position, eta or dwell");
+    }
+    // [seq, point, x, y, eta, action, dwell]: compact, plans can be long.
+    list.push_back(
+        {w.seq, w.point, w.xy.x(), w.xy.y(), w.eta, engine::WaypointActionName(w.action), w.dwell});
+  }
+  return list.dump();
+}
+
+Result<std::vector<engine::Waypoint>> DecodeWaypoints(const std::string& text) {
+  std::vector<engine::Waypoint> out;
+  Status status = ReadJson("plan", text, [&](const json& list) -> Status {
+    if (!list.is_array()) return Corrupt("plan", "waypoints are not a list");
+    for (const json& row : list) {
+      if (!row.is_array() || row.size() != 7) return Corrupt("plan", "waypoint is not a 7-tuple");
+      engine::Waypoint w;
+      w.seq = row[0].get<int>();
+      w.point = row[1].get<engine::PointId>();
+      w.xy = {row[2].get<double>(), row[3].get<double>()};
+      w.eta = row[4].get<double>();
+      const auto action = engine::ParseWaypointAction(row[5].get<std::string>());
+      if (!action) return Corrupt("plan", "unknown action " + row[5].dump());
+      w.action = *action;
+      w.dwell = row[6].get<double>();
+      out.push_back(w);
+    }
+    return engine::Ok{};
+  });
+  if (!status.ok()) return status.error();
+  return out;
+}
+
+Result<std::string> EncodeStrings(const std::vector<std::string>& strings) {
+  try {
+    return json(strings).dump();
+  } catch (const json::exception& e) {
+    return engine::InvalidArgument(std::string("id list is not valid UTF-8: ") + e.what());
+  }
+}
+
+Result<std::vector<std::string>> DecodeStrings(const std::string& text) {
+  std::vector<std::string> out;
+  Status status = ReadJson("id list", text, [&](const json& j) -> Status {
+    out = j.get<std::vector<std::string>>();
+    return engine::Ok{};
+  });
+  if (!status.ok()) return status.error();
+  return out;
+}
+
+}  // namespace dispatch::storage

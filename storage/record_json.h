@@ -1,0 +1,35 @@
+// JSON encodings of the stored records' non-queried fields (the "body" columns of the SQLite
+// schema) and the canonical content encoding behind OrderContentHash.
+//
+// Queried fields (ids, states, times) live in their own columns; the rest of a record is one
+// JSON text so that adding a field needs no schema migration. Decoders accept exactly what
+// the encoders write and report anything else as kIoError "stored ... is corrupt: ...".
+// Doubles must be finite (JSON has no inf/NaN): encoders reject others with kInvalidArgument.
+// Pure functions; thread-safe.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "storage/store.h"
+
+namespace dispatch::storage {
+
+// Order body: picks, drop, work_time, release_time.
+Result<std::string> EncodeOrderBody(const engine::Order& order);
+// Fills picks, drop, work_time, release_time of `order` from `body`.
+Status DecodeOrderBody(const std::string& body, engine::Order& order);
+
+// Robot body: everything of engine::Robot except id and state.
+Result<std::string> EncodeRobotBody(const engine::Robot& robot);
+Status DecodeRobotBody(const std::string& body, engine::Robot& robot);
+
+// Plan waypoints.
+Result<std::string> EncodeWaypoints(const std::vector<engine::Waypoint>& waypoints);
+Result<std::vector<engine::Waypoint>> DecodeWaypoints(const std::string& text);
+
+// A JSON array of strings (robot ids, order ids); kInvalidArgument for non-UTF-8 text.
+Result<std::string> EncodeStrings(const std::vector<std::string>& strings);
+Result<std::vector<std::string>> DecodeStrings(const std::string& text);
+
+}  // namespace dispatch::storage
