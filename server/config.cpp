@@ -1,0 +1,157 @@
+#include "server/config.h"
+
+#include <CLI/CLI.hpp>
+#include <nlohmann/json.hpp>
+
+#include <cmath>
+#include <fstream>
+#include <algorithm>
+#include <functional>
+#include <sstream>
+
+namespace dispatch::server {
+namespace {
+
+using engine::InvalidArgument;
+
+// One config key: its flag and how to read it from JSON into a config.
+struct Key {
+  const char* name;  // JSON key; the flag is "--" + name with '_' -> '-'
+  std::function<void(const nlohmann::json&, ServerConfig&)> from_json;
+  std::function<nlohmann::json(const ServerConfig&)> to_json;
+};
+
+template <class T>
+Key MakeKey(const char* name, T ServerConfig::*member) {
+  return {name, [member](const nlohmann::json& j, ServerConfig& c) { c.*member = j.get<T>(); },
+          [member](const ServerConfig& c) { return nlohmann::json(c.*member); }};
+}
+
+std::vector<Key> Keys() {
+  return {
+      MakeKey("bind", &ServerConfig::bind),
+      MakeKey("grpc_port", &ServerConfig::grpc_port),
+      MakeKey("http_port", &ServerConfig::http_port),
+      MakeKey("db", &ServerConfig::db),
+      MakeKey("map", &ServerConfig::map),
+      MakeKey("strategy", &ServerConfig::strategy),
+      MakeKey("zeta", &ServerConfig::zeta),
+      MakeKey("alpha", &ServerConfig::alpha),
+      MakeKey("beta", &ServerConfig::beta),
+      MakeKey("time_scale", &ServerConfig::time_scale),
+      MakeKey("heartbeat_interval", &ServerConfig::heartbeat_interval),
+      MakeKey("heartbeat_timeout", &ServerConfig::heartbeat_timeout),
+      MakeKey("offline_grace", &ServerConfig::offline_grace),
+      MakeKey("ports_file", &ServerConfig::ports_file),
+      MakeKey("log_level", &ServerConfig::log_level),
+  };
+}
+
+std::string FlagName(const char* key) {
+  std::string flag = std::string("--") + key;
+  for (char& c : flag) {
+    if (c == '_') c = '-';
+  }
+  return flag;
+}
+
+engine::Status ApplyConfigFile(const std::string& path, ServerConfig& config) {
+  std::ifstream in(path);
+  if (!in) return InvalidArgument("cannot read config file '" + path + "'");
+  nlohmann::json j;
+  try {
+    in >> j;
+  } catch (const nlohmann::json::exception& e) {
+    return InvalidArgument("config file '" + path + "' is not JSON: " + e.what());
+  }
+  if (!j.is_object()) return InvalidArgument("config file '" + path + "' must hold a JSON object");
+  const auto keys = Keys();
+  for (const auto& [name, value] : j.items()) {
+    auto it = std::find_if(keys.begin(), keys.end(), [&](const Key& k) { return name == k.name; });
+    if (it == keys.end()) {
+      return InvalidArgument("config file '" + path + "': unknown key '" + name + "'");
+    }
+    try {
+      it->from_json(value, config);
+    } catch (const nlohmann::json::exception&) {
+      return InvalidArgument("config file '" + path + "': key '" + name + "' has the wrong type (" +
+                             value.dump() + ")");
+    }
+  }
+  return engine::Ok{};
+}
+
+}  // namespace
+
+engine::Status ValidateServerConfig(const ServerConfig& c) {
+  auto port_ok = [](int p) { return p >= 0 && p <= 65535; };
+  if (!port_ok(c.grpc_port)) return InvalidArgument("grpc_port must be in 0..65535");
+  if (!port_ok(c.http_port)) return InvalidArgument("http_port must be in 0..65535");
+  if (c.bind.empty()) return InvalidArgument("bind must not be empty");
+  if (c.db.empty()) return InvalidArgument("db must name a SQLite file");
+  if (c.strategy != "auction" && c.strategy != "greedy") {
+    return InvalidArgument("strategy must be 'auction' or 'greedy', not '" + c.strategy + "'");
+  }
+  for (auto [name, v] : {std::pair{"zeta", c.zeta}, {"alpha", c.alpha}, {"beta", c.beta}}) {
+    if (!std::isfinite(v) || v < 0) return InvalidArgument(std::string(name) + " must be finite and >= 0");
+  }
+  auto positive = [](double v) { return std::isfinite(v) && v > 0; };
+  if (!positive(c.time_scale)) return InvalidArgument("time_scale must be > 0");
+  if (!positive(c.heartbeat_interval)) return InvalidArgument("heartbeat_interval must be > 0");
+  if (!positive(c.heartbeat_timeout) || c.heartbeat_timeout < c.heartbeat_interval) {
+    return InvalidArgument("heartbeat_timeout must be >= heartbeat_interval");
+  }
+  if (!std::isfinite(c.offline_grace) || c.offline_grace < 0) {
+    return InvalidArgument("offline_grace must be >= 0");
+  }
+  return engine::Ok{};
+}
+
+engine::Result<ParsedCommandLine> ParseCommandLine(int argc, char** argv) {
+  CLI::App app{"dispatchd: warehouse robot dispatch service (gRPC + REST)"};
+  ServerConfig flags;
+  std::string config_file;
+  app.add_option("--config", config_file, "JSON config file with the same keys as the flags");
+  app.add_option("--bind", flags.bind, "Address to listen on")->capture_default_str();
+  app.add_option("--grpc-port", flags.grpc_port, "gRPC port (0 = any free port)")->capture_default_str();
+  app.add_option("--http-port", flags.http_port, "REST port (0 = any free port)")->capture_default_str();
+  app.add_option("--db", flags.db, "SQLite database file")->capture_default_str();
+  app.add_option("--map", flags.map, "chu2024 | map.json | MovingAI .map")->capture_default_str();
+  app.add_option("--strategy", flags.strategy, "auction | greedy")->capture_default_str();
+  app.add_option("--zeta", flags.zeta, "Traffic weight (Chu2024 eq. 5)")->capture_default_str();
+  app.add_option("--alpha", flags.alpha, "Weight of T_t (Chu2024 eq. 1)")->capture_default_str();
+  app.add_option("--beta", flags.beta, "Weight of T_d (Chu2024 eq. 1)")->capture_default_str();
+  app.add_option("--time-scale", flags.time_scale, "Dispatcher seconds per wall second")
+      ->capture_default_str();
+  app.add_option("--heartbeat-interval", flags.heartbeat_interval, "Robot heartbeat period, s")
+      ->capture_default_str();
+  app.add_option("--heartbeat-timeout", flags.heartbeat_timeout, "Silence before offline, s")
+      ->capture_default_str();
+  app.add_option("--offline-grace", flags.offline_grace,
+                 "Seconds offline before a robot's orders are re-allocated")
+      ->capture_default_str();
+  app.add_option("--ports-file", flags.ports_file, "Write the chosen ports as JSON here");
+  app.add_option("--log-level", flags.log_level, "trace|debug|info|warn|error")->capture_default_str();
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    ParsedCommandLine out;
+    out.exit_code = app.exit(e);
+    return out;
+  }
+
+  ParsedCommandLine out;
+  if (!config_file.empty()) {
+    auto applied = ApplyConfigFile(config_file, out.config);
+    if (!applied.ok()) return applied.error();
+  }
+  // Flags given on the command line override the file.
+  for (const Key& key : Keys()) {
+    if (app.get_option(FlagName(key.name))->count() > 0) key.from_json(key.to_json(flags), out.config);
+  }
+  auto valid = ValidateServerConfig(out.config);
+  if (!valid.ok()) return valid.error();
+  return out;
+}
+
+}  // namespace dispatch::server

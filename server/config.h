@@ -1,0 +1,44 @@
+// ServerConfig: everything dispatchd is started with (SPEC §4 "Operations"), from flags and an
+// optional JSON config file with the same keys (flags win). Plain value; validate with
+// ValidateServerConfig. Thread-safe to share once built.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "engine/common/result.h"
+
+namespace dispatch::server {
+
+struct ServerConfig {
+  std::string bind = "0.0.0.0";   // address both listeners bind; tests use 127.0.0.1
+  int grpc_port = 50051;          // 0 = pick a free port
+  int http_port = 8080;           // 0 = pick a free port
+  std::string db = "dispatch.db"; // SQLite file
+  std::string map = "chu2024";    // chu2024 | <file>.json | <file>.map
+  std::string strategy = "auction";  // auction | greedy
+  double zeta = 100.0;            // Chu2024 eq. (5) traffic weight
+  double alpha = 0.5;             // Chu2024 eq. (1) weight of T_t
+  double beta = 0.5;              // Chu2024 eq. (1) weight of T_d
+  double time_scale = 1.0;        // dispatcher seconds per wall-clock second
+  double heartbeat_interval = 1.0;  // wall seconds between robot heartbeats
+  double heartbeat_timeout = 5.0;   // wall seconds of silence before a robot is offline
+  double offline_grace = 10.0;      // wall seconds offline before its orders are re-allocated
+  std::string ports_file;         // written as {"grpc_port":..,"http_port":..} once listening
+  std::string log_level = "info";  // spdlog level name
+};
+
+// kInvalidArgument naming the field.
+engine::Status ValidateServerConfig(const ServerConfig& config);
+
+// Parses dispatchd's command line (with --config FILE: JSON object with the keys above, e.g.
+// {"grpc_port": 0, "db": "/var/lib/dispatch.db"}; flags given on the command line win).
+// Returns the config, or an error; `exit_code` >= 0 means "exit now with this code" (e.g.
+// --help was printed).
+struct ParsedCommandLine {
+  ServerConfig config;
+  int exit_code = -1;
+};
+engine::Result<ParsedCommandLine> ParseCommandLine(int argc, char** argv);
+
+}  // namespace dispatch::server

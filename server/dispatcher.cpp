@@ -1,0 +1,404 @@
+// Dispatcher: loop, recovery, snapshots and the order commands. Allocation and plans are in
+// dispatcher_plans.cpp, robot streams in dispatcher_robots.cpp.
+#include "server/dispatcher.h"
+
+#include <spdlog/spdlog.h>
+
+#include <algorithm>
+#include <cmath>
+
+#include "engine/allocation/auction_allocator.h"
+#include "engine/allocation/greedy_allocator.h"
+#include "server/json_convert.h"
+
+namespace dispatch::server {
+
+ServiceStatus FromEngineError(const engine::Error& error) {
+  switch (error.code) {
+    case engine::ErrorCode::kInvalidArgument:
+    case engine::ErrorCode::kNotFound:
+    case engine::ErrorCode::kUnreachable:
+      return MakeStatus(StatusCode::kInvalidArgument, error.message);
+    case engine::ErrorCode::kFailedPrecondition:
+      return MakeStatus(StatusCode::kFailedPrecondition, error.message);
+    case engine::ErrorCode::kIoError:
+      return MakeStatus(StatusCode::kUnavailable, "storage failed: " + error.message);
+  }
+  return MakeStatus(StatusCode::kInternal, error.message);
+}
+
+engine::Result<std::unique_ptr<Dispatcher>> Dispatcher::Create(
+    std::shared_ptr<const engine::WarehouseMap> map, std::shared_ptr<const engine::RouteTable> routes,
+    storage::Store& store, DispatcherOptions options) {
+  if (!map || !routes) return engine::InvalidArgument("dispatcher: null map or route table");
+  if (auto valid = engine::ValidateAllocationConfig(options.allocation); !valid.ok()) {
+    return valid.error();
+  }
+  std::unique_ptr<engine::Allocator> allocator;
+  if (options.strategy == "auction") {
+    allocator = std::make_unique<engine::AuctionAllocator>();
+  } else if (options.strategy == "greedy") {
+    allocator = std::make_unique<engine::GreedyAllocator>();
+  } else {
+    return engine::InvalidArgument("unknown strategy '" + options.strategy + "' (auction | greedy)");
+  }
+  std::unique_ptr<Dispatcher> d(new Dispatcher(std::move(map), std::move(routes), store,
+                                               std::move(options), std::move(allocator)));
+  if (auto recovered = d->Recover(); !recovered.ok()) return recovered.error();
+  d->Publish();
+  return d;
+}
+
+Dispatcher::Dispatcher(std::shared_ptr<const engine::WarehouseMap> map,
+                       std::shared_ptr<const engine::RouteTable> routes, storage::Store& store,
+                       DispatcherOptions options, std::unique_ptr<engine::Allocator> allocator)
+    : map_(std::move(map)),
+      routes_(std::move(routes)),
+      store_(store),
+      options_(std::move(options)),
+      allocator_(std::move(allocator)),
+      wall_start_(Clock::now()) {}
+
+Dispatcher::~Dispatcher() { Stop(); }
+
+engine::Status Dispatcher::Recover() {
+  // Orders, in submission order.
+  storage::OrderQuery query;
+  query.page_size = storage::kMaxPageSize;
+  for (;;) {
+    auto page = store_.ListOrders(query);
+    if (!page.ok()) return page.error();
+    for (const auto& record : page->orders) {
+      auto view = std::make_shared<OrderView>();
+      view->record = record;
+      view->position = static_cast<std::int64_t>(orders_.size()) + 1;
+      if (engine::IsTerminal(record.order.state)) view->finished_time = record.updated_time;
+      time_base_ = std::max({time_base_, record.updated_time, record.order.created_time});
+      const std::string& id = record.order.id;
+      if (id.rfind("ord-", 0) == 0) {
+        last_order_number_ = std::max<std::int64_t>(last_order_number_, std::atoll(id.c_str() + 4));
+      }
+      Put(std::move(view));
+    }
+    if (page->next_page_token.empty()) break;
+    query.page_token = page->next_page_token;
+  }
+  // Allocation explanations from the journal (the latest per order wins).
+  storage::EventQuery events;
+  events.limit = 1000;
+  for (;;) {
+    auto batch = store_.ListEvents(events);
+    if (!batch.ok()) return batch.error();
+    for (const auto& event : *batch) {
+      events.after_id = event.id;
+      auto explanation = ParseAllocationDetail(event.detail);
+      if (!explanation) continue;
+      if (auto view = Find(event.order_id)) {
+        auto copy = std::make_shared<OrderView>(*view);
+        copy->explanation = std::move(*explanation);
+        Put(std::move(copy));
+      }
+    }
+    if (batch->size() < static_cast<std::size_t>(events.limit)) break;
+  }
+  // Robots (all offline until they reconnect) and their plans.
+  auto robots = store_.ListRobots();
+  if (!robots.ok()) return robots.error();
+  for (auto& record : *robots) {
+    RobotRuntime r;
+    r.record = record;
+    r.record.robot.state = engine::RobotState::kOffline;
+    r.offline_since = Clock::now();
+    time_base_ = std::max(time_base_, record.last_seen);
+    robots_.emplace(record.robot.id, std::move(r));
+  }
+  auto assignments = store_.ListAssignments();
+  if (!assignments.ok()) return assignments.error();
+  for (auto& a : *assignments) {
+    auto it = robots_.find(a.robot_id);
+    if (it == robots_.end()) continue;
+    time_base_ = std::max(time_base_, a.updated_time);
+    it->second.assignment = a;
+    it->second.has_assignment = true;
+  }
+  spdlog::info("recovered {} orders, {} robots, {} assignments; dispatcher time {:.1f} s",
+               orders_.size(), robots_.size(), assignments->size(), time_base_);
+  return engine::Ok{};
+}
+
+void Dispatcher::Start() {
+  if (started_.exchange(true)) return;
+  thread_ = std::thread([this] { Loop(); });
+}
+
+void Dispatcher::CloseStreams() {
+  Post([this] {
+    for (auto& [id, robot] : robots_) {
+      if (robot.link) {
+        CloseLink(robot.link, MakeStatus(StatusCode::kUnavailable, "dispatcher shutting down"));
+        link_robot_.erase(robot.link.get());
+        robot.link.reset();
+        dirty_ = true;
+      }
+    }
+  });
+  hub_.CloseAll();
+}
+
+void Dispatcher::Stop() {
+  if (!started_.load()) return;
+  {
+    std::lock_guard<std::mutex> lock(queue_mu_);
+    if (stopping_) return;
+  }
+  CloseStreams();
+  {
+    std::lock_guard<std::mutex> lock(queue_mu_);
+    stopping_ = true;
+  }
+  queue_cv_.notify_all();
+  if (thread_.joinable()) thread_.join();
+}
+
+void Dispatcher::Post(std::function<void()> fn) {
+  {
+    std::lock_guard<std::mutex> lock(queue_mu_);
+    queue_.push_back(std::move(fn));
+  }
+  queue_cv_.notify_one();
+}
+
+double Dispatcher::Now() const {
+  const std::chrono::duration<double> elapsed = Clock::now() - wall_start_;
+  return time_base_ + elapsed.count() * options_.time_scale;
+}
+
+void Dispatcher::Loop() {
+  const double tick_s = std::clamp(options_.heartbeat_timeout / 10.0, 0.01, 0.5);
+  const auto tick = std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(tick_s));
+  auto next_tick = Clock::now() + tick;
+  for (;;) {
+    std::deque<std::function<void()>> batch;
+    bool stopping = false;
+    {
+      std::unique_lock<std::mutex> lock(queue_mu_);
+      queue_cv_.wait_until(lock, next_tick, [&] { return !queue_.empty() || stopping_; });
+      batch.swap(queue_);
+      stopping = stopping_;
+    }
+    for (auto& fn : batch) fn();
+    if (Clock::now() >= next_tick) {
+      Tick();
+      next_tick = Clock::now() + tick;
+    }
+    // Publish first, then let replies, robot messages and journal events out: whoever hears
+    // of a change finds it in the snapshot.
+    if (dirty_) Publish();
+    std::vector<std::function<void()>> effects;
+    effects.swap(deferred_);
+    for (auto& effect : effects) effect();
+    if (stopping) {
+      std::lock_guard<std::mutex> lock(queue_mu_);
+      if (queue_.empty()) break;
+    }
+  }
+}
+
+void Dispatcher::Publish() {
+  auto snap = std::make_shared<Snapshot>();
+  snap->version = ++snapshot_version_;
+  snap->time = Now();
+  snap->map_name = map_->name();
+  snap->map_version = options_.map_version;
+  snap->strategy = options_.strategy;
+  snap->time_scale = options_.time_scale;
+  snap->orders = orders_;
+  snap->by_id = by_id_;
+  snap->by_client_id = by_client_id_;
+  for (const auto& [id, r] : robots_) {
+    RobotView view;
+    view.robot = r.record.robot;
+    view.kind = r.record.kind;
+    view.connected = r.link != nullptr;
+    view.last_seen = r.record.last_seen;
+    if (r.has_assignment) {
+      view.robot.task_queue = r.assignment.order_ids;
+      view.plan_id = r.assignment.plan_id;
+      view.waypoints = r.assignment.plan.waypoints.size();
+    }
+    snap->robots.emplace(id, std::move(view));
+  }
+  std::atomic_store(&snapshot_, std::shared_ptr<const Snapshot>(std::move(snap)));
+  dirty_ = false;
+}
+
+std::shared_ptr<const OrderView> Dispatcher::Find(const std::string& order_id) const {
+  auto it = by_id_.find(order_id);
+  return it == by_id_.end() ? nullptr : orders_[it->second];
+}
+
+void Dispatcher::Put(std::shared_ptr<OrderView> view) {
+  const std::string id = view->record.order.id;
+  auto it = by_id_.find(id);
+  if (it == by_id_.end()) {
+    by_id_.emplace(id, orders_.size());
+    by_client_id_.emplace(view->record.order.client_id, orders_.size());
+    orders_.push_back(std::move(view));
+  } else {
+    orders_[it->second] = std::move(view);
+  }
+  dirty_ = true;
+}
+
+void Dispatcher::Journal(const storage::OrderEvent& event) {
+  Defer([this, event] { hub_.Publish(event); });
+}
+
+void Dispatcher::Defer(std::function<void()> effect) { deferred_.push_back(std::move(effect)); }
+
+void Dispatcher::CloseLink(const std::shared_ptr<RobotLink>& link, ServiceStatus status) {
+  Defer([link, status = std::move(status)] { link->Close(status); });
+}
+
+std::string Dispatcher::NextOrderId() {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "ord-%06lld", static_cast<long long>(last_order_number_ + 1));
+  return buf;
+}
+
+// --- Orders --------------------------------------------------------------------------------
+
+void Dispatcher::SubmitOrder(engine::OrderRequest request, std::function<void(SubmitReply)> done) {
+  Post([this, request = std::move(request), done = std::move(done)] {
+    DoSubmit(request, [this, done](SubmitReply reply) {
+      Defer([done, reply = std::move(reply)]() mutable { done(std::move(reply)); });
+    });
+  });
+}
+
+void Dispatcher::CancelOrder(std::string order_id, std::string reason,
+                             std::function<void(OrderReply)> done) {
+  Post([this, order_id = std::move(order_id), reason = std::move(reason), done = std::move(done)] {
+    DoCancel(order_id, reason, [this, done](OrderReply reply) {
+      Defer([done, reply = std::move(reply)]() mutable { done(std::move(reply)); });
+    });
+  });
+}
+
+ServiceStatus Dispatcher::CheckReachable(const engine::Order& order) const {
+  std::vector<engine::PointId> stops = order.picks;
+  stops.push_back(order.drop);
+  for (std::size_t i = 0; i + 1 < stops.size(); ++i) {
+    if (!std::isfinite(routes_->Cost(stops[i], stops[i + 1]))) {
+      const auto& a = map_->point(stops[i]);
+      const auto& b = map_->point(stops[i + 1]);
+      return MakeStatus(StatusCode::kInvalidArgument,
+                        "order '" + order.client_id + "': no route from " +
+                            engine::PointKindName(a.kind) + " point '" + a.name + "' to " +
+                            engine::PointKindName(b.kind) + " point '" + b.name + "'");
+    }
+  }
+  return OkStatus();
+}
+
+void Dispatcher::DoSubmit(const engine::OrderRequest& request,
+                          const std::function<void(SubmitReply)>& done) {
+  SubmitReply reply;
+  if (request.client_id.empty()) {
+    reply.status = MakeStatus(StatusCode::kInvalidArgument, "client_order_id is required");
+    return done(std::move(reply));
+  }
+  if (request.client_id.size() > 128) {
+    reply.status = MakeStatus(StatusCode::kInvalidArgument,
+                              "client_order_id is longer than 128 bytes");
+    return done(std::move(reply));
+  }
+  engine::OrderRequest req = request;
+  req.id = req.client_id;  // errors name the order by the client's id
+  req.created_time = Now();
+  auto resolved = engine::ResolveOrder(*map_, req, options_.snap);
+  if (!resolved.ok()) {
+    reply.status = FromEngineError(resolved.error());
+    return done(std::move(reply));
+  }
+  engine::Order order = std::move(resolved).value();
+  order.id = NextOrderId();
+  if (auto reach = CheckReachable(order); !reach.ok()) {
+    reply.status = reach;
+    return done(std::move(reply));
+  }
+  if (auto it = by_client_id_.find(order.client_id); it != by_client_id_.end()) {
+    const auto& existing = orders_[it->second];
+    if (storage::OrderContentHash(order) == existing->record.content_hash) {
+      reply.order = existing;
+      reply.created = false;
+      return done(std::move(reply));
+    }
+    reply.status = MakeStatus(
+        StatusCode::kAlreadyExists,
+        "client_order_id '" + order.client_id + "' already names order " +
+            existing->record.order.id + " with different content; this submission (picks, drop, "
+            "formation, priority, work time or release time) differs from it");
+    return done(std::move(reply));
+  }
+  auto inserted = store_.InsertOrder(order);
+  if (!inserted.ok()) {
+    reply.status = inserted.error().code == engine::ErrorCode::kFailedPrecondition
+                       ? MakeStatus(StatusCode::kAlreadyExists, inserted.error().message)
+                       : FromEngineError(inserted.error());
+    if (reply.status.code == StatusCode::kUnavailable) {
+      reply.status.message = "order '" + order.client_id + "' was NOT accepted: " + reply.status.message;
+    }
+    spdlog::warn("submit {}: {}", order.client_id, reply.status.message);
+    return done(std::move(reply));
+  }
+  ++last_order_number_;
+  auto view = std::make_shared<OrderView>();
+  view->record = inserted->record;
+  view->position = static_cast<std::int64_t>(orders_.size()) + 1;
+  Put(view);
+  reply.order = view;
+  reply.created = inserted->created;
+  done(std::move(reply));
+  storage::EventQuery first;
+  first.order_id = order.id;
+  first.limit = 1;
+  if (auto events = store_.ListEvents(first); events.ok() && !events->empty()) {
+    Journal(events->front());
+  }
+  spdlog::info("order {} ({}) accepted", order.id, order.client_id);
+  AllocatePending();
+}
+
+void Dispatcher::DoCancel(const std::string& order_id, const std::string& reason,
+                          const std::function<void(OrderReply)>& done) {
+  OrderReply reply;
+  auto view = Find(order_id);
+  if (!view) {
+    reply.status = MakeStatus(StatusCode::kNotFound, "no order with id '" + order_id + "'");
+    return done(std::move(reply));
+  }
+  const engine::OrderState state = view->record.order.state;
+  if (state == engine::OrderState::kCancelled) {
+    reply.order = view;
+    return done(std::move(reply));
+  }
+  if (engine::IsTerminal(state)) {
+    reply.status = MakeStatus(StatusCode::kFailedPrecondition,
+                              "order " + order_id + " is already " +
+                                  engine::OrderStateName(state) + "; only open orders can be cancelled");
+    return done(std::move(reply));
+  }
+  ServiceStatus status;
+  const std::string why = reason.empty() ? "cancelled by client" : reason;
+  if (!ReleaseOrders({order_id}, [](const OrderView&) { return engine::OrderState::kCancelled; },
+                     why, &status)) {
+    reply.status = status;
+    return done(std::move(reply));
+  }
+  reply.order = Find(order_id);
+  done(std::move(reply));
+  AllocatePending();
+}
+
+}  // namespace dispatch::server

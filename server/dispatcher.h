@@ -1,0 +1,229 @@
+// Dispatcher: the one writer of the engine state (SPEC §4 "Concurrency").
+//
+// One loop thread owns the order book, the robots (pose, link, current plan) and the
+// allocator. API threads never touch them: they post commands (Post) and get the answer
+// through a callback run on the loop thread (gRPC reactors finish from it; REST waits on a
+// future, see Call). After every batch of commands the loop publishes an immutable Snapshot
+// (atomic shared_ptr swap) that reads use without locks of the loop; replies, robot messages
+// and journal events of the batch go out only after that publish (read-your-writes).
+//
+// Durability: an order is committed to the Store (InsertOrder) before SubmitOrder answers
+// OK; a failed write is an error to the caller and leaves the in-memory state unchanged.
+// Awards (order -> assigned + the allocation explanation as a journal entry + the robots'
+// plans) are one store transaction. At start the dispatcher recovers orders, explanations,
+// robots and assignments from the store.
+//
+// Allocation: the strategy (auction or greedy) runs over the connected robots whenever an
+// order arrives, a robot connects or finishes an order, or an order comes back for
+// re-allocation. Each round builds a fresh engine::FleetState whose robots start where their
+// current plan ends (or where they stand) and when it ends. Orders stay `accepted` while no
+// robot (or fewer than 3 for a formation) is connected.
+//
+// Robots: Hello registers (snapping the pose to the nearest map point within
+// Options::robot_snap_tolerance); waypoints are numbered over the robot's whole life; every
+// waypoint is sent released (intersection grants and holds come with the traffic controller
+// in a later slice). Progress: a pick (waypoint reached or picked event) moves the order to
+// in_progress, the drop of every team member completes it. A robot silent for
+// heartbeat_timeout goes offline (stream closed); after offline_grace more its assigned
+// orders go back to accepted and are re-allocated, and its in_progress orders fail (the load
+// is on a robot that is gone).
+//
+// Thread safety: the public methods are thread-safe; everything else runs on the loop thread.
+#pragma once
+
+#include <atomic>
+#include <chrono>
+#include <condition_variable>
+#include <deque>
+#include <functional>
+#include <future>
+#include <map>
+#include <memory>
+#include <mutex>
+#include <string>
+#include <thread>
+#include <unordered_map>
+#include <vector>
+
+#include "engine/allocation/allocator.h"
+#include "engine/fleet/order.h"
+#include "engine/routing/route_table.h"
+#include "server/robot_link.h"
+#include "server/service_status.h"
+#include "server/snapshot.h"
+#include "server/watch_hub.h"
+#include "storage/store.h"
+
+namespace dispatch::server {
+
+struct DispatcherOptions {
+  engine::AllocationConfig allocation;
+  std::string strategy = "auction";  // auction | greedy
+  double time_scale = 1.0;           // dispatcher seconds per wall second
+  double heartbeat_interval = 1.0;   // wall seconds
+  double heartbeat_timeout = 5.0;    // wall seconds
+  double offline_grace = 10.0;       // wall seconds
+  engine::SnapOptions snap;          // order stops
+  double robot_snap_tolerance = 1.0;  // metres from a Hello pose to its nearest point
+  std::string map_version;
+};
+
+struct SubmitReply {
+  ServiceStatus status;
+  std::shared_ptr<const OrderView> order;
+  bool created = false;
+};
+
+struct OrderReply {
+  ServiceStatus status;
+  std::shared_ptr<const OrderView> order;
+};
+
+class Dispatcher {
+ public:
+  // Recovers the state from `store` (which must outlive the dispatcher). Errors: bad
+  // options, unreadable store.
+  static engine::Result<std::unique_ptr<Dispatcher>> Create(
+      std::shared_ptr<const engine::WarehouseMap> map,
+      std::shared_ptr<const engine::RouteTable> routes, storage::Store& store,
+      DispatcherOptions options);
+  ~Dispatcher();
+  Dispatcher(const Dispatcher&) = delete;
+  Dispatcher& operator=(const Dispatcher&) = delete;
+
+  void Start();
+  // Finishes every robot stream and WatchOrders stream (UNAVAILABLE); the loop keeps running.
+  void CloseStreams();
+  // Closes the streams, runs the commands already queued, stops the loop. Idempotent.
+  void Stop();
+
+  std::shared_ptr<const Snapshot> snapshot() const { return std::atomic_load(&snapshot_); }
+  WatchHub& watch_hub() { return hub_; }
+  storage::Store& store() { return store_; }
+  const engine::WarehouseMap& map() const { return *map_; }
+  const DispatcherOptions& options() const { return options_; }
+
+  // --- Orders (callbacks run on the loop thread; they must not block) ------------------
+  void SubmitOrder(engine::OrderRequest request, std::function<void(SubmitReply)> done);
+  void CancelOrder(std::string order_id, std::string reason, std::function<void(OrderReply)> done);
+
+  // --- Robot streams -----------------------------------------------------------------
+  // Every message of a stream, Hello first. Replies go to `link`.
+  void OnRobotMessage(std::shared_ptr<RobotLink> link, RobotInbound message);
+  // The stream ended (client gone or cancelled).
+  void OnRobotGone(std::shared_ptr<RobotLink> link);
+
+  // Runs `fn` on the loop thread.
+  void Post(std::function<void()> fn);
+  // Runs `fn` on the loop thread and waits for its result (for threads that may block,
+  // e.g. REST handlers).
+  template <class T>
+  T Call(std::function<void(std::function<void(T)>)> fn) {
+    auto promise = std::make_shared<std::promise<T>>();
+    auto future = promise->get_future();
+    Post([fn = std::move(fn), promise] { fn([promise](T value) { promise->set_value(std::move(value)); }); });
+    return future.get();
+  }
+
+ private:
+  using Clock = std::chrono::steady_clock;
+  struct RobotRuntime {
+    storage::RobotRecord record;
+    std::shared_ptr<RobotLink> link;  // null when not connected
+    Clock::time_point last_heard;
+    std::optional<Clock::time_point> offline_since;  // set while offline with orders to watch
+    storage::AssignmentRecord assignment;  // plan.waypoints[0] anchors; then one segment per order
+    bool has_assignment = false;
+  };
+
+  Dispatcher(std::shared_ptr<const engine::WarehouseMap> map,
+             std::shared_ptr<const engine::RouteTable> routes, storage::Store& store,
+             DispatcherOptions options, std::unique_ptr<engine::Allocator> allocator);
+  engine::Status Recover();
+  void Loop();
+  double Now() const;
+
+  // Orders (dispatcher.cpp).
+  void DoSubmit(const engine::OrderRequest& request, const std::function<void(SubmitReply)>& done);
+  void DoCancel(const std::string& order_id, const std::string& reason,
+                const std::function<void(OrderReply)>& done);
+  ServiceStatus CheckReachable(const engine::Order& order) const;
+  std::shared_ptr<const OrderView> Find(const std::string& order_id) const;
+  void Put(std::shared_ptr<OrderView> view);  // replaces (or adds) an order in the book
+  // Publishes a committed journal event to the watchers (deferred, see Defer).
+  void Journal(const storage::OrderEvent& event);
+  // Runs `effect` after this batch's snapshot is published: replies, robot messages and
+  // journal events leave the loop only once the state they announce is readable.
+  void Defer(std::function<void()> effect);
+  void CloseLink(const std::shared_ptr<RobotLink>& link, ServiceStatus status);
+  std::string NextOrderId();
+
+  // Allocation and plans (dispatcher_plans.cpp).
+  void AllocatePending();
+  // Runs the strategy for one order and commits the award; false if the store failed.
+  bool AwardOrder(const engine::Order& order, engine::FleetState& fleet);
+  // Removes `order_id` and every later order from the plan; returns the later ones.
+  static std::vector<std::string> CutPlan(storage::AssignmentRecord& plan, const std::string& order_id);
+  // Drops the finished first order (up to its drop waypoint) from the plan; false if
+  // `order_id` is not the plan's first order.
+  static bool TrimDone(storage::AssignmentRecord& plan, const std::string& order_id);
+  // Index of the first waypoint of the plan's k-th order segment.
+  static std::size_t SegmentStart(const storage::AssignmentRecord& plan, std::size_t k);
+  // Takes `order_ids` away from their robots and moves each to target(order) (cancelled,
+  // failed, or accepted for re-allocation) with `reason`; orders queued after them on the
+  // same robots go back to accepted. One store transaction; false (and *status) on failure,
+  // with nothing changed.
+  bool ReleaseOrders(const std::vector<std::string>& order_ids,
+                     const std::function<engine::OrderState(const OrderView&)>& target,
+                     const std::string& reason, ServiceStatus* status);
+  // Assignment (full plan) or PlanUpdate (waypoints from `from_sequence` on).
+  RobotOutbound PlanMessage(const RobotRuntime& robot, bool full, std::uint64_t from_sequence) const;
+  // Stamps the robot's next message sequence and the time, and sends if connected.
+  void SendTo(RobotRuntime& robot, RobotOutbound message);
+  static std::string OrderOfWaypoint(const storage::AssignmentRecord& plan, std::size_t index);
+  RobotRuntime* RobotOf(const std::string& id);
+
+  // Robots (dispatcher_robots.cpp).
+  void DoRobotMessage(const std::shared_ptr<RobotLink>& link, const RobotInbound& message);
+  void DoHello(const std::shared_ptr<RobotLink>& link, const RobotInbound& hello);
+  void DoWaypointReached(RobotRuntime& robot, const RobotInbound& message);
+  void DoTaskEvent(RobotRuntime& robot, const RobotInbound& message);
+  void DoRobotGone(const std::shared_ptr<RobotLink>& link);
+  void MarkOffline(RobotRuntime& robot, const std::string& why);
+  void StartOrder(const std::string& order_id, const std::string& detail);
+  void Tick();
+  void Publish();
+
+  const std::shared_ptr<const engine::WarehouseMap> map_;
+  const std::shared_ptr<const engine::RouteTable> routes_;
+  storage::Store& store_;
+  const DispatcherOptions options_;
+  WatchHub hub_;
+
+  // Command queue: guarded by queue_mu_.
+  std::mutex queue_mu_;
+  std::condition_variable queue_cv_;
+  std::deque<std::function<void()>> queue_;
+  bool stopping_ = false;
+  std::thread thread_;
+  std::atomic<bool> started_{false};
+
+  std::shared_ptr<const Snapshot> snapshot_;  // atomic_load / atomic_store only
+
+  // Loop-thread state (no lock: only the loop touches it after Start).
+  std::unique_ptr<engine::Allocator> allocator_;
+  Clock::time_point wall_start_;
+  double time_base_ = 0.0;  // dispatcher seconds at wall_start_
+  std::vector<std::shared_ptr<const OrderView>> orders_;
+  std::unordered_map<std::string, std::size_t> by_id_;
+  std::unordered_map<std::string, std::size_t> by_client_id_;
+  std::map<std::string, RobotRuntime> robots_;
+  std::unordered_map<const RobotLink*, std::string> link_robot_;
+  std::int64_t last_order_number_ = 0;
+  std::uint64_t snapshot_version_ = 0;
+  bool dirty_ = true;
+  std::vector<std::function<void()>> deferred_;  // effects of the current batch
+  bool retry_allocation_ = false;
+};
+
+}  // namespace dispatch::server

@@ -1,0 +1,313 @@
+// Dispatcher: robot streams (hello, reports, progress events), heartbeats and the offline
+// grace that re-allocates a lost robot's orders.
+#include <spdlog/spdlog.h>
+
+#include <cmath>
+#include <sstream>
+
+#include "server/dispatcher.h"
+
+namespace dispatch::server {
+namespace {
+
+bool ValidRobotId(const std::string& id) {
+  if (id.empty() || id.size() > 64) return false;
+  for (char c : id) {
+    if (!(std::isalnum(static_cast<unsigned char>(c)) || c == '_' || c == '-' || c == '.')) return false;
+  }
+  return true;
+}
+
+std::string Fixed(double v) {
+  std::ostringstream out;
+  out.precision(2);
+  out << std::fixed << v;
+  return out.str();
+}
+
+}  // namespace
+
+void Dispatcher::OnRobotMessage(std::shared_ptr<RobotLink> link, RobotInbound message) {
+  Post([this, link = std::move(link), message = std::move(message)] { DoRobotMessage(link, message); });
+}
+
+void Dispatcher::OnRobotGone(std::shared_ptr<RobotLink> link) {
+  Post([this, link = std::move(link)] { DoRobotGone(link); });
+}
+
+void Dispatcher::DoRobotMessage(const std::shared_ptr<RobotLink>& link, const RobotInbound& m) {
+  auto known = link_robot_.find(link.get());
+  if (m.kind == RobotInbound::Kind::kHello) {
+    if (known != link_robot_.end()) {
+      CloseLink(link, MakeStatus(StatusCode::kInvalidArgument, "Hello sent twice on one stream"));
+      return;
+    }
+    DoHello(link, m);
+    return;
+  }
+  if (known == link_robot_.end()) {
+    CloseLink(link, MakeStatus(StatusCode::kInvalidArgument, "the first message of a stream must be Hello"));
+    return;
+  }
+  RobotRuntime* r = RobotOf(known->second);
+  if (!r || r->link != link) return;  // a superseded stream
+  r->last_heard = Clock::now();
+  r->record.last_seen = Now();
+  dirty_ = true;
+  switch (m.kind) {
+    case RobotInbound::Kind::kState: {
+      if (!std::isfinite(m.pose.position.x()) || !std::isfinite(m.pose.position.y())) return;
+      r->record.robot.pose = m.pose;
+      if (m.arc_id && *m.arc_id >= 0 && static_cast<std::size_t>(*m.arc_id) < map_->arcs().size()) {
+        r->record.robot.current_point = map_->arc(*m.arc_id).to;
+      } else {
+        r->record.robot.current_point = map_->NearestPoint(m.pose.position);
+      }
+      if (m.state && *m.state != engine::RobotState::kOffline) r->record.robot.state = *m.state;
+      if (m.battery) r->record.robot.battery = *m.battery;
+      break;
+    }
+    case RobotInbound::Kind::kWaypointReached: DoWaypointReached(*r, m); break;
+    case RobotInbound::Kind::kTaskEvent: DoTaskEvent(*r, m); break;
+    case RobotInbound::Kind::kAck:
+      r->record.last_acked_sequence = std::max(r->record.last_acked_sequence, m.sequence);
+      break;
+    case RobotInbound::Kind::kHeartbeat:
+    case RobotInbound::Kind::kHello: break;
+  }
+}
+
+void Dispatcher::DoHello(const std::shared_ptr<RobotLink>& link, const RobotInbound& hello) {
+  auto reject = [&](StatusCode code, std::string message) {
+    spdlog::warn("robot hello rejected: {}", message);
+    CloseLink(link, MakeStatus(code, std::move(message)));
+  };
+  if (!ValidRobotId(hello.robot_id)) {
+    return reject(StatusCode::kInvalidArgument,
+                  "robot id '" + hello.robot_id + "' is invalid: use 1-64 letters, digits, '_', '-' or '.'");
+  }
+  const Eigen::Vector2d xy = hello.pose.position;
+  if (!std::isfinite(xy.x()) || !std::isfinite(xy.y()) || !std::isfinite(hello.pose.heading)) {
+    return reject(StatusCode::kInvalidArgument, "robot " + hello.robot_id + ": pose is not finite");
+  }
+  double distance = 0.0;
+  const engine::PointId point = map_->NearestPoint(xy, std::nullopt, &distance);
+  if (point == engine::kNoPoint || distance > options_.robot_snap_tolerance) {
+    std::string nearest = point == engine::kNoPoint ? "none" : "'" + map_->point(point).name + "' " + Fixed(distance) + " m away";
+    return reject(StatusCode::kInvalidArgument,
+                  "robot " + hello.robot_id + ": pose (" + Fixed(xy.x()) + ", " + Fixed(xy.y()) +
+                      ") is not on the map (nearest point " + nearest + ", tolerance " +
+                      Fixed(options_.robot_snap_tolerance) + " m)");
+  }
+  auto [it, inserted] = robots_.try_emplace(hello.robot_id);
+  RobotRuntime& r = it->second;
+  if (r.link && r.link != link) {
+    const std::chrono::duration<double> silent = Clock::now() - r.last_heard;
+    if (silent.count() <= options_.heartbeat_timeout) {
+      return reject(StatusCode::kAlreadyExists,
+                    "robot " + hello.robot_id + " already has a live stream (heard " +
+                        Fixed(silent.count()) + " s ago); retry after its heartbeat times out");
+    }
+    CloseLink(r.link, MakeStatus(StatusCode::kUnavailable, "superseded by a new stream"));
+    link_robot_.erase(r.link.get());
+    r.link.reset();
+  }
+  storage::RobotRecord record = r.record;
+  record.robot.id = hello.robot_id;
+  if (hello.diameter > 0) record.robot.diameter = hello.diameter;
+  record.robot.max_speed = hello.max_speed > 0 ? hello.max_speed : options_.allocation.speed;
+  record.robot.pose = hello.pose;
+  record.robot.pose.position = xy;
+  record.robot.current_point = point;
+  record.robot.state = engine::RobotState::kIdle;
+  record.kind = hello.robot_kind.empty() ? "differential" : hello.robot_kind;
+  record.last_seen = Now();
+  record.last_acked_sequence = std::max(record.last_acked_sequence, hello.last_acked_sequence);
+  if (record.next_sequence <= record.last_acked_sequence) record.next_sequence = record.last_acked_sequence + 1;
+  if (auto valid = engine::ValidateRobot(record.robot); !valid.ok()) {
+    if (inserted) robots_.erase(it);
+    return reject(StatusCode::kInvalidArgument, valid.error().message);
+  }
+  const bool resend = r.has_assignment && !r.assignment.order_ids.empty();
+  storage::RobotRecord stored = record;
+  stored.next_sequence += resend ? 2 : 1;  // Welcome (+ the current plan)
+  if (auto saved = store_.UpsertRobot(stored); !saved.ok()) {
+    if (inserted) robots_.erase(it);
+    return reject(StatusCode::kUnavailable, "robot " + hello.robot_id + " not registered: storage failed: " +
+                                                saved.error().message);
+  }
+  r.record = record;
+  r.link = link;
+  r.last_heard = Clock::now();
+  r.offline_since.reset();
+  link_robot_[link.get()] = hello.robot_id;
+  dirty_ = true;
+  RobotOutbound welcome;
+  welcome.kind = RobotOutbound::Kind::kWelcome;
+  welcome.time_scale = options_.time_scale;
+  welcome.heartbeat_interval = options_.heartbeat_interval;
+  welcome.heartbeat_timeout = options_.heartbeat_timeout;
+  welcome.resume_from_sequence = record.last_acked_sequence + 1;
+  welcome.map_version = options_.map_version;
+  SendTo(r, std::move(welcome));
+  // Resume: the robot gets its whole current plan again (it skips waypoints it has passed).
+  if (resend) SendTo(r, PlanMessage(r, true, 0));
+  spdlog::info("robot {} connected at '{}'", hello.robot_id, map_->point(point).name);
+  AllocatePending();
+}
+
+void Dispatcher::StartOrder(const std::string& order_id, const std::string& detail) {
+  auto view = Find(order_id);
+  if (!view || view->record.order.state != engine::OrderState::kAssigned) return;
+  storage::OrderTransition t;
+  t.order_id = order_id;
+  t.to = engine::OrderState::kInProgress;
+  t.time = Now();
+  t.detail = detail;
+  auto event = store_.TransitionOrder(t);
+  if (!event.ok()) {
+    spdlog::error("order {} -> in_progress not stored: {}", order_id, event.error().message);
+    return;
+  }
+  auto copy = std::make_shared<OrderView>(*view);
+  copy->record.order.state = engine::OrderState::kInProgress;
+  copy->record.updated_time = t.time;
+  Put(copy);
+  Journal(*event);
+}
+
+void Dispatcher::DoWaypointReached(RobotRuntime& r, const RobotInbound& m) {
+  const auto& w = r.assignment.plan.waypoints;
+  for (std::size_t i = 0; i < w.size(); ++i) {
+    if (static_cast<std::uint64_t>(w[i].seq) != m.sequence) continue;
+    r.record.robot.current_point = w[i].point;
+    if (std::isfinite(m.pose.position.x()) && std::isfinite(m.pose.position.y())) r.record.robot.pose = m.pose;
+    if (w[i].action == engine::WaypointAction::kPick) {
+      const std::string order = OrderOfWaypoint(r.assignment, i);
+      StartOrder(order, r.record.robot.id + " reached pick '" + map_->point(w[i].point).name + "'");
+    }
+    return;
+  }
+}
+
+void Dispatcher::DoTaskEvent(RobotRuntime& r, const RobotInbound& m) {
+  auto view = Find(m.order_id);
+  const std::string& robot = r.record.robot.id;
+  if (!view || engine::IsTerminal(view->record.order.state)) return;  // late or repeated
+  const auto& team = view->record.robots;
+  if (std::find(team.begin(), team.end(), robot) == team.end()) return;
+  std::string where = m.point_id >= 0 && static_cast<std::size_t>(m.point_id) < map_->point_count()
+                          ? "'" + map_->point(m.point_id).name + "'"
+                          : "?";
+  if (!m.dropped) {
+    if (view->record.order.state == engine::OrderState::kAssigned) {
+      StartOrder(m.order_id, robot + " picked at " + where);
+    } else if (auto e = store_.AppendProgress(m.order_id, Now(), robot + " picked at " + where); e.ok()) {
+      Journal(*e);
+    }
+    return;
+  }
+  if (view->dropped_by.count(robot)) return;  // repeated
+  StartOrder(m.order_id, robot + " dropped at " + where);
+  view = Find(m.order_id);
+  storage::AssignmentRecord plan = r.assignment;
+  const bool trimmed = TrimDone(plan, m.order_id);
+  std::set<std::string> dropped = view->dropped_by;
+  dropped.insert(robot);
+  const bool complete = dropped.size() >= team.size();
+  const double now = Now();
+  std::optional<storage::OrderEvent> event;
+  auto committed = store_.RunInTransaction([&](storage::Store& s) -> engine::Status {
+    if (trimmed) {
+      plan.updated_time = now;
+      if (auto saved = s.SaveAssignment(plan); !saved.ok()) return saved.error();
+    }
+    if (complete) {
+      storage::OrderTransition t;
+      t.order_id = m.order_id;
+      t.to = engine::OrderState::kCompleted;
+      t.time = now;
+      t.detail = robot + " dropped at " + where;
+      auto e = s.TransitionOrder(t);
+      if (!e.ok()) return e.error();
+      event = *e;
+    } else {
+      auto e = s.AppendProgress(m.order_id, now, robot + " dropped at " + where);
+      if (!e.ok()) return e.error();
+      event = *e;
+    }
+    return engine::Ok{};
+  });
+  if (!committed.ok()) {
+    spdlog::error("drop of order {} by {} not stored: {}", m.order_id, robot, committed.error().message);
+    return;
+  }
+  if (trimmed) {
+    r.assignment = std::move(plan);
+    r.record.robot.task_queue = r.assignment.order_ids;
+  }
+  auto copy = std::make_shared<OrderView>(*view);
+  copy->dropped_by = std::move(dropped);
+  if (complete) {
+    copy->record.order.state = engine::OrderState::kCompleted;
+    copy->record.updated_time = now;
+    copy->finished_time = now;
+  }
+  Put(copy);
+  if (event) Journal(*event);
+  if (complete) spdlog::info("order {} completed", m.order_id);
+  AllocatePending();
+}
+
+void Dispatcher::MarkOffline(RobotRuntime& r, const std::string& why) {
+  if (r.link) {
+    CloseLink(r.link, MakeStatus(StatusCode::kUnavailable, why));
+    link_robot_.erase(r.link.get());
+    r.link.reset();
+  }
+  r.record.robot.state = engine::RobotState::kOffline;
+  r.offline_since = Clock::now();
+  dirty_ = true;
+  if (auto saved = store_.UpsertRobot(r.record); !saved.ok()) {
+    spdlog::warn("robot {} offline state not stored: {}", r.record.robot.id, saved.error().message);
+  }
+  spdlog::warn("robot {} offline: {}", r.record.robot.id, why);
+}
+
+void Dispatcher::DoRobotGone(const std::shared_ptr<RobotLink>& link) {
+  auto known = link_robot_.find(link.get());
+  if (known == link_robot_.end()) return;
+  RobotRuntime* r = RobotOf(known->second);
+  if (r && r->link == link) MarkOffline(*r, "stream closed");
+  link_robot_.erase(link.get());
+}
+
+void Dispatcher::Tick() {
+  const auto now = Clock::now();
+  for (auto& [id, r] : robots_) {
+    if (r.link) {
+      const std::chrono::duration<double> silent = now - r.last_heard;
+      if (silent.count() > options_.heartbeat_timeout) {
+        MarkOffline(r, "no message for " + Fixed(silent.count()) + " s (heartbeat timeout " +
+                           Fixed(options_.heartbeat_timeout) + " s)");
+      }
+      continue;
+    }
+    if (!r.offline_since || !r.has_assignment || r.assignment.order_ids.empty()) continue;
+    const std::chrono::duration<double> offline = now - *r.offline_since;
+    if (offline.count() < options_.offline_grace) continue;
+    ServiceStatus status;
+    const std::string why = "robot " + id + " offline for more than " + Fixed(options_.offline_grace) + " s";
+    auto target = [](const OrderView& v) {
+      return v.record.order.state == engine::OrderState::kInProgress ? engine::OrderState::kFailed
+                                                                     : engine::OrderState::kAccepted;
+    };
+    if (ReleaseOrders(r.assignment.order_ids, target, why, &status)) {
+      r.offline_since.reset();
+      retry_allocation_ = true;
+    }
+  }
+  if (retry_allocation_) AllocatePending();
+}
+
+}  // namespace dispatch::server

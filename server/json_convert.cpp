@@ -1,0 +1,146 @@
+#include "server/json_convert.h"
+
+#include <cmath>
+#include <limits>
+
+namespace dispatch::server {
+namespace {
+
+using nlohmann::json;
+
+// JSON has no infinity: unreachable bids' terms are written as null and read back as +inf.
+json Num(double v) { return std::isfinite(v) ? json(v) : json(nullptr); }
+double NumOf(const json& j) {
+  return j.is_null() ? std::numeric_limits<double>::infinity() : j.get<double>();
+}
+
+json BidJson(const engine::Bid& b) {
+  json peaks = json::array();
+  for (const auto& [zone, n] : b.peaks) peaks.push_back({zone, n});
+  return {{"robot", b.robot}, {"reachable", b.reachable}, {"priced", b.priced},
+          {"t_d", Num(b.t_d)}, {"t_w", Num(b.t_w)}, {"t_t", Num(b.t_t)},
+          {"flow", Num(b.flow)}, {"x", Num(b.x)}, {"bid", Num(b.bid)},
+          {"ready_time", Num(b.ready_time)}, {"peaks", peaks}};
+}
+
+engine::Bid BidOf(const json& j) {
+  engine::Bid b;
+  b.robot = j.at("robot").get<std::string>();
+  b.reachable = j.at("reachable").get<bool>();
+  b.priced = j.at("priced").get<bool>();
+  b.t_d = NumOf(j.at("t_d"));
+  b.t_w = NumOf(j.at("t_w"));
+  b.t_t = NumOf(j.at("t_t"));
+  b.flow = NumOf(j.at("flow"));
+  b.x = NumOf(j.at("x"));
+  b.bid = NumOf(j.at("bid"));
+  b.ready_time = NumOf(j.at("ready_time"));
+  for (const auto& p : j.at("peaks")) b.peaks.emplace_back(p.at(0).get<int>(), p.at(1).get<int>());
+  return b;
+}
+
+json RawAllocation(const AllocationRecord& a) {
+  json bids = json::array(), companions = json::array();
+  for (const auto& b : a.award.bids) bids.push_back(BidJson(b));
+  for (const auto& b : a.award.companion_bids) companions.push_back(BidJson(b));
+  return {{"order_id", a.award.order_id}, {"strategy", a.award.strategy},
+          {"alpha", a.alpha}, {"beta", a.beta}, {"zeta", a.zeta}, {"time", a.time},
+          {"bids", bids}, {"companion_bids", companions}, {"winners", a.award.winners},
+          {"reason", a.award.reason}};
+}
+
+}  // namespace
+
+std::string AllocationDetail(const AllocationRecord& allocation) {
+  return kAllocationDetailPrefix + RawAllocation(allocation).dump();
+}
+
+std::optional<AllocationRecord> ParseAllocationDetail(const std::string& detail) {
+  const std::string prefix = kAllocationDetailPrefix;
+  if (detail.rfind(prefix, 0) != 0) return std::nullopt;
+  try {
+    const json j = json::parse(detail.substr(prefix.size()));
+    AllocationRecord a;
+    a.award.order_id = j.at("order_id").get<std::string>();
+    a.award.strategy = j.at("strategy").get<std::string>();
+    a.alpha = j.at("alpha").get<double>();
+    a.beta = j.at("beta").get<double>();
+    a.zeta = j.at("zeta").get<double>();
+    a.time = j.at("time").get<double>();
+    for (const auto& b : j.at("bids")) a.award.bids.push_back(BidOf(b));
+    for (const auto& b : j.at("companion_bids")) a.award.companion_bids.push_back(BidOf(b));
+    a.award.winners = j.at("winners").get<std::vector<std::string>>();
+    a.award.reason = j.at("reason").get<std::string>();
+    return a;
+  } catch (const json::exception&) {
+    return std::nullopt;
+  }
+}
+
+nlohmann::json AllocationToJson(const AllocationRecord& allocation, const engine::WarehouseMap& map) {
+  json j = RawAllocation(allocation);
+  for (auto* list : {&j["bids"], &j["companion_bids"]}) {
+    for (auto& bid : *list) {
+      json peaks = json::array();
+      for (const auto& p : bid["peaks"]) {
+        const int zone = p.at(0).get<int>();
+        const bool known = zone >= 0 && static_cast<std::size_t>(zone) < map.zones().size();
+        peaks.push_back({{"zone", known ? map.zones()[static_cast<std::size_t>(zone)].name : "?"},
+                         {"zone_id", zone}, {"peak_robots", p.at(1)}});
+      }
+      bid["peaks"] = peaks;
+    }
+  }
+  return j;
+}
+
+nlohmann::json StopToJson(engine::PointId point, const engine::WarehouseMap& map) {
+  if (point < 0 || static_cast<std::size_t>(point) >= map.point_count()) return {{"point_id", point}};
+  const auto& p = map.point(point);
+  return {{"point_id", point}, {"name", p.name}, {"x", p.position.x()}, {"y", p.position.y()}};
+}
+
+nlohmann::json OrderToJson(const OrderView& view, const engine::WarehouseMap& map, bool explain) {
+  const engine::Order& o = view.record.order;
+  json picks = json::array();
+  for (engine::PointId p : o.picks) picks.push_back(StopToJson(p, map));
+  json j = {{"id", o.id},
+            {"client_id", o.client_id},
+            {"state", engine::OrderStateName(o.state)},
+            {"robots", view.record.robots},
+            {"priority", o.priority},
+            {"picks", picks},
+            {"drop", StopToJson(o.drop, map)},
+            {"formation", o.formation},
+            {"work_time", o.work_time},
+            {"created_time", o.created_time},
+            {"updated_time", view.record.updated_time},
+            {"finished_time", view.finished_time ? json(*view.finished_time) : json(nullptr)},
+            {"reason", view.record.reason}};
+  if (explain) {
+    j["allocation"] = view.explanation ? AllocationToJson(*view.explanation, map) : json(nullptr);
+  }
+  return j;
+}
+
+nlohmann::json RobotToJson(const RobotView& view, const engine::WarehouseMap& map) {
+  const engine::Robot& r = view.robot;
+  json j = {{"id", r.id},
+            {"state", engine::RobotStateName(r.state)},
+            {"connected", view.connected},
+            {"kind", view.kind},
+            {"x", r.pose.position.x()},
+            {"y", r.pose.position.y()},
+            {"heading", r.pose.heading},
+            {"diameter", r.diameter},
+            {"max_speed", r.max_speed},
+            {"orders", r.task_queue},
+            {"plan_id", view.plan_id},
+            {"plan_waypoints", view.waypoints},
+            {"last_seen", view.last_seen},
+            {"battery", r.battery ? json(*r.battery) : json(nullptr)}};
+  j["point"] = r.current_point == engine::kNoPoint ? json(nullptr) : StopToJson(r.current_point, map);
+  return j;
+}
+
+}  // namespace dispatch::server

@@ -1,0 +1,39 @@
+// dispatchd: the warehouse dispatch service. See server/config.h for the flags and
+// server/server.h for what runs. SIGTERM / SIGINT shut it down gracefully.
+#include <spdlog/spdlog.h>
+
+#include <csignal>
+#include <cstdio>
+
+#include "server/config.h"
+#include "server/server.h"
+
+int main(int argc, char** argv) {
+  auto parsed = dispatch::server::ParseCommandLine(argc, argv);
+  if (!parsed.ok()) {
+    std::fprintf(stderr, "dispatchd: %s\n", parsed.error().message.c_str());
+    return 2;
+  }
+  if (parsed->exit_code >= 0) return parsed->exit_code;
+  const auto& config = parsed->config;
+  spdlog::set_level(spdlog::level::from_str(config.log_level));
+
+  // Block the shutdown signals in every thread (threads inherit the mask) and wait for them
+  // here, so no handler runs inside gRPC or SQLite code.
+  sigset_t signals;
+  sigemptyset(&signals);
+  sigaddset(&signals, SIGTERM);
+  sigaddset(&signals, SIGINT);
+  pthread_sigmask(SIG_BLOCK, &signals, nullptr);
+
+  auto server = dispatch::server::DispatchServer::Start(config);
+  if (!server.ok()) {
+    spdlog::error("dispatchd: {}", server.error().message);
+    return 1;
+  }
+  int signal = 0;
+  sigwait(&signals, &signal);
+  spdlog::info("signal {} received: shutting down", signal);
+  (*server)->Shutdown();
+  return 0;
+}

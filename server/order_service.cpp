@@ -1,0 +1,234 @@
+#include "server/order_service.h"
+
+#include <set>
+
+#include "server/grpc_status.h"
+#include "server/proto_convert.h"
+#include "server/queued_writer.h"
+
+namespace dispatch::server {
+namespace {
+
+grpc::ServerUnaryReactor* Done(grpc::CallbackServerContext* context, grpc::Status status) {
+  auto* reactor = context->DefaultReactor();
+  reactor->Finish(std::move(status));
+  return reactor;
+}
+
+// One WatchOrders stream: subscribed to the hub before the replay so nothing falls between.
+class WatchReactor final : public QueuedWriter<grpc::ServerWriteReactor<pb::OrderEvent>, pb::OrderEvent> {
+ public:
+  WatchReactor(Dispatcher& dispatcher, const pb::WatchOrdersRequest& request)
+      : dispatcher_(dispatcher), filter_(request.order_ids().begin(), request.order_ids().end()) {
+    sink_ = std::make_shared<Sink>(this);
+    sub_ = dispatcher_.watch_hub().Subscribe(sink_);
+    if (request.from_start()) {
+      Replay(0);
+    } else if (request.after_event_id() > 0) {
+      Replay(static_cast<std::int64_t>(request.after_event_id()));
+    }
+    std::vector<storage::OrderEvent> live;
+    {
+      std::lock_guard<std::mutex> lock(mu_);
+      replaying_ = false;
+      live.swap(buffered_);
+    }
+    for (const auto& e : live) Deliver(e);
+  }
+
+  void OnDone() override {
+    dispatcher_.watch_hub().Unsubscribe(sub_);
+    sink_->Detach();
+    delete this;
+  }
+  void OnCancel() override { RequestFinish(grpc::Status::CANCELLED); }
+
+ private:
+  class Sink final : public OrderEventSink {
+   public:
+    explicit Sink(WatchReactor* owner) : owner_(owner) {}
+    void OnEvent(const storage::OrderEvent& event) override {
+      std::lock_guard<std::mutex> lock(mu_);
+      if (owner_) owner_->OnLive(event);
+    }
+    void OnClose() override {
+      std::lock_guard<std::mutex> lock(mu_);
+      if (owner_) owner_->RequestFinish({grpc::StatusCode::UNAVAILABLE, "server shutting down"});
+    }
+    void Detach() {
+      std::lock_guard<std::mutex> lock(mu_);
+      owner_ = nullptr;
+    }
+
+   private:
+    std::mutex mu_;  // guards owner_ (the reactor is deleted only after Detach)
+    WatchReactor* owner_;
+  };
+
+  void Replay(std::int64_t after) {
+    storage::EventQuery query;
+    query.after_id = after;
+    if (filter_.size() == 1) query.order_id = *filter_.begin();
+    query.limit = 1000;
+    for (;;) {
+      auto events = dispatcher_.store().ListEvents(query);
+      if (!events.ok()) {
+        RequestFinish({grpc::StatusCode::UNAVAILABLE, "journal replay failed: " + events.error().message});
+        return;
+      }
+      for (const auto& e : *events) {
+        Deliver(e);
+        query.after_id = e.id;
+      }
+      if (events->size() < static_cast<std::size_t>(query.limit)) break;
+    }
+  }
+
+  void OnLive(const storage::OrderEvent& event) {
+    {
+      std::lock_guard<std::mutex> lock(mu_);
+      if (replaying_) {
+        buffered_.push_back(event);
+        return;
+      }
+    }
+    Deliver(event);
+  }
+
+  void Deliver(const storage::OrderEvent& event) {
+    {
+      std::lock_guard<std::mutex> lock(mu_);
+      if (event.id <= last_sent_) return;  // replayed already
+      last_sent_ = event.id;
+    }
+    if (!filter_.empty() && !filter_.count(event.order_id)) return;
+    pb::OrderEvent out;
+    EventToProto(event, &out);
+    Enqueue(std::move(out));
+  }
+
+  Dispatcher& dispatcher_;
+  const std::set<std::string> filter_;
+  std::shared_ptr<Sink> sink_;
+  std::uint64_t sub_ = 0;
+  std::mutex mu_;  // guards replaying_, buffered_, last_sent_
+  bool replaying_ = true;
+  std::vector<storage::OrderEvent> buffered_;
+  std::int64_t last_sent_ = 0;
+};
+
+constexpr int kDefaultPageSize = 100;
+
+}  // namespace
+
+grpc::ServerUnaryReactor* OrderServiceImpl::SubmitOrder(grpc::CallbackServerContext* context,
+                                                        const pb::SubmitOrderRequest* request,
+                                                        pb::SubmitOrderResponse* response) {
+  auto converted = OrderRequestFromProto(*request);
+  if (!converted.ok()) return Done(context, ToGrpcStatus(FromEngineError(converted.error())));
+  auto* reactor = context->DefaultReactor();
+  dispatcher_.SubmitOrder(std::move(converted).value(), [this, reactor, response](SubmitReply reply) {
+    if (reply.status.ok()) {
+      OrderToProto(*reply.order, dispatcher_.map(), response->mutable_order());
+      response->set_created(reply.created);
+    }
+    reactor->Finish(ToGrpcStatus(reply.status));
+  });
+  return reactor;
+}
+
+grpc::ServerUnaryReactor* OrderServiceImpl::GetOrder(grpc::CallbackServerContext* context,
+                                                     const pb::GetOrderRequest* request,
+                                                     pb::Order* response) {
+  auto snap = dispatcher_.snapshot();
+  std::shared_ptr<const OrderView> order;
+  std::string key;
+  switch (request->key_case()) {
+    case pb::GetOrderRequest::kOrderId:
+      order = snap->FindOrder(request->order_id());
+      key = "id '" + request->order_id() + "'";
+      break;
+    case pb::GetOrderRequest::kClientOrderId:
+      order = snap->FindClientOrder(request->client_order_id());
+      key = "client_order_id '" + request->client_order_id() + "'";
+      break;
+    case pb::GetOrderRequest::KEY_NOT_SET:
+      return Done(context, {grpc::StatusCode::INVALID_ARGUMENT, "give order_id or client_order_id"});
+  }
+  if (!order) return Done(context, {grpc::StatusCode::NOT_FOUND, "no order with " + key});
+  OrderToProto(*order, dispatcher_.map(), response);
+  return Done(context, grpc::Status::OK);
+}
+
+grpc::ServerUnaryReactor* OrderServiceImpl::CancelOrder(grpc::CallbackServerContext* context,
+                                                        const pb::CancelOrderRequest* request,
+                                                        pb::Order* response) {
+  if (request->order_id().empty()) {
+    return Done(context, {grpc::StatusCode::INVALID_ARGUMENT, "order_id is required"});
+  }
+  auto* reactor = context->DefaultReactor();
+  dispatcher_.CancelOrder(request->order_id(), request->reason(),
+                          [this, reactor, response](OrderReply reply) {
+                            if (reply.status.ok()) OrderToProto(*reply.order, dispatcher_.map(), response);
+                            reactor->Finish(ToGrpcStatus(reply.status));
+                          });
+  return reactor;
+}
+
+grpc::ServerUnaryReactor* OrderServiceImpl::ListOrders(grpc::CallbackServerContext* context,
+                                                       const pb::ListOrdersRequest* request,
+                                                       pb::ListOrdersResponse* response) {
+  std::set<engine::OrderState> states;
+  for (int s : request->states()) {
+    auto state = OrderStateFromProto(static_cast<pb::OrderState>(s));
+    if (state) states.insert(*state);
+  }
+  if (request->page_size() < 0) {
+    return Done(context, {grpc::StatusCode::INVALID_ARGUMENT, "page_size must be >= 0"});
+  }
+  const int page = request->page_size() == 0 ? kDefaultPageSize
+                                             : std::min(request->page_size(), storage::kMaxPageSize);
+  std::int64_t after = 0;
+  if (!request->page_token().empty()) {
+    const std::string& t = request->page_token();
+    char* end = nullptr;
+    after = t.size() > 1 && t[0] == 'p' ? std::strtoll(t.c_str() + 1, &end, 10) : -1;
+    if (after < 0 || end == nullptr || *end != '\0') {
+      return Done(context, {grpc::StatusCode::INVALID_ARGUMENT, "page_token '" + t + "' is not one this server issued"});
+    }
+  }
+  auto snap = dispatcher_.snapshot();
+  for (std::size_t i = static_cast<std::size_t>(after); i < snap->orders.size(); ++i) {
+    const auto& view = *snap->orders[i];
+    if (!states.empty() && !states.count(view.record.order.state)) continue;
+    if (response->orders_size() == page) {
+      response->set_next_page_token("p" + std::to_string(i));
+      break;
+    }
+    OrderToProto(view, dispatcher_.map(), response->add_orders());
+  }
+  return Done(context, grpc::Status::OK);
+}
+
+grpc::ServerWriteReactor<pb::OrderEvent>* OrderServiceImpl::WatchOrders(
+    grpc::CallbackServerContext* /*context*/, const pb::WatchOrdersRequest* request) {
+  return new WatchReactor(dispatcher_, *request);
+}
+
+grpc::ServerUnaryReactor* OrderServiceImpl::ExplainAllocation(
+    grpc::CallbackServerContext* context, const pb::ExplainAllocationRequest* request,
+    pb::AllocationExplanation* response) {
+  auto order = dispatcher_.snapshot()->FindOrder(request->order_id());
+  if (!order) {
+    return Done(context, {grpc::StatusCode::NOT_FOUND, "no order with id '" + request->order_id() + "'"});
+  }
+  if (!order->explanation) {
+    return Done(context, {grpc::StatusCode::FAILED_PRECONDITION,
+                          "order " + request->order_id() + " has not been allocated yet (state " +
+                              engine::OrderStateName(order->record.order.state) + ")"});
+  }
+  AllocationToProto(*order->explanation, dispatcher_.map(), response);
+  return Done(context, grpc::Status::OK);
+}
+
+}  // namespace dispatch::server

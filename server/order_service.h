@@ -1,0 +1,40 @@
+// OrderService (proto/warehouse/dispatch/v1/orders.proto) on gRPC's callback API. Writes go
+// to the dispatcher loop and finish from its reply callback (no thread waits); reads use the
+// published snapshot; WatchOrders replays the journal from the store and then streams live
+// events from the dispatcher's WatchHub. Thread-safe.
+#pragma once
+
+#include "server/dispatcher.h"
+#include "warehouse/dispatch/v1/orders.grpc.pb.h"
+
+namespace dispatch::server {
+
+class OrderServiceImpl final : public ::warehouse::dispatch::v1::OrderService::CallbackService {
+ public:
+  explicit OrderServiceImpl(Dispatcher& dispatcher) : dispatcher_(dispatcher) {}
+
+  grpc::ServerUnaryReactor* SubmitOrder(grpc::CallbackServerContext* context,
+                                        const ::warehouse::dispatch::v1::SubmitOrderRequest* request,
+                                        ::warehouse::dispatch::v1::SubmitOrderResponse* response) override;
+  grpc::ServerUnaryReactor* GetOrder(grpc::CallbackServerContext* context,
+                                     const ::warehouse::dispatch::v1::GetOrderRequest* request,
+                                     ::warehouse::dispatch::v1::Order* response) override;
+  grpc::ServerUnaryReactor* CancelOrder(grpc::CallbackServerContext* context,
+                                        const ::warehouse::dispatch::v1::CancelOrderRequest* request,
+                                        ::warehouse::dispatch::v1::Order* response) override;
+  grpc::ServerUnaryReactor* ListOrders(grpc::CallbackServerContext* context,
+                                       const ::warehouse::dispatch::v1::ListOrdersRequest* request,
+                                       ::warehouse::dispatch::v1::ListOrdersResponse* response) override;
+  grpc::ServerWriteReactor<::warehouse::dispatch::v1::OrderEvent>* WatchOrders(
+      grpc::CallbackServerContext* context,
+      const ::warehouse::dispatch::v1::WatchOrdersRequest* request) override;
+  grpc::ServerUnaryReactor* ExplainAllocation(
+      grpc::CallbackServerContext* context,
+      const ::warehouse::dispatch::v1::ExplainAllocationRequest* request,
+      ::warehouse::dispatch::v1::AllocationExplanation* response) override;
+
+ private:
+  Dispatcher& dispatcher_;
+};
+
+}  // namespace dispatch::server

@@ -1,0 +1,168 @@
+#include "server/rest_handlers.h"
+
+#include <cmath>
+
+#include "server/dispatcher.h"
+#include "server/json_convert.h"
+
+namespace dispatch::server {
+namespace {
+
+using nlohmann::json;
+
+int HttpStatus(StatusCode code) {
+  switch (code) {
+    case StatusCode::kOk: return 200;
+    case StatusCode::kInvalidArgument: return 400;
+    case StatusCode::kNotFound: return 404;
+    case StatusCode::kAlreadyExists: return 409;
+    case StatusCode::kFailedPrecondition: return 409;
+    case StatusCode::kUnavailable: return 503;
+    case StatusCode::kInternal: return 500;
+  }
+  return 500;
+}
+
+RestReply Error(int status, const std::string& message) { return {status, {{"error", message}}}; }
+RestReply Error(const ServiceStatus& s) { return Error(HttpStatus(s.code), s.message); }
+
+engine::Result<engine::StopSpec> StopOf(const json& j, const std::string& what) {
+  if (j.is_string()) return engine::StopSpec(j.get<std::string>());
+  if (j.is_object() && j.contains("x") && j.contains("y") && j["x"].is_number() && j["y"].is_number()) {
+    return engine::StopSpec(Eigen::Vector2d(j["x"].get<double>(), j["y"].get<double>()));
+  }
+  return engine::InvalidArgument(what + " must be a point name or {\"x\": .., \"y\": ..}");
+}
+
+engine::Result<engine::OrderRequest> RequestOf(const std::string& body) {
+  json j;
+  try {
+    j = json::parse(body);
+  } catch (const json::exception& e) {
+    return engine::InvalidArgument(std::string("body is not JSON: ") + e.what());
+  }
+  if (!j.is_object()) return engine::InvalidArgument("body must be a JSON object");
+  engine::OrderRequest r;
+  try {
+    const char* id_key = j.contains("client_order_id") ? "client_order_id" : "client_id";
+    if (!j.contains(id_key) || !j[id_key].is_string()) {
+      return engine::InvalidArgument("client_order_id (string) is required");
+    }
+    r.client_id = j[id_key].get<std::string>();
+    if (j.contains("priority")) r.priority = j["priority"].get<int>();
+    if (!j.contains("picks") || !j["picks"].is_array()) {
+      return engine::InvalidArgument("picks (array of stops) is required");
+    }
+    int k = 0;
+    for (const auto& p : j["picks"]) {
+      auto stop = StopOf(p, "pick " + std::to_string(++k));
+      if (!stop.ok()) return stop.error();
+      r.picks.push_back(*stop);
+    }
+    if (!j.contains("drop")) return engine::InvalidArgument("drop is required");
+    auto drop = StopOf(j["drop"], "drop");
+    if (!drop.ok()) return drop.error();
+    r.drop = *drop;
+    if (j.contains("formation")) r.formation = j["formation"].get<bool>();
+    if (j.contains("work_time")) r.work_time = j["work_time"].get<double>();
+    if (j.contains("release_time") && !j["release_time"].is_null()) {
+      r.release_time = j["release_time"].get<double>();
+    }
+  } catch (const json::exception& e) {
+    return engine::InvalidArgument(std::string("a field has the wrong type: ") + e.what());
+  }
+  return r;
+}
+
+}  // namespace
+
+RestReply RestHandlers::Health() const { return {200, {{"status", "ok"}}}; }
+
+RestReply RestHandlers::Ready() const {
+  auto snap = dispatcher_.snapshot();
+  if (!snap) return Error(503, "dispatcher not ready");
+  return {200, {{"ready", true}, {"snapshot", snap->version}}};
+}
+
+RestReply RestHandlers::Status() const {
+  auto snap = dispatcher_.snapshot();
+  json orders = json::object();
+  for (const char* s : {"accepted", "assigned", "in_progress", "completed", "cancelled", "failed"}) {
+    orders[s] = 0;
+  }
+  for (const auto& o : snap->orders) orders[engine::OrderStateName(o->record.order.state)] = orders[engine::OrderStateName(o->record.order.state)].get<int>() + 1;
+  int connected = 0;
+  for (const auto& [id, r] : snap->robots) connected += r.connected ? 1 : 0;
+  return {200,
+          {{"map", snap->map_name},
+           {"map_version", snap->map_version},
+           {"strategy", snap->strategy},
+           {"time", snap->time},
+           {"time_scale", snap->time_scale},
+           {"snapshot", snap->version},
+           {"orders", orders},
+           {"robots", {{"total", snap->robots.size()}, {"connected", connected}}}}};
+}
+
+RestReply RestHandlers::Robots() const {
+  auto snap = dispatcher_.snapshot();
+  json robots = json::array();
+  for (const auto& [id, r] : snap->robots) robots.push_back(RobotToJson(r, dispatcher_.map()));
+  return {200, {{"robots", robots}}};
+}
+
+RestReply RestHandlers::Robot(const std::string& id) const {
+  auto snap = dispatcher_.snapshot();
+  auto it = snap->robots.find(id);
+  if (it == snap->robots.end()) return Error(404, "no robot with id '" + id + "'");
+  return {200, RobotToJson(it->second, dispatcher_.map())};
+}
+
+RestReply RestHandlers::Orders(const std::optional<std::string>& state) const {
+  std::optional<engine::OrderState> filter;
+  if (state) {
+    filter = engine::ParseOrderState(*state);
+    if (!filter) {
+      return Error(400, "unknown state '" + *state +
+                            "' (accepted, assigned, in_progress, completed, cancelled, failed)");
+    }
+  }
+  auto snap = dispatcher_.snapshot();
+  json orders = json::array();
+  for (const auto& o : snap->orders) {
+    if (filter && o->record.order.state != *filter) continue;
+    orders.push_back(OrderToJson(*o, dispatcher_.map(), false));
+  }
+  return {200, {{"orders", orders}}};
+}
+
+RestReply RestHandlers::Order(const std::string& id) const {
+  auto snap = dispatcher_.snapshot();
+  auto order = snap->FindOrder(id);
+  if (!order) order = snap->FindClientOrder(id);
+  if (!order) return Error(404, "no order with id or client id '" + id + "'");
+  return {200, OrderToJson(*order, dispatcher_.map(), true)};
+}
+
+RestReply RestHandlers::SubmitOrder(const std::string& body) {
+  auto request = RequestOf(body);
+  if (!request.ok()) return Error(FromEngineError(request.error()));
+  SubmitReply reply = dispatcher_.Call<SubmitReply>(
+      [this, r = std::move(request).value()](std::function<void(SubmitReply)> done) mutable {
+        dispatcher_.SubmitOrder(std::move(r), std::move(done));
+      });
+  if (!reply.status.ok()) return Error(reply.status);
+  json j = OrderToJson(*reply.order, dispatcher_.map(), false);
+  j["created"] = reply.created;
+  return {reply.created ? 201 : 200, j};
+}
+
+RestReply RestHandlers::CancelOrder(const std::string& id, const std::string& reason) {
+  OrderReply reply = dispatcher_.Call<OrderReply>([this, id, reason](std::function<void(OrderReply)> done) {
+    dispatcher_.CancelOrder(id, reason, std::move(done));
+  });
+  if (!reply.status.ok()) return Error(reply.status);
+  return {200, OrderToJson(*reply.order, dispatcher_.map(), false)};
+}
+
+}  // namespace dispatch::server

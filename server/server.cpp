@@ -1,0 +1,141 @@
+#include "server/server.h"
+
+#include <grpcpp/grpcpp.h>
+#include <spdlog/spdlog.h>
+
+#include <cstdio>
+#include <fstream>
+
+#include "engine/cli/map_source.h"
+#include "engine/io/map_json.h"
+#include "engine/routing/route_table.h"
+#include "server/dispatcher.h"
+#include "server/fleet_service.h"
+#include "server/order_service.h"
+#include "server/rest_api.h"
+#include "storage/sqlite_store.h"
+
+namespace dispatch::server {
+namespace {
+
+engine::Status WritePortsFile(const std::string& path, const ServerPorts& ports) {
+  const std::string tmp = path + ".tmp";
+  {
+    std::ofstream out(tmp, std::ios::trunc);
+    out << nlohmann::json{{"grpc_port", ports.grpc}, {"http_port", ports.http}}.dump() << "\n";
+    if (!out) return engine::IoError("cannot write ports file '" + tmp + "'");
+  }
+  if (std::rename(tmp.c_str(), path.c_str()) != 0) {
+    return engine::IoError("cannot rename '" + tmp + "' to '" + path + "'");
+  }
+  return engine::Ok{};
+}
+
+}  // namespace
+
+std::string MapContentHash(const std::string& text) {
+  std::uint64_t h = 1469598103934665603ull;
+  for (unsigned char c : text) {
+    h ^= c;
+    h *= 1099511628211ull;
+  }
+  char buf[17];
+  std::snprintf(buf, sizeof buf, "%016llx", static_cast<unsigned long long>(h));
+  return buf;
+}
+
+engine::Result<std::unique_ptr<DispatchServer>> DispatchServer::Start(const ServerConfig& config,
+                                                                      storage::Store* store) {
+  if (auto valid = ValidateServerConfig(config); !valid.ok()) return valid.error();
+  spdlog::set_level(spdlog::level::from_str(config.log_level));
+  std::unique_ptr<DispatchServer> s(new DispatchServer());
+
+  auto loaded = engine::LoadMapSource(config.map);
+  if (!loaded.ok()) return loaded.error();
+  auto map = std::make_shared<const engine::WarehouseMap>(std::move(loaded).value());
+  engine::AllocationConfig allocation;
+  allocation.alpha = config.alpha;
+  allocation.beta = config.beta;
+  allocation.zeta = config.zeta;
+  engine::RouteTableOptions route_options;
+  route_options.speed = allocation.speed;
+  auto routes = engine::MakeRouteTable(map, route_options);
+  if (!routes.ok()) return routes.error();
+  std::shared_ptr<const engine::RouteTable> shared_routes = std::move(routes).value();
+
+  if (store) {
+    s->store_ = store;
+  } else {
+    auto opened = storage::SqliteStore::Open(config.db);
+    if (!opened.ok()) return opened.error();
+    s->owned_store_ = std::move(opened).value();
+    s->store_ = s->owned_store_.get();
+  }
+  storage::MapVersion version;
+  version.name = map->name();
+  version.content_hash = MapContentHash(engine::WriteMapJson(*map));
+  version.source = config.map == "chu2024" ? "builtin:chu2024" : config.map;
+  auto recorded = s->store_->RecordMapVersion(version);
+  if (!recorded.ok()) return recorded.error();
+  spdlog::info("map '{}' ({} points), version {} ({})", map->name(), map->point_count(),
+               recorded->version, recorded->content_hash);
+
+  DispatcherOptions options;
+  options.allocation = allocation;
+  options.strategy = config.strategy;
+  options.time_scale = config.time_scale;
+  options.heartbeat_interval = config.heartbeat_interval;
+  options.heartbeat_timeout = config.heartbeat_timeout;
+  options.offline_grace = config.offline_grace;
+  options.map_version = recorded->content_hash;
+  auto dispatcher = Dispatcher::Create(map, shared_routes, *s->store_, options);
+  if (!dispatcher.ok()) return dispatcher.error();
+  s->dispatcher_ = std::move(dispatcher).value();
+  s->dispatcher_->Start();
+
+  s->order_service_ = std::make_unique<OrderServiceImpl>(*s->dispatcher_);
+  s->fleet_service_ = std::make_unique<FleetServiceImpl>(*s->dispatcher_);
+  s->map_service_ = std::make_unique<MapServiceImpl>(*s->dispatcher_);
+  grpc::ServerBuilder builder;
+  int grpc_port = 0;
+  builder.AddListeningPort(config.bind + ":" + std::to_string(config.grpc_port),
+                           grpc::InsecureServerCredentials(), &grpc_port);
+  builder.RegisterService(s->order_service_.get());
+  builder.RegisterService(s->fleet_service_.get());
+  builder.RegisterService(s->map_service_.get());
+  s->grpc_ = builder.BuildAndStart();
+  if (!s->grpc_ || grpc_port == 0) {
+    return engine::IoError("cannot listen for gRPC on " + config.bind + ":" + std::to_string(config.grpc_port));
+  }
+  s->ports_.grpc = grpc_port;
+
+  s->rest_ = std::make_unique<RestServer>(RestHandlers(*s->dispatcher_));
+  const int http_port = s->rest_->Start(config.bind, config.http_port);
+  if (http_port <= 0) {
+    return engine::IoError("cannot listen for HTTP on " + config.bind + ":" + std::to_string(config.http_port));
+  }
+  s->ports_.http = http_port;
+  spdlog::info("listening: gRPC {}:{}, HTTP {}:{}", config.bind, grpc_port, config.bind, http_port);
+  if (!config.ports_file.empty()) {
+    if (auto written = WritePortsFile(config.ports_file, s->ports_); !written.ok()) return written.error();
+  }
+  return s;
+}
+
+DispatchServer::~DispatchServer() { Shutdown(); }
+
+void DispatchServer::Shutdown() {
+  std::lock_guard<std::mutex> lock(shutdown_mu_);
+  if (shut_down_) return;
+  shut_down_ = true;
+  if (rest_) rest_->Stop();
+  if (dispatcher_) dispatcher_->CloseStreams();
+  if (grpc_) {
+    grpc_->Shutdown(std::chrono::system_clock::now() + std::chrono::seconds(3));
+    grpc_->Wait();
+  }
+  if (dispatcher_) dispatcher_->Stop();
+  spdlog::info("dispatchd stopped");
+}
+
+}  // namespace dispatch::server

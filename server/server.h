@@ -1,0 +1,70 @@
+// DispatchServer: dispatchd assembled (SPEC §4): map + route table, store (SQLite, or one a
+// test injects), dispatcher loop, gRPC (Order/Fleet/Map services, callback API) and REST.
+//
+// Start order: load the map, build the route table, open the store, record the map version,
+// recover, start the loop, listen (gRPC, then HTTP), write the ports file. Shutdown order:
+// HTTP stops; robot and watch streams are finished (UNAVAILABLE "shutting down"); gRPC
+// shuts down (in-flight unary calls still get their answers from the loop, a short deadline
+// cancels the rest); the loop stops; the store closes. Every acknowledged write is already
+// committed, so the database is consistent at any point. Shutdown is idempotent and
+// thread-safe; the destructor calls it.
+#pragma once
+
+#include <memory>
+#include <mutex>
+#include <string>
+
+#include "engine/common/result.h"
+#include "server/config.h"
+#include "storage/store.h"
+
+namespace grpc {
+class Server;
+}
+
+namespace dispatch::server {
+
+class Dispatcher;
+class RestServer;
+class OrderServiceImpl;
+class FleetServiceImpl;
+class MapServiceImpl;
+
+struct ServerPorts {
+  int grpc = 0;
+  int http = 0;
+};
+
+class DispatchServer {
+ public:
+  // `store` (optional, must outlive the server) replaces the SQLite file of config.db.
+  static engine::Result<std::unique_ptr<DispatchServer>> Start(const ServerConfig& config,
+                                                               storage::Store* store = nullptr);
+  ~DispatchServer();
+  DispatchServer(const DispatchServer&) = delete;
+  DispatchServer& operator=(const DispatchServer&) = delete;
+
+  ServerPorts ports() const { return ports_; }
+  Dispatcher& dispatcher() { return *dispatcher_; }
+  void Shutdown();
+
+ private:
+  DispatchServer() = default;
+
+  std::unique_ptr<storage::Store> owned_store_;
+  storage::Store* store_ = nullptr;
+  std::unique_ptr<Dispatcher> dispatcher_;
+  std::unique_ptr<OrderServiceImpl> order_service_;
+  std::unique_ptr<FleetServiceImpl> fleet_service_;
+  std::unique_ptr<MapServiceImpl> map_service_;
+  std::unique_ptr<grpc::Server> grpc_;
+  std::unique_ptr<RestServer> rest_;
+  ServerPorts ports_;
+  std::mutex shutdown_mu_;  // serialises Shutdown
+  bool shut_down_ = false;
+};
+
+// FNV-1a 64 of the map's JSON encoding, 16 hex digits: the map version tag.
+std::string MapContentHash(const std::string& map_json);
+
+}  // namespace dispatch::server

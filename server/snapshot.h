@@ -1,0 +1,69 @@
+// Snapshot: the immutable picture of the dispatcher's state that the loop publishes after
+// every batch of commands (SPEC §4 "Concurrency": queues in, snapshots out). Readers (gRPC
+// GetOrder/ListOrders, REST) take a shared_ptr<const Snapshot> and never touch the loop's
+// state or locks. Orders are shared between consecutive snapshots (copy on write per order).
+#pragma once
+
+#include <cstdint>
+#include <map>
+#include <memory>
+#include <optional>
+#include <set>
+#include <string>
+#include <unordered_map>
+#include <vector>
+
+#include "engine/allocation/bid.h"
+#include "storage/store.h"
+
+namespace dispatch::server {
+
+// An award and the weights it was made with (journaled, so it survives restarts).
+struct AllocationRecord {
+  engine::AwardExplanation award;
+  double alpha = 0.0;
+  double beta = 0.0;
+  double zeta = 0.0;
+  double time = 0.0;  // dispatcher seconds when the auction ran
+};
+
+struct OrderView {
+  storage::OrderRecord record;  // order (current state), robots, reason, updated_time
+  std::int64_t position = 0;    // 1-based submission position (ListOrders paging key)
+  std::optional<AllocationRecord> explanation;  // the auction behind the award
+  std::optional<double> finished_time;  // set once terminal
+  std::set<std::string> dropped_by;     // team members that reported the drop
+};
+
+struct RobotView {
+  engine::Robot robot;  // pose, state (offline when not connected), current point, queue
+  std::string kind;
+  bool connected = false;
+  double last_seen = 0.0;  // dispatcher seconds
+  std::uint64_t plan_id = 0;
+  std::size_t waypoints = 0;  // in its current plan
+};
+
+struct Snapshot {
+  std::uint64_t version = 0;  // increases with every publish
+  double time = 0.0;          // dispatcher seconds at publish
+  std::string map_name;
+  std::string map_version;
+  std::string strategy;
+  double time_scale = 1.0;
+  std::vector<std::shared_ptr<const OrderView>> orders;  // submission order
+  std::unordered_map<std::string, std::size_t> by_id;         // order id -> index
+  std::unordered_map<std::string, std::size_t> by_client_id;  // client id -> index
+  std::map<std::string, RobotView> robots;                    // by id
+
+  std::shared_ptr<const OrderView> FindOrder(const std::string& id) const {
+    auto it = by_id.find(id);
+    return it == by_id.end() ? nullptr : orders[it->second];
+  }
+  std::shared_ptr<const OrderView> FindClientOrder(const std::string& client_id) const {
+    auto it = by_client_id.find(client_id);
+    return it == by_client_id.end() ? nullptr : orders[it->second];
+  }
+};
+
+}  // namespace dispatch::server

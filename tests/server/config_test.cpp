@@ -1,0 +1,69 @@
+// dispatchd's command line and config file: defaults, flags, file keys, flags win, errors.
+#include <gtest/gtest.h>
+
+#include <fstream>
+
+#include "server/config.h"
+#include "tests/server/test_support.h"
+
+namespace dispatch::server::testing {
+namespace {
+
+engine::Result<ParsedCommandLine> Parse(std::vector<std::string> args) {
+  args.insert(args.begin(), "dispatchd");
+  std::vector<char*> argv;
+  for (auto& a : args) argv.push_back(a.data());
+  return ParseCommandLine(static_cast<int>(argv.size()), argv.data());
+}
+
+TEST(ServerConfigTest, FlagsSetTheConfig) {
+  auto parsed = Parse({"--grpc-port", "0", "--http-port", "8081", "--db", "x.db", "--map", "chu2024",
+                       "--strategy", "greedy", "--zeta", "0", "--alpha", "0.3", "--beta", "0.7",
+                       "--time-scale", "10", "--bind", "127.0.0.1", "--ports-file", "p.json"});
+  ASSERT_TRUE(parsed.ok()) << parsed.error().message;
+  const ServerConfig& c = parsed->config;
+  EXPECT_EQ(c.grpc_port, 0);
+  EXPECT_EQ(c.http_port, 8081);
+  EXPECT_EQ(c.db, "x.db");
+  EXPECT_EQ(c.strategy, "greedy");
+  EXPECT_DOUBLE_EQ(c.zeta, 0.0);
+  EXPECT_DOUBLE_EQ(c.alpha, 0.3);
+  EXPECT_DOUBLE_EQ(c.beta, 0.7);
+  EXPECT_DOUBLE_EQ(c.time_scale, 10.0);
+  EXPECT_EQ(c.bind, "127.0.0.1");
+  EXPECT_EQ(c.ports_file, "p.json");
+}
+
+TEST(ServerConfigTest, FileKeysApplyAndFlagsWin) {
+  TempDir dir;
+  const std::string file = dir.File("dispatchd.json");
+  std::ofstream(file) << R"({"grpc_port": 7000, "http_port": 7001, "db": "file.db", "zeta": 50})";
+  auto parsed = Parse({"--config", file, "--http-port", "9000"});
+  ASSERT_TRUE(parsed.ok()) << parsed.error().message;
+  EXPECT_EQ(parsed->config.grpc_port, 7000);
+  EXPECT_EQ(parsed->config.http_port, 9000);
+  EXPECT_EQ(parsed->config.db, "file.db");
+  EXPECT_DOUBLE_EQ(parsed->config.zeta, 50.0);
+  EXPECT_EQ(parsed->config.strategy, "auction");
+}
+
+TEST(ServerConfigTest, BadValuesAreNamed) {
+  TempDir dir;
+  const std::string file = dir.File("bad.json");
+  std::ofstream(file) << R"({"grpc_prot": 1})";
+  auto unknown_key = Parse({"--config", file});
+  ASSERT_FALSE(unknown_key.ok());
+  EXPECT_NE(unknown_key.error().message.find("grpc_prot"), std::string::npos);
+  auto strategy = Parse({"--strategy", "random"});
+  ASSERT_FALSE(strategy.ok());
+  EXPECT_NE(strategy.error().message.find("random"), std::string::npos);
+  auto port = Parse({"--grpc-port", "70000"});
+  ASSERT_FALSE(port.ok());
+  EXPECT_NE(port.error().message.find("grpc_port"), std::string::npos);
+  auto scale = Parse({"--time-scale", "0"});
+  ASSERT_FALSE(scale.ok());
+  EXPECT_NE(scale.error().message.find("time_scale"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace dispatch::server::testing

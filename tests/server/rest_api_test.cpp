@@ -1,0 +1,155 @@
+// REST basics through httplib::Client against an in-process server on 127.0.0.1.
+// httplib.h comes after every header that pulls in Eigen (see STYLE.md on `_res`).
+#include "tests/server/test_support.h"
+
+#include <httplib.h>
+#include <nlohmann/json.hpp>
+
+namespace dispatch::server::testing {
+namespace {
+
+using nlohmann::json;
+
+class RestApiTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    auto started = DispatchServer::Start(TestConfig(dir_.File("rest.db")));
+    ASSERT_TRUE(started.ok()) << started.error().message;
+    server_ = std::move(started).value();
+    client_ = std::make_unique<httplib::Client>("127.0.0.1", server_->ports().http);
+    client_->set_read_timeout(10, 0);
+  }
+
+  json Body(const httplib::Result& r) {
+    EXPECT_TRUE(r) << "no HTTP response";
+    if (!r) return json();
+    EXPECT_EQ(r->get_header_value("Content-Type"), "application/json");
+    return json::parse(r->body);
+  }
+
+  TempDir dir_;
+  std::unique_ptr<DispatchServer> server_;
+  std::unique_ptr<httplib::Client> client_;
+};
+
+TEST_F(RestApiTest, HealthReadyAndStatus) {
+  auto health = client_->Get("/healthz");
+  ASSERT_TRUE(health);
+  EXPECT_EQ(health->status, 200);
+  auto ready = client_->Get("/readyz");
+  ASSERT_TRUE(ready);
+  EXPECT_EQ(ready->status, 200);
+  EXPECT_TRUE(Body(ready)["ready"].get<bool>());
+  auto status = client_->Get("/api/v1/status");
+  ASSERT_TRUE(status);
+  const json s = Body(status);
+  EXPECT_EQ(s["map"], "chu2024");
+  EXPECT_EQ(s["strategy"], "auction");
+  EXPECT_EQ(s["orders"]["accepted"], 0);
+}
+
+TEST_F(RestApiTest, OrdersThroughJson) {
+  const std::string order = R"({"client_order_id": "rest-1", "picks": ["K3-2-3N"], "drop": "D-B2"})";
+  auto created = client_->Post("/api/v1/orders", order, "application/json");
+  ASSERT_TRUE(created);
+  EXPECT_EQ(created->status, 201) << created->body;
+  const json c = Body(created);
+  const std::string id = c["id"];
+  EXPECT_EQ(c["client_id"], "rest-1");
+  EXPECT_EQ(c["state"], "accepted");
+  EXPECT_TRUE(c["robots"].is_array());
+
+  auto repeat = client_->Post("/api/v1/orders", order, "application/json");
+  ASSERT_TRUE(repeat);
+  EXPECT_EQ(repeat->status, 200);
+  EXPECT_EQ(Body(repeat)["id"], id);
+  EXPECT_FALSE(Body(repeat)["created"].get<bool>());
+
+  auto conflict = client_->Post("/api/v1/orders",
+                                R"({"client_order_id": "rest-1", "picks": ["K3-2-3N"], "drop": "D-B1"})",
+                                "application/json");
+  ASSERT_TRUE(conflict);
+  EXPECT_EQ(conflict->status, 409);
+  EXPECT_NE(Body(conflict)["error"].get<std::string>().find(id), std::string::npos);
+
+  auto coords = client_->Post(
+      "/api/v1/orders", R"({"client_order_id": "rest-2", "picks": [{"x": 4, "y": 5}], "drop": "D-B1"})",
+      "application/json");
+  ASSERT_TRUE(coords);
+  EXPECT_EQ(coords->status, 201) << coords->body;
+  EXPECT_EQ(Body(coords)["picks"][0]["name"], "K1-1-1N");
+
+  auto list = client_->Get("/api/v1/orders");
+  ASSERT_TRUE(list);
+  const json l = Body(list);
+  ASSERT_EQ(l["orders"].size(), 2u);
+  EXPECT_EQ(l["orders"][0]["id"], id);
+  EXPECT_EQ(l["orders"][0]["state"], "accepted");
+
+  auto one = client_->Get("/api/v1/orders/" + id);
+  ASSERT_TRUE(one);
+  EXPECT_EQ(one->status, 200);
+  EXPECT_TRUE(Body(one).contains("allocation"));
+
+  auto cancelled = client_->Delete("/api/v1/orders/" + id);
+  ASSERT_TRUE(cancelled);
+  EXPECT_EQ(cancelled->status, 200);
+  EXPECT_EQ(Body(cancelled)["state"], "cancelled");
+
+  auto filtered = client_->Get("/api/v1/orders?state=cancelled");
+  ASSERT_TRUE(filtered);
+  ASSERT_EQ(Body(filtered)["orders"].size(), 1u);
+  EXPECT_EQ(Body(filtered)["orders"][0]["id"], id);
+  auto accepted = client_->Get("/api/v1/orders?state=accepted");
+  ASSERT_TRUE(accepted);
+  EXPECT_EQ(Body(accepted)["orders"].size(), 1u);
+}
+
+TEST_F(RestApiTest, ErrorsAreJsonWithAReason) {
+  struct Case {
+    httplib::Result result;
+    int status;
+  };
+  std::vector<Case> cases;
+  cases.push_back({client_->Post("/api/v1/orders", "{not json", "application/json"), 400});
+  cases.push_back({client_->Post("/api/v1/orders", R"({"client_order_id": "x", "picks": ["NOPE"], "drop": "D-B1"})",
+                                 "application/json"),
+                   400});
+  cases.push_back({client_->Post("/api/v1/orders", R"({"picks": ["K3-2-3N"], "drop": "D-B1"})", "application/json"), 400});
+  cases.push_back({client_->Get("/api/v1/orders/ord-424242"), 404});
+  cases.push_back({client_->Delete("/api/v1/orders/ord-424242"), 404});
+  cases.push_back({client_->Get("/api/v1/orders?state=sleeping"), 400});
+  cases.push_back({client_->Get("/api/v1/robots/R99"), 404});
+  cases.push_back({client_->Get("/api/v1/nothing-here"), 404});
+  for (auto& c : cases) {
+    ASSERT_TRUE(c.result);
+    EXPECT_EQ(c.result->status, c.status) << c.result->body;
+    const json body = json::parse(c.result->body);
+    ASSERT_TRUE(body.contains("error")) << c.result->body;
+    EXPECT_FALSE(body["error"].get<std::string>().empty());
+  }
+}
+
+TEST_F(RestApiTest, RobotsAppearWhenTheyConnect) {
+  auto empty = client_->Get("/api/v1/robots");
+  ASSERT_TRUE(empty);
+  EXPECT_TRUE(Body(empty)["robots"].empty());
+  auto channel = ChannelTo(*server_);
+  FakeRobot robot(channel, "R7");
+  robot.Connect(3.875, -1.25);
+  ASSERT_TRUE(robot.WaitFor(pb::ServerMessage::kWelcome));
+  // The loop sends the Welcome only after publishing the snapshot that holds the robot.
+  auto got = client_->Get("/api/v1/robots/R7");
+  ASSERT_TRUE(got);
+  ASSERT_EQ(got->status, 200) << got->body;
+  const json r = Body(got);
+  EXPECT_EQ(r["id"], "R7");
+  EXPECT_TRUE(r["connected"].get<bool>());
+  EXPECT_EQ(r["point"]["name"], "park-P1");
+  auto all = client_->Get("/api/v1/robots");
+  ASSERT_TRUE(all);
+  EXPECT_EQ(Body(all)["robots"].size(), 1u);
+}
+
+}  // namespace
+}  // namespace dispatch::server::testing
