@@ -118,6 +118,7 @@ engine::Result<std::unique_ptr<DispatchServer>> DispatchServer::Start(const Serv
   spdlog::info("listening: gRPC {}:{}, HTTP {}:{}", config.bind, grpc_port, config.bind, http_port);
   if (!config.ports_file.empty()) {
     if (auto written = WritePortsFile(config.ports_file, s->ports_); !written.ok()) return written.error();
+    spdlog::info("ports written to {}", config.ports_file);
   }
   return s;
 }
