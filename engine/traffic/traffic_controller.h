@@ -1,0 +1,153 @@
+// TrafficController: the online, reservation-based local traffic layer (SPEC §3.5; Chu2024
+// §3.3 crossing rule; Wang2019 §3.2 node control and §3.3 head-on conflicts), driven only by
+// what robots report (which point they stand at, which arc they drive) and the time. The same
+// object runs inside the order-stream simulator and, later, the server's dispatcher loop.
+//
+// Resources and rules (a robot may depart from point p to the next point q of its route only
+// when Request() says kGo; it then holds q until it leaves it):
+//  - Points: each point is held by at most one robot (the one standing there, or driving
+//    towards it, or driving away from it until it is point_clearance past it: LeftPoint). A point is free only when no OTHER robot holds it or any point closer than
+//    `point_clearance` to it (Chu2024 eps1; e.g. a pick dock 0.5 m off a lane point).
+//    Robots of equal speed then never get closer than the point spacing (>= eps1).
+//  - Intersections (Chu2024 eqs. (13)-(15)): entering the inner region I_w needs a grant for
+//    the movement (point before, point after) from IntersectionGrants (FIFO, exclusive
+//    between different movements); released when the robot arrives past I_w.
+//  - Single-lane corridors (Wang2019 §3.3, LaneCorridors): reserved for one direction at a
+//    time, from the point BEFORE the corridor's end point (look-ahead of one arc), so a robot
+//    waiting to enter never stands on the corridor's end that an oncoming robot must leave by.
+//    A corridor with a service point inside (robots stop and may turn back there) takes one
+//    robot at a time; pure transit corridors take any number in one direction.
+//    A robot that meets a corridor held the other way (a head-on conflict) compares the
+//    expected wait (the oncoming robots' time to leave it) with the extra time of a detour
+//    avoiding it and takes the faster (HeadOnPolicy::kChooseFaster); the decision is logged.
+//  - Waits (Wang2019 §3.2 steps 3-4): waiting on a corridor longer than T_w1, or on a held
+//    point / grant longer than T_w2, re-plans a detour if one exists; a robot that has waited
+//    `blocked_after` with no alternative is reported blocked (kBlocked, with the reason).
+//  - Priority: a robot that works (picks/drops: SetWorking) is never asked to yield; among
+//    the others loaded robots (SetLoaded) come before empty ones, then lower index.
+//  - Deadlock (ResolveDeadlocks): the wait-for graph has an edge from every waiting robot to
+//    one robot it waits for (point holder, oncoming corridor holder, or grant holder); each
+//    node has out-degree <= 1, so cycles are found in O(robots). In each cycle the lowest-
+//    priority member that can act re-plans a detour avoiding what it waits for, or backs off
+//    to a free neighbouring point and re-plans from there. An idle robot (no route) that
+//    somebody waits for is sent to a siding off the waiter's route (StepAside, "nudge").
+//
+// Costs: Request/Arrived are O(route look-ahead + clearance neighbours); ResolveDeadlocks is
+// O(robots); detours run one Dijkstra over the map (reused buffers). No all-pairs work.
+// Deterministic. Not thread-safe: one owner (the simulator or the dispatcher loop).
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "engine/common/result.h"
+#include "engine/map/warehouse_map.h"
+#include "engine/traffic/intersection_grants.h"
+#include "engine/traffic/lane_corridors.h"
+
+namespace dispatch::engine {
+
+enum class HeadOnPolicy {
+  kChooseFaster,  // Wang2019 §3.3: wait or re-plan, whichever is expected faster
+  kAlwaysWait,    // the paper's "single waiting strategy" (for comparison, §4.3)
+  kAlwaysReplan,  // always detour when a detour exists
+};
+
+// Defaults: Wang2019 names T_w1 / T_w2 but gives no values. T_w1 = 10 s is about the time a
+// robot needs to drive a 10-cell aisle at 1 m/s; T_w2 = 20 s is longer than a pick (5 s) plus
+// clearing the next cells, so queues behind a working robot do not re-plan needlessly.
+// blocked_after = 120 s: like SimConfig::max_wait of the plan simulator.
+struct TrafficControllerConfig {
+  double speed = 1.0;            // m/s, robots' cruise speed (arc max_speed caps it)
+  double point_clearance = 0.6;  // m: points closer than this conflict (eps1)
+  double t_w1 = 10.0;            // s: corridor (head-on) wait before re-planning
+  double t_w2 = 20.0;            // s: held point / grant wait before re-planning
+  double blocked_after = 120.0;  // s of waiting with no alternative -> blocked
+  bool intersection_grants = true;
+  HeadOnPolicy head_on = HeadOnPolicy::kChooseFaster;
+  Status Validate() const;
+};
+
+enum class TrafficDecision { kGo, kWait, kReplanned, kBlocked };
+
+// One head-on decision (Wang2019 §3.3 / §4.3): who met whom, both estimates, the choice.
+struct HeadOnRecord {
+  double t = 0.0;
+  std::string robot, oncoming;
+  double wait_estimate = 0.0;   // s until the oncoming robots have left the corridor
+  double replan_extra = 0.0;    // s a detour adds (+inf: none)
+  bool replanned = false;
+};
+
+struct TrafficStats {
+  std::size_t replans = 0;             // detours taken (head-on, timeouts, deadlocks)
+  std::size_t grants = 0;              // intersection grants issued
+  std::size_t deadlocks_resolved = 0;  // wait-for cycles broken
+  std::size_t nudges = 0;              // idle robots stepped aside
+  std::size_t head_on_conflicts = 0;
+  std::vector<HeadOnRecord> head_on;   // first 1000 decisions
+};
+
+class TrafficController {
+ public:
+  static Result<TrafficController> Create(std::shared_ptr<const WarehouseMap> map,
+                                          const TrafficControllerConfig& config = {});
+  TrafficController(TrafficController&&) noexcept;
+  TrafficController& operator=(TrafficController&&) noexcept;
+  ~TrafficController();
+
+  // Places a robot standing at `at` (which it holds). Errors: unknown point, point held.
+  Result<std::size_t> AddRobot(const std::string& id, PointId at);
+  std::size_t robot_count() const;
+  const std::string& robot_id(std::size_t r) const;
+
+  // The robot's route from where it stands: points[0] must be its point, consecutive points
+  // joined by arcs. Withdraws pending grant requests. Errors: bad route.
+  Status SetRoute(std::size_t r, std::vector<PointId> points);
+  // Remaining route: the point it stands at (or drives to) and the rest.
+  std::vector<PointId> RemainingRoute(std::size_t r) const;
+  bool HasRoute(std::size_t r) const;  // some point is left to drive to
+  PointId At(std::size_t r) const;     // the point it stands at / last left
+  PointId Next(std::size_t r) const;   // the point it drives to, or kNoPoint while standing
+  // Working (picking/dropping) until `work_end` (s): top priority, never asked to yield; the
+  // remaining work counts in oncoming robots' wait estimates.
+  void SetWorking(std::size_t r, bool working, double work_end = 0.0);
+  void SetLoaded(std::size_t r, bool loaded);
+  // Idle: no work assigned. Only idle robots are nudged aside for others.
+  void SetIdle(std::size_t r, bool idle);
+
+  // The robot stands at At(r) and wants to drive to its next route point at time t.
+  // kGo: reservations taken, drive the arc (Next(r)) and call Arrived; kWait: stay (why() says
+  // why); kReplanned: the route changed, ask again; kBlocked: no alternative for too long.
+  TrafficDecision Request(std::size_t r, double t);
+  // The driving robot is at least point_clearance past At(r): releases that point, so a long
+  // arc does not keep the point behind it blocked until the robot arrives.
+  void LeftPoint(std::size_t r);
+  // The robot has reached Next(r): releases the point behind it, corridors and grants it left.
+  void Arrived(std::size_t r, double t);
+  // Removes the robot from the floor (fault, or it left): releases everything it holds.
+  void Remove(std::size_t r);
+  const std::string& why(std::size_t r) const;  // reason of the last kWait / kBlocked
+  // "R3 at 'c9' -> 'c8' route 'c9' 'c8' ... waiting on R4 (point 'c8' held by R4)".
+  std::string Describe(std::size_t r) const;
+
+  // Sends an idle robot (no route, not working) to the nearest free "siding": a point that is
+  // not a service point, not inside a corridor and not an intersection point, within 40 points
+  // (breadth-first). False when it already stands on one or none is found.
+  bool StepAside(std::size_t r);
+  // Breaks wait-for cycles and nudges idle robots that block others. Returns cycles broken.
+  std::size_t ResolveDeadlocks(double t);
+
+  const TrafficStats& stats() const;
+  const LaneCorridors& corridors() const;
+
+ private:
+  struct Impl;
+  explicit TrafficController(std::unique_ptr<Impl> impl);
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace dispatch::engine

@@ -1,0 +1,206 @@
+// TrafficController: point reservations, corridors (head-on), grants, deadlock breaking,
+// nudges and blocked robots, driven like the simulator drives it (positions and time only).
+#include "engine/traffic/traffic_controller.h"
+
+#include <gtest/gtest.h>
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "engine/io/movingai_map.h"
+#include "engine/map/map_builder.h"
+
+namespace dispatch::engine {
+namespace {
+
+std::shared_ptr<const WarehouseMap> Grid(const std::vector<std::string>& rows) {
+  std::string text = "type octile\nheight " + std::to_string(rows.size()) + "\nwidth " +
+                     std::to_string(rows[0].size()) + "\nmap\n";
+  for (const auto& r : rows) text += r + "\n";
+  auto map = ParseMovingAiMap(text, "grid");
+  if (!map.ok()) throw std::runtime_error(map.error().message);
+  return std::make_shared<const WarehouseMap>(std::move(map).value());
+}
+
+PointId P(const WarehouseMap& m, const std::string& name) { return *m.FindPoint(name); }
+
+std::vector<PointId> Route(const WarehouseMap& m, std::initializer_list<const char*> names) {
+  std::vector<PointId> out;
+  for (const char* n : names) out.push_back(P(m, n));
+  return out;
+}
+
+TrafficController Make(std::shared_ptr<const WarehouseMap> map, TrafficControllerConfig c = {}) {
+  auto ctl = TrafficController::Create(std::move(map), c);
+  if (!ctl.ok()) throw std::runtime_error(ctl.error().message);
+  return std::move(ctl).value();
+}
+
+// One "step" of an ideal driver: arcs take one step; standing robots with a route ask.
+void Step(TrafficController& ctl, double t) {
+  for (std::size_t r = 0; r < ctl.robot_count(); ++r) {
+    if (ctl.Next(r) != kNoPoint) {
+      ctl.Arrived(r, t);
+    } else if (ctl.HasRoute(r)) {
+      while (ctl.Request(r, t) == TrafficDecision::kReplanned) {
+      }
+    }
+  }
+  ctl.ResolveDeadlocks(t);
+}
+
+TEST(TrafficControllerTest, PointsAreExclusive) {
+  auto map = Grid({"....."});
+  TrafficController ctl = Make(map);
+  const std::size_t a = *ctl.AddRobot("A", P(*map, "c1"));
+  const std::size_t b = *ctl.AddRobot("B", P(*map, "c0"));
+  EXPECT_FALSE(ctl.AddRobot("C", P(*map, "c1")).ok());  // c1 is A's
+  ASSERT_TRUE(ctl.SetRoute(a, Route(*map, {"c1", "c2", "c3"})).ok());
+  ASSERT_TRUE(ctl.SetRoute(b, Route(*map, {"c0", "c1", "c2"})).ok());
+  EXPECT_EQ(ctl.Request(b, 0.0), TrafficDecision::kWait);
+  EXPECT_NE(ctl.why(b).find("held by A"), std::string::npos) << ctl.why(b);
+  EXPECT_EQ(ctl.Request(a, 0.0), TrafficDecision::kGo);
+  EXPECT_EQ(ctl.Next(a), P(*map, "c2"));
+  EXPECT_EQ(ctl.Request(b, 0.1), TrafficDecision::kWait);  // A still holds c1 while driving
+  ctl.Arrived(a, 1.0);
+  EXPECT_EQ(ctl.Request(b, 1.0), TrafficDecision::kGo);
+  // A route that does not start where the robot stands is refused.
+  EXPECT_FALSE(ctl.SetRoute(a, Route(*map, {"c3", "c4"})).ok());
+}
+
+TEST(TrafficControllerTest, HeadOnWithoutDetourWaitsAndIsLogged) {
+  auto map = Grid({"......"});
+  TrafficController ctl = Make(map);
+  const std::size_t a = *ctl.AddRobot("A", P(*map, "c0"));
+  const std::size_t b = *ctl.AddRobot("B", P(*map, "c5"));
+  ASSERT_TRUE(ctl.SetRoute(a, Route(*map, {"c0", "c1", "c2"})).ok());
+  ASSERT_TRUE(ctl.SetRoute(b, Route(*map, {"c5", "c4", "c3"})).ok());
+  EXPECT_EQ(ctl.Request(a, 0.0), TrafficDecision::kGo);  // A reserves the lane eastwards
+  EXPECT_EQ(ctl.Request(b, 0.0), TrafficDecision::kWait);
+  EXPECT_NE(ctl.why(b).find("head-on"), std::string::npos) << ctl.why(b);
+  ASSERT_EQ(ctl.stats().head_on.size(), 1u);
+  EXPECT_EQ(ctl.stats().head_on[0].robot, "B");
+  EXPECT_EQ(ctl.stats().head_on[0].oncoming, "A");
+  EXPECT_FALSE(ctl.stats().head_on[0].replanned);
+  EXPECT_GT(ctl.stats().head_on[0].wait_estimate, 0.0);
+  // A is done at c2 and leaves the corridor only when it leaves the map's lane: here it
+  // stays inside, so B keeps waiting; removing A frees the lane.
+  ctl.Arrived(a, 1.0);
+  EXPECT_EQ(ctl.Request(a, 1.0), TrafficDecision::kGo);
+  ctl.Arrived(a, 2.0);
+  EXPECT_EQ(ctl.Request(b, 2.0), TrafficDecision::kWait);
+  ctl.Remove(a);
+  EXPECT_EQ(ctl.Request(b, 3.0), TrafficDecision::kGo);
+}
+
+TEST(TrafficControllerTest, SwapOnOpenGridIsADeadlockThatGetsBroken) {
+  auto map = Grid({"...", "...", "..."});
+  TrafficController ctl = Make(map);
+  const std::size_t a = *ctl.AddRobot("A", P(*map, "c3"));
+  const std::size_t b = *ctl.AddRobot("B", P(*map, "c4"));
+  ASSERT_TRUE(ctl.SetRoute(a, Route(*map, {"c3", "c4", "c5"})).ok());
+  ASSERT_TRUE(ctl.SetRoute(b, Route(*map, {"c4", "c3"})).ok());
+  EXPECT_EQ(ctl.Request(a, 0.0), TrafficDecision::kWait);
+  EXPECT_EQ(ctl.Request(b, 0.0), TrafficDecision::kWait);
+  EXPECT_EQ(ctl.ResolveDeadlocks(0.0), 1u);
+  EXPECT_EQ(ctl.stats().deadlocks_resolved, 1u);
+  double t = 0;
+  for (int i = 0; i < 40 && (ctl.HasRoute(a) || ctl.HasRoute(b) || ctl.Next(a) != kNoPoint ||
+                             ctl.Next(b) != kNoPoint);
+       ++i) {
+    Step(ctl, t += 1.0);
+  }
+  EXPECT_EQ(ctl.At(a), P(*map, "c5"));
+  EXPECT_EQ(ctl.At(b), P(*map, "c3"));
+  EXPECT_GE(ctl.stats().replans, 1u);
+}
+
+TEST(TrafficControllerTest, IdleRobotInTheWayIsNudgedToASiding) {
+  auto map = Grid({".....", "@@.@@"});
+  TrafficController ctl = Make(map);
+  const std::size_t a = *ctl.AddRobot("A", P(*map, "c0"));
+  const std::size_t b = *ctl.AddRobot("B", P(*map, "c2"));  // idle, on A's way
+  ASSERT_TRUE(ctl.SetRoute(a, Route(*map, {"c0", "c1", "c2", "c3", "c4"})).ok());
+  double t = 0;
+  for (int i = 0; i < 30 && ctl.At(a) != P(*map, "c4"); ++i) Step(ctl, t += 1.0);
+  EXPECT_EQ(ctl.At(a), P(*map, "c4"));
+  EXPECT_EQ(ctl.At(b), P(*map, "c7"));  // the spur below c2
+  EXPECT_EQ(ctl.stats().nudges, 1u);
+  EXPECT_EQ(ctl.stats().deadlocks_resolved, 0u);
+}
+
+TEST(TrafficControllerTest, WorkingRobotIsNeverMovedAndAWaiterWithoutDetourIsBlocked) {
+  auto map = Grid({"...."});
+  TrafficControllerConfig config;
+  config.blocked_after = 30.0;
+  TrafficController ctl = Make(map, config);
+  const std::size_t w = *ctl.AddRobot("W", P(*map, "c2"));
+  ctl.SetWorking(w, true, 1e9);
+  ctl.SetIdle(w, false);
+  const std::size_t b = *ctl.AddRobot("B", P(*map, "c0"));
+  ASSERT_TRUE(ctl.SetRoute(b, Route(*map, {"c0", "c1", "c2", "c3"})).ok());
+  TrafficDecision last = TrafficDecision::kWait;
+  double t = 0;
+  for (int i = 0; i < 100 && last != TrafficDecision::kBlocked; ++i) {
+    t += 1.0;
+    if (ctl.Next(b) != kNoPoint) ctl.Arrived(b, t);
+    last = ctl.Request(b, t);
+    ctl.ResolveDeadlocks(t);
+  }
+  EXPECT_EQ(last, TrafficDecision::kBlocked);
+  EXPECT_LE(t, 35.0);
+  EXPECT_NE(ctl.why(b).find("no alternative"), std::string::npos) << ctl.why(b);
+  EXPECT_NE(ctl.why(b).find("held by W"), std::string::npos) << ctl.why(b);
+  EXPECT_EQ(ctl.At(w), P(*map, "c2"));
+}
+
+TEST(TrafficControllerTest, IntersectionNeedsAGrantAndReleasesItBehind) {
+  MapBuilder b("cross");
+  b.SetFloor({-1, -1}, {11, 11});
+  b.AddRectZone("z", {-1, -1}, {11, 11});
+  b.AddPoint("W", {2, 5}, PointKind::kLane);
+  b.AddPoint("C1", {5, 5}, PointKind::kIntersection);
+  b.AddPoint("C2", {6, 5}, PointKind::kIntersection);
+  b.AddPoint("E", {9, 5}, PointKind::kLane);
+  b.AddPoint("S", {6, 2}, PointKind::kLane);
+  b.AddPoint("N", {6, 9}, PointKind::kLane);
+  b.AddPath("W", "C1");
+  b.AddPath("C1", "C2");
+  b.AddPath("C2", "E");
+  b.AddPath("S", "C2");
+  b.AddPath("C2", "N");
+  b.AddIntersection("X", {"C1", "C2"}, {"W", "S"});
+  MapBuildOptions options;
+  options.check_service_connectivity = false;
+  auto built = b.Build(options);
+  ASSERT_TRUE(built.ok()) << built.error().message;
+  auto map = std::make_shared<const WarehouseMap>(std::move(built).value());
+  TrafficController ctl = Make(map);
+  const std::size_t a = *ctl.AddRobot("A", P(*map, "W"));
+  const std::size_t c = *ctl.AddRobot("B", P(*map, "S"));
+  ASSERT_TRUE(ctl.SetRoute(a, Route(*map, {"W", "C1", "C2", "E"})).ok());
+  ASSERT_TRUE(ctl.SetRoute(c, Route(*map, {"S", "C2", "N"})).ok());
+  EXPECT_EQ(ctl.Request(a, 0.0), TrafficDecision::kGo);  // grant W -> E
+  ctl.Arrived(a, 1.0);                                   // A in I_w at C1; C2 is free
+  EXPECT_EQ(ctl.Request(c, 1.0), TrafficDecision::kWait);  // crossing movement: no grant
+  EXPECT_NE(ctl.why(c).find("grant"), std::string::npos) << ctl.why(c);
+  EXPECT_EQ(ctl.Request(a, 1.0), TrafficDecision::kGo);
+  ctl.Arrived(a, 2.0);
+  EXPECT_EQ(ctl.Request(a, 2.0), TrafficDecision::kGo);
+  EXPECT_EQ(ctl.Request(c, 2.0), TrafficDecision::kWait);  // A still inside (drives to E)
+  ctl.Arrived(a, 3.0);                                     // A has left I_w
+  EXPECT_EQ(ctl.Request(c, 3.0), TrafficDecision::kGo);
+  EXPECT_EQ(ctl.stats().grants, 2u);
+}
+
+TEST(TrafficControllerTest, RejectsBadConfig) {
+  auto map = Grid({".."});
+  TrafficControllerConfig c;
+  c.t_w1 = 0;
+  EXPECT_FALSE(TrafficController::Create(map, c).ok());
+  EXPECT_FALSE(TrafficController::Create(nullptr, {}).ok());
+}
+
+}  // namespace
+}  // namespace dispatch::engine
