@@ -1,11 +1,21 @@
-// dispatch-sim: allocate a task table with the auction on the Chu2024 floor (R1..R18 at their
-// stations), simulate the plans with traffic rules off and/or on, and print per-order
-// completion times, makespan and the minimum pairwise robot distance (seed 000 Fig. 8).
-//   dispatch-sim --table ../shared/scenarios/chu2024-table1.csv --rules both --csv fig8.csv
+// dispatch-sim: the offline simulators (SPEC §3.8, issue 4).
+//   dispatch-sim plan --table ../shared/scenarios/chu2024-table1.csv --rules both --csv fig8.csv
+//       allocate a task table with the auction on the Chu2024 floor (R1..R18), execute the
+//       timed plans with the Chu2024 rules off and/or on (seed 000 Fig. 8, Tables 3-4).
+//   dispatch-sim stream --map chu2024 --robots 18 (--orders FILE | --random 200 --seed 1)
+//       [--strategy auction|greedy] [--zeta 100] [--csv series.csv] [--orders-csv out.csv]
+//       an order stream with release times under the online traffic controller.
+//   dispatch-sim compare [--random 200 --seed 1 --robots 18 --map chu2024]
+//       auction zeta=100, auction zeta=0 and greedy on one random stream (issue 4 §4).
+//   dispatch-sim headon
+//       seed 004 §4.3: a head-on conflict resolved by waiting vs. re-planning.
 #include <CLI/CLI.hpp>
 
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
+#include <tuple>
+#include <utility>
 #include <fstream>
 #include <iostream>
 #include <memory>
@@ -16,6 +26,10 @@
 #include "engine/cli/map_source.h"
 #include "engine/cli/scenario.h"
 #include "engine/routing/route_table.h"
+#include "engine/sim/fleet_placement.h"
+#include "engine/sim/head_on_scenario.h"
+#include "engine/sim/order_stream.h"
+#include "engine/sim/random_orders.h"
 #include "engine/sim/simulator.h"
 #include "engine/traffic/safety_check.h"
 
@@ -52,21 +66,19 @@ void Print(const char* label, const SimResult& r, const SafetyReport& safety) {
   }
 }
 
-int Main(int argc, char** argv) {
-  CLI::App app{"Simulate a task table on the Chu2024 floor (seed 000 Fig. 8)"};
+struct PlanArgs {
   std::string table, rules = "both", csv;
   double zeta = 100.0;
-  AllocationConfig config;
   SimConfig sim;
-  app.add_option("--table", table, "Task table CSV (seed format)")->required();
-  app.add_option("--zeta", zeta, "Traffic weight of the auction (eq. 5)")->capture_default_str();
-  app.add_option("--rules", rules, "Traffic rules: on, off or both")->capture_default_str()
-      ->check(CLI::IsMember({"on", "off", "both"}));
-  app.add_option("--csv", csv, "Write t,min_distance_off,min_distance_on here");
-  app.add_option("--dt", sim.time_step, "Time step, s")->capture_default_str()
-      ->check(CLI::PositiveNumber);
-  CLI11_PARSE(app, argc, argv);
+};
 
+int RunPlan(const PlanArgs& args) {
+  const std::string& table = args.table;
+  const std::string& rules = args.rules;
+  const std::string& csv = args.csv;
+  const double zeta = args.zeta;
+  const SimConfig& sim = args.sim;
+  AllocationConfig config;
   auto loaded = LoadMapSource("chu2024");
   if (!loaded.ok()) return Fail(loaded.error().message);
   auto map = std::make_shared<const WarehouseMap>(std::move(loaded).value());
@@ -125,6 +137,197 @@ int Main(int argc, char** argv) {
     }
   }
   return failed == 0 ? 0 : 2;
+}
+
+struct StreamArgs {
+  std::string map = "chu2024", orders, csv, orders_csv, strategy = "auction";
+  std::size_t robots = 18, random = 0;
+  std::uint64_t seed = 1;
+  double interval = 2.0, zeta = 100.0, dt = 0.1, max_time = 36000.0;
+};
+
+struct Setup {
+  std::shared_ptr<const WarehouseMap> map;
+  std::shared_ptr<const RouteTable> routes;
+  std::vector<FleetRobot> robots;
+  std::vector<Order> orders;
+};
+
+Result<Setup> Prepare(const StreamArgs& a) {
+  Setup s;
+  auto loaded = LoadMapSource(a.map);
+  if (!loaded.ok()) return loaded.error();
+  s.map = std::make_shared<const WarehouseMap>(std::move(loaded).value());
+  auto routes = MakeRouteTable(s.map, {});
+  if (!routes.ok()) return routes.error();
+  s.routes = std::move(routes).value();
+  auto robots = PlaceRobots(*s.map, a.robots);
+  if (!robots.ok()) return robots.error();
+  s.robots = std::move(robots).value();
+  if (!a.orders.empty()) {
+    auto orders = LoadTaskTableOrders(*s.map, a.orders);
+    if (!orders.ok()) return orders.error();
+    s.orders = std::move(orders).value();
+  } else {
+    RandomOrderOptions ro;
+    ro.count = a.random;
+    ro.seed = a.seed;
+    ro.interval = a.interval;
+    auto orders = RandomOrders(*s.map, ro);
+    if (!orders.ok()) return orders.error();
+    s.orders = std::move(orders).value();
+  }
+  return s;
+}
+
+StreamConfig ConfigOf(const StreamArgs& a, const std::string& strategy, double zeta) {
+  StreamConfig c;
+  c.time_step = a.dt;
+  c.max_time = a.max_time;
+  c.strategy = strategy == "greedy" ? AllocationStrategy::kGreedy : AllocationStrategy::kAuction;
+  c.allocation.zeta = zeta;
+  return c;
+}
+
+void PrintSummary(const std::string& label, const StreamResult& r) {
+  std::printf("%s: %zu/%zu orders completed, makespan %.1f s, throughput %.1f orders/h, "
+              "mean completion %.1f s\n",
+              label.c_str(), r.completed, r.orders.size(), r.makespan, r.throughput_per_hour,
+              r.mean_completion);
+  std::printf("  distance %.1f m, waiting %.1f s, stops %zu, re-plans %zu, grants %zu, "
+              "deadlocks resolved %zu, nudges %zu, head-on %zu, min distance %.3f m\n",
+              r.total_distance, r.total_waiting_time, r.stops, r.traffic.replans,
+              r.traffic.grants, r.traffic.deadlocks_resolved, r.traffic.nudges,
+              r.traffic.head_on_conflicts, r.overall_min_distance);
+  for (std::size_t i = 0; i < r.blocked.size() && i < 5; ++i) {
+    std::printf("  blocked: %s\n", r.blocked[i].c_str());
+  }
+  std::size_t shown = 0;
+  for (const StreamOrderOutcome& o : r.orders) {
+    if (o.completed || shown++ >= 5) continue;
+    std::printf("  %s failed: %s\n", o.order_id.c_str(), o.failure.c_str());
+  }
+}
+
+int RunStream(const StreamArgs& a) {
+  if (a.orders.empty() && a.random == 0) return Fail("stream: give --orders FILE or --random N");
+  auto setup = Prepare(a);
+  if (!setup.ok()) return Fail(setup.error().message);
+  auto r = SimulateOrderStream(setup->map, setup->routes, setup->robots, setup->orders,
+                               ConfigOf(a, a.strategy, a.zeta));
+  if (!r.ok()) return Fail(r.error().message);
+  char label[128];
+  std::snprintf(label, sizeof label, "%s on %s, %zu robots, %s (zeta %g)",
+                a.orders.empty() ? "random stream" : a.orders.c_str(), a.map.c_str(),
+                setup->robots.size(), a.strategy.c_str(), a.zeta);
+  PrintSummary(label, *r);
+  if (!a.orders_csv.empty()) {
+    std::ofstream out(a.orders_csv);
+    if (!out) return Fail("cannot write " + a.orders_csv);
+    out << "order,robot,release,completion,completed,failure\n";
+    for (const StreamOrderOutcome& o : r->orders) {
+      out << o.order_id << ',' << o.robot << ',' << o.release_time << ',';
+      if (o.completed) out << o.completion_time;
+      out << ',' << (o.completed ? 1 : 0) << ",\"" << o.failure << "\"\n";
+    }
+  }
+  if (!a.csv.empty()) {
+    std::ofstream out(a.csv);
+    if (!out) return Fail("cannot write " + a.csv);
+    out << "t,min_distance\n";
+    for (std::size_t i = 0; i < r->times.size(); ++i) {
+      out << r->times[i] << ',';
+      if (std::isfinite(r->min_distance[i])) out << r->min_distance[i];
+      out << '\n';
+    }
+  }
+  return r->all_completed() ? 0 : 2;
+}
+
+int RunCompare(StreamArgs a) {
+  if (a.orders.empty() && a.random == 0) a.random = 200;
+  auto setup = Prepare(a);
+  if (!setup.ok()) return Fail(setup.error().message);
+  std::printf("%zu orders (%s), %zu robots on %s, dt %g s\n", setup->orders.size(),
+              a.orders.empty() ? ("random, seed " + std::to_string(a.seed)).c_str()
+                               : a.orders.c_str(),
+              setup->robots.size(), a.map.c_str(), a.dt);
+  std::printf("%-18s %9s %10s %12s %10s %10s %9s %8s %9s\n", "strategy", "completed",
+              "makespan", "throughput/h", "mean compl", "waiting s", "distance", "replans",
+              "deadlocks");
+  int rc = 0;
+  for (auto [name, strategy, zeta] : {std::tuple{"auction zeta=100", "auction", 100.0},
+                                      std::tuple{"auction zeta=0", "auction", 0.0},
+                                      std::tuple{"greedy", "greedy", 0.0}}) {
+    StreamConfig c = ConfigOf(a, strategy, zeta);
+    c.record_series = false;
+    auto r = SimulateOrderStream(setup->map, setup->routes, setup->robots, setup->orders, c);
+    if (!r.ok()) return Fail(r.error().message);
+    std::printf("%-18s %5zu/%-3zu %10.1f %12.1f %10.1f %10.1f %9.1f %8zu %9zu\n", name,
+                r->completed, r->orders.size(), r->makespan, r->throughput_per_hour,
+                r->mean_completion, r->total_waiting_time, r->total_distance,
+                r->traffic.replans, r->traffic.deadlocks_resolved);
+    if (!r->all_completed()) rc = 2;
+  }
+  return rc;
+}
+
+int RunHeadOn() {
+  std::printf("Seed 004 §4.3: head-on on a single lane, h2 (lower priority) meets h1\n");
+  std::printf("%-10s %-14s %10s %10s %10s  %s\n", "h1 work", "policy", "h2 time", "wait est",
+              "detour +", "decision");
+  for (double work : {30.0, 5.0}) {
+    auto c = RunHeadOnComparison(work);
+    if (!c.ok()) return Fail(c.error().message);
+    for (auto [name, run] : {std::pair{"wait only", &c->wait}, std::pair{"re-plan", &c->replan},
+                             std::pair{"controller", &c->chosen}}) {
+      std::printf("%-10.0f %-14s %9.1fs %9.1fs %9.1fs  %s\n", work, name, run->h2_time,
+                  run->wait_estimate, run->replan_extra, run->replanned ? "re-plan" : "wait");
+    }
+  }
+  return 0;
+}
+
+int Main(int argc, char** argv) {
+  CLI::App app{"Offline simulators: timed plans (Chu2024) and order streams"};
+  app.require_subcommand(1);
+  PlanArgs plan;
+  auto* p = app.add_subcommand("plan", "Task table -> auction -> timed plans under the Chu2024 rules");
+  p->add_option("--table", plan.table, "Task table CSV (seed format)")->required();
+  p->add_option("--zeta", plan.zeta, "Traffic weight of the auction (eq. 5)")->capture_default_str();
+  p->add_option("--rules", plan.rules, "Traffic rules: on, off or both")->capture_default_str()
+      ->check(CLI::IsMember({"on", "off", "both"}));
+  p->add_option("--csv", plan.csv, "Write t,min_distance_off,min_distance_on here");
+  p->add_option("--dt", plan.sim.time_step, "Time step, s")->capture_default_str()
+      ->check(CLI::PositiveNumber);
+  StreamArgs stream;
+  auto add_stream = [](CLI::App* c, StreamArgs& a) {
+    c->add_option("--map", a.map, "chu2024, a JSON map file or a MovingAI .map")->capture_default_str();
+    c->add_option("--robots", a.robots, "Robots (stations first, then lane points)")->capture_default_str();
+    c->add_option("--orders", a.orders, "Task table CSV (optional release column)");
+    c->add_option("--random", a.random, "Random orders instead of a table");
+    c->add_option("--seed", a.seed, "Seed of the random orders")->capture_default_str();
+    c->add_option("--interval", a.interval, "Mean seconds between random releases")->capture_default_str();
+    c->add_option("--dt", a.dt, "Time step, s")->capture_default_str()->check(CLI::PositiveNumber);
+    c->add_option("--max-time", a.max_time, "Simulated seconds before giving up")->capture_default_str();
+  };
+  auto* s = app.add_subcommand("stream", "Order stream under the online traffic controller");
+  add_stream(s, stream);
+  s->add_option("--strategy", stream.strategy, "auction or greedy")->capture_default_str()
+      ->check(CLI::IsMember({"auction", "greedy"}));
+  s->add_option("--zeta", stream.zeta, "Traffic weight of the auction")->capture_default_str();
+  s->add_option("--csv", stream.csv, "Write t,min_distance here");
+  s->add_option("--orders-csv", stream.orders_csv, "Write per-order results here");
+  StreamArgs compare;
+  auto* c = app.add_subcommand("compare", "Auction zeta=100 / zeta=0 / greedy on one stream");
+  add_stream(c, compare);
+  auto* h = app.add_subcommand("headon", "Seed 004 §4.3: wait vs. re-plan on a head-on conflict");
+  CLI11_PARSE(app, argc, argv);
+  if (*p) return RunPlan(plan);
+  if (*s) return RunStream(stream);
+  if (*c) return RunCompare(compare);
+  if (*h) return RunHeadOn();
+  return 1;
 }
 
 }  // namespace

@@ -1,0 +1,110 @@
+#include "engine/sim/head_on_scenario.h"
+
+#include <memory>
+
+#include "engine/map/map_builder.h"
+#include "engine/routing/route_table.h"
+
+namespace dispatch::engine {
+namespace {
+
+Result<WarehouseMap> HeadOnFloor() {
+  MapBuilder b("wang2019-head-on");
+  b.SetFloor({0, -1}, {18, 11});
+  b.AddRectZone("z", {0, -1}, {18, 11});
+  b.AddPoint("S1", {14, 0}, PointKind::kPark);
+  b.AddPoint("B", {14, 2}, PointKind::kLane);
+  for (int y = 3; y <= 7; ++y) {
+    b.AddPoint("c" + std::to_string(y), {14, y}, y == 5 ? PointKind::kPick : PointKind::kLane);
+  }
+  b.AddPoint("T", {14, 8}, PointKind::kLane);
+  b.AddPoint("U", {14, 10}, PointKind::kPick);
+  b.AddPoint("V", {16, 8}, PointKind::kDrop);
+  b.AddPoint("X", {16, 2}, PointKind::kDrop);
+  b.AddPoint("D1", {7, 2}, PointKind::kLane);
+  b.AddPoint("D2", {7, 8}, PointKind::kLane);
+  auto lane = [&](const char* f, const char* t, std::optional<double> len = std::nullopt) {
+    b.AddPath(f, t, len, 0.0, true);
+  };
+  lane("S1", "B");
+  lane("B", "c3");
+  lane("c3", "c4");
+  lane("c4", "c5");
+  lane("c5", "c6");
+  lane("c6", "c7");
+  lane("c7", "T");
+  lane("T", "U");
+  lane("T", "V");
+  lane("B", "X");
+  lane("B", "D1");
+  lane("D1", "D2");
+  lane("D2", "T");
+  MapBuildOptions options;
+  options.check_service_connectivity = false;
+  return b.Build(options);
+}
+
+Result<HeadOnRun> RunOnce(std::shared_ptr<const WarehouseMap> map,
+                          std::shared_ptr<const RouteTable> routes, double h1_work,
+                          HeadOnPolicy policy) {
+  const WarehouseMap& m = *map;
+  std::vector<FleetRobot> robots{{"h1", *m.FindPoint("S1"), 0.0}, {"h2", *m.FindPoint("U"), 0.0}};
+  Order o1;
+  o1.id = "O1";
+  o1.picks = {*m.FindPoint("c5")};
+  o1.drop = *m.FindPoint("V");
+  o1.work_time = h1_work;
+  o1.release_time = 0.0;
+  Order o2;
+  o2.id = "O2";
+  o2.picks = {*m.FindPoint("U")};
+  o2.drop = *m.FindPoint("X");
+  o2.work_time = 1.0;
+  o2.release_time = 10.0;
+  o2.created_time = 10.0;
+  StreamConfig config;
+  config.strategy = AllocationStrategy::kPreassigned;
+  config.preassigned = {{"O1", "h1"}, {"O2", "h2"}};
+  config.traffic.head_on = policy;
+  config.traffic.t_w1 = 1000.0;  // the policies alone decide
+  config.return_home = false;
+  config.idle_step_aside = false;  // h2 waits at U for its release
+  config.max_time = 600.0;
+  auto r = SimulateOrderStream(map, routes, robots, {o1, o2}, config);
+  if (!r.ok()) return r.error();
+  if (!r->all_completed()) return InvalidArgument("head-on scenario: an order did not complete");
+  HeadOnRun run;
+  run.h1_time = r->orders[0].completion_time - r->orders[0].release_time;
+  run.h2_time = r->orders[1].completion_time - r->orders[1].release_time;
+  for (const HeadOnRecord& rec : r->traffic.head_on) {
+    if (rec.robot != "h2") continue;
+    run.replanned = rec.replanned;
+    run.wait_estimate = rec.wait_estimate;
+    run.replan_extra = rec.replan_extra;
+    break;
+  }
+  return run;
+}
+
+}  // namespace
+
+Result<HeadOnComparison> RunHeadOnComparison(double h1_work) {
+  auto built = HeadOnFloor();
+  if (!built.ok()) return built.error();
+  auto map = std::make_shared<const WarehouseMap>(std::move(built).value());
+  auto table = MakeRouteTable(map, {});
+  if (!table.ok()) return table.error();
+  std::shared_ptr<const RouteTable> routes = std::move(table).value();
+  HeadOnComparison out;
+  out.h1_work = h1_work;
+  for (auto [policy, slot] : {std::pair{HeadOnPolicy::kAlwaysWait, &out.wait},
+                              std::pair{HeadOnPolicy::kAlwaysReplan, &out.replan},
+                              std::pair{HeadOnPolicy::kChooseFaster, &out.chosen}}) {
+    auto run = RunOnce(map, routes, h1_work, policy);
+    if (!run.ok()) return run.error();
+    *slot = *run;
+  }
+  return out;
+}
+
+}  // namespace dispatch::engine
