@@ -32,6 +32,7 @@ struct RobotState {
   WaitKind wait = WaitKind::kNone;
   double wait_start = 0.0;
   double next_detour_try = 0.0;
+  double next_break_try = 0.0;  // BreakCycle retries a robot that could not act after 1 s
   int waits_on = -1;
   PointId wait_point = kNoPoint;
   int wait_corridor = -1;
@@ -178,7 +179,11 @@ struct TrafficController::Impl {
 
   // Cheapest route from -> to avoiding `ban_point`, corridor `ban_corridor` and intersection
   // `ban_guard` (each -1/kNoPoint for none). Empty points when there is none.
-  Detour Route(PointId from, PointId to, PointId ban_point, int ban_corridor, int ban_guard) {
+  // A* with the straight-line time as heuristic (admissible: paths are never shorter than
+  // the straight distance and no robot is faster than `speed`); searches stop once every
+  // open route costs more than `bound` seconds (no route returned then).
+  Detour Route(PointId from, PointId to, PointId ban_point, int ban_corridor, int ban_guard,
+               double bound = kInf) {
     Detour out;
     if (to == ban_point || from == to) {
       if (from == to) out = {{from}, 0.0};
@@ -190,20 +195,28 @@ struct TrafficController::Impl {
     }
     using Item = std::pair<double, PointId>;
     std::priority_queue<Item, std::vector<Item>, std::greater<>> heap;
+    const Eigen::Vector2d goal = M().point(to).position;
+    auto h = [&](PointId v) { return (M().point(v).position - goal).norm() / config.speed; };
     auto relax = [&](PointId v, double d, ArcId a) {
       const auto i = static_cast<std::size_t>(v);
       if (seen[i] == stamp && dist[i] <= d) return;
       seen[i] = stamp;
       dist[i] = d;
       via[i] = a;
-      heap.push({d, v});
+      heap.push({d + h(v), v});
     };
     relax(from, 0.0, -1);
+    bool found = false;
     while (!heap.empty()) {
-      const auto [d, u] = heap.top();
+      const auto [key, u] = heap.top();
       heap.pop();
-      if (d > dist[static_cast<std::size_t>(u)]) continue;
-      if (u == to) break;
+      const double d = dist[static_cast<std::size_t>(u)];
+      if (key > d + h(u) + 1e-12) continue;  // stale entry
+      if (key > bound) break;
+      if (u == to) {
+        found = true;
+        break;
+      }
       for (ArcId a : M().out_arcs(u)) {
         const PointId v = M().arc(a).to;
         if (v == ban_point) continue;
@@ -213,7 +226,7 @@ struct TrafficController::Impl {
       }
     }
     const auto ti = static_cast<std::size_t>(to);
-    if (seen[ti] != stamp) return out;
+    if (!found) return out;
     out.cost = dist[ti];
     for (PointId v = to; v != from; v = M().arc(via[static_cast<std::size_t>(v)]).from) {
       out.points.push_back(v);
@@ -267,7 +280,10 @@ struct TrafficController::Impl {
                  bool need_free_first_hop) {
     RobotState& x = robots[r];
     if (x.pos + 1 >= x.route.size()) return false;
-    Detour d = Route(x.at, x.route.back(), ban_point, ban_corridor, ban_guard);
+    // Detours more than blocked_after longer than the current route are not worth taking
+    // (and bounding keeps a failing search from sweeping the whole floor).
+    const double bound = RouteCost(x) + config.blocked_after;
+    Detour d = Route(x.at, x.route.back(), ban_point, ban_corridor, ban_guard, bound);
     if (d.points.size() < 2 || !StartAllowed(r, d.points)) return false;
     if (need_free_first_hop && PointBlocker(d.points[1], r) >= 0) return false;
     if (!Assign(r, std::move(d.points)).ok()) return false;
@@ -288,8 +304,9 @@ struct TrafficController::Impl {
       if (c >= 0 && CorridorBlocker(c, lanes.Direction(M(), a), r) >= 0) continue;
       std::vector<PointId> route{x.at};
       if (goal != kNoPoint) {
-        Detour d = Route(n, goal, ban_point, -1, -1);
-        if (d.points.empty()) d = Route(n, goal, kNoPoint, -1, -1);
+        const double bound = RouteCost(x) + config.blocked_after;
+        Detour d = Route(n, goal, ban_point, -1, -1, bound);
+        if (d.points.empty()) d = Route(n, goal, kNoPoint, -1, -1, bound);
         if (d.points.empty()) continue;
         route.insert(route.end(), d.points.begin(), d.points.end());
       } else {
@@ -358,9 +375,14 @@ struct TrafficController::Impl {
         if (static_cast<std::size_t>(h) == r) continue;
         rec.wait_estimate = std::max(rec.wait_estimate, ClearTime(static_cast<std::size_t>(h), c, t));
       }
-      Detour d = Route(x.at, x.route.back(), kNoPoint, c, -1);
+      // kChooseFaster only needs detours faster than waiting: bound the search there.
+      const double old_cost = RouteCost(x);
+      const double bound = config.head_on == HeadOnPolicy::kChooseFaster
+                               ? old_cost + rec.wait_estimate
+                               : kInf;
+      Detour d = Route(x.at, x.route.back(), kNoPoint, c, -1, bound);
       if (!d.points.empty() && !StartAllowed(r, d.points)) d = Detour{};
-      rec.replan_extra = d.points.empty() ? kInf : d.cost - RouteCost(x);
+      rec.replan_extra = d.points.empty() ? kInf : d.cost - old_cost;
       const bool replan =
           !d.points.empty() && (config.head_on == HeadOnPolicy::kAlwaysReplan ||
                                 (config.head_on == HeadOnPolicy::kChooseFaster &&
@@ -491,24 +513,25 @@ struct TrafficController::Impl {
     ClearWait(x);
   }
 
-  bool BreakCycle(const std::vector<std::size_t>& members) {
+  bool BreakCycle(const std::vector<std::size_t>& members, double t) {
     std::vector<std::size_t> order = members;
     std::sort(order.begin(), order.end(),
               [&](std::size_t a, std::size_t b) { return Lower(a, b); });
     for (std::size_t v : order) {
       RobotState& x = robots[v];
-      if (x.working || x.next != kNoPoint) continue;
+      if (x.working || x.next != kNoPoint || t < x.next_break_try) continue;
       const PointId want = x.pos + 1 < x.route.size() ? x.route[x.pos + 1] : kNoPoint;
       const bool ok =
           x.wait == WaitKind::kCorridor ? TryDetour(v, kNoPoint, x.wait_corridor, -1, true)
           : x.wait == WaitKind::kGrant  ? TryDetour(v, kNoPoint, -1, M().IntersectionOf(want), true)
                                         : TryDetour(v, want, -1, -1, true);
       if (ok || TryBackOff(v, want, want)) return true;
+      x.next_break_try = t + 1.0;
     }
     return false;
   }
 
-  std::size_t ResolveDeadlocks() {
+  std::size_t ResolveDeadlocks(double t) {
     const std::size_t n = robots.size();
     std::vector<std::uint32_t> walk(n, 0);
     std::uint32_t walk_id = 0;
@@ -527,7 +550,7 @@ struct TrafficController::Impl {
       if (v >= 0 && walk[static_cast<std::size_t>(v)] == walk_id) {
         auto it = std::find(path.begin(), path.end(), static_cast<std::size_t>(v));
         std::vector<std::size_t> cycle(it, path.end());
-        if (BreakCycle(cycle)) {
+        if (BreakCycle(cycle, t)) {
           ++broken;
           ++stats.deadlocks_resolved;
         }
@@ -704,7 +727,7 @@ std::string TrafficController::Describe(std::size_t r) const {
 
 bool TrafficController::StepAside(std::size_t r) { return impl_->StepAside(r, {}); }
 
-std::size_t TrafficController::ResolveDeadlocks(double /*t*/) { return impl_->ResolveDeadlocks(); }
+std::size_t TrafficController::ResolveDeadlocks(double t) { return impl_->ResolveDeadlocks(t); }
 const TrafficStats& TrafficController::stats() const { return impl_->stats; }
 const LaneCorridors& TrafficController::corridors() const { return impl_->lanes; }
 

@@ -29,11 +29,13 @@
 //    one robot it waits for (point holder, oncoming corridor holder, or grant holder); each
 //    node has out-degree <= 1, so cycles are found in O(robots). In each cycle the lowest-
 //    priority member that can act re-plans a detour avoiding what it waits for, or backs off
-//    to a free neighbouring point and re-plans from there. An idle robot (no route) that
+//    to a free neighbouring point and re-plans from there (a member that could not act is
+//    retried after 1 s; detours are bounded to blocked_after beyond the current route's
+//    cost, A* with the straight-line heuristic). An idle robot (no route) that
 //    somebody waits for is sent to a siding off the waiter's route (StepAside, "nudge").
 //
 // Costs: Request/Arrived are O(route look-ahead + clearance neighbours); ResolveDeadlocks is
-// O(robots); detours run one Dijkstra over the map (reused buffers). No all-pairs work.
+// O(robots); detours run one bounded A* over the map (reused buffers). No all-pairs work.
 // Deterministic. Not thread-safe: one owner (the simulator or the dispatcher loop).
 #pragma once
 
@@ -78,7 +80,8 @@ struct HeadOnRecord {
   double t = 0.0;
   std::string robot, oncoming;
   double wait_estimate = 0.0;   // s until the oncoming robots have left the corridor
-  double replan_extra = 0.0;    // s a detour adds (+inf: none)
+  double replan_extra = 0.0;    // s a detour adds (+inf: none; under kChooseFaster also
+                                // "none faster than waiting": that search is bounded)
   bool replanned = false;
 };
 

@@ -1,0 +1,93 @@
+// sim_bench: the order-stream simulator (engine/sim/order_stream.h) under the online traffic
+// controller on a large generated floor, as fast as the CPU allows (issue 4 §5).
+//
+//   BM_Simulate/R   R robots on a 20 x 20-shelf grid floor (engine/map/grid_floor.h: 4 x 2
+//                   cell shelves, 2-cell aisles, 122 x 82 cells, ~6800 points, lazy route
+//                   table, all lanes bidirectional), auction (zeta = 100) allocating every
+//                   10 s (one FleetState rebuild per batch), a steady stream of random orders (one every 110 / R s: about one
+//                   order per robot per task duration), 300 simulated seconds, dt = 0.1 s.
+// Counter `speedup` = simulated seconds per wall second (target: R = 500 at >= 100x).
+// The map, the route table (warmed on every pick and drop) and the orders are built once,
+// outside the timing. Run from a Release build:
+//   cmake --build build-rel --target sim_bench && build-rel/tests/benchmarks/sim_bench
+#include <benchmark/benchmark.h>
+
+#include <memory>
+#include <stdexcept>
+
+#include "engine/map/grid_floor.h"
+#include "engine/routing/route_table.h"
+#include "engine/sim/fleet_placement.h"
+#include "engine/sim/order_stream.h"
+#include "engine/sim/random_orders.h"
+
+namespace dispatch::engine {
+namespace {
+
+constexpr double kHorizon = 300.0;
+
+struct Floor {
+  std::shared_ptr<const WarehouseMap> map;
+  std::shared_ptr<const RouteTable> routes;
+};
+
+const Floor& LargeFloor() {
+  static const Floor floor = [] {
+    auto m = BuildGridFloor({});
+    if (!m.ok()) throw std::runtime_error(m.error().message);
+    Floor f;
+    f.map = std::make_shared<const WarehouseMap>(std::move(m).value());
+    auto t = MakeRouteTable(f.map, {});
+    if (!t.ok()) throw std::runtime_error(t.error().message);
+    f.routes = std::move(t).value();
+    // Warm the lazy table's per-destination searches on every stop.
+    PointId any = 0;
+    for (std::size_t p = 0; p < f.map->point_count(); ++p) {
+      if (IsServicePoint(f.map->points()[p].kind)) {
+        benchmark::DoNotOptimize(f.routes->Cost(any, static_cast<PointId>(p)));
+      }
+    }
+    return f;
+  }();
+  return floor;
+}
+
+void BM_Simulate(benchmark::State& state) {
+  const Floor& f = LargeFloor();
+  const auto robots_count = static_cast<std::size_t>(state.range(0));
+  auto robots = PlaceRobots(*f.map, robots_count);
+  if (!robots.ok()) throw std::runtime_error(robots.error().message);
+  RandomOrderOptions ro;
+  ro.interval = 110.0 / static_cast<double>(robots_count);
+  ro.count = static_cast<std::size_t>(kHorizon / ro.interval);
+  ro.seed = 42;
+  auto orders = RandomOrders(*f.map, ro);
+  if (!orders.ok()) throw std::runtime_error(orders.error().message);
+  StreamConfig config;
+  config.max_time = kHorizon;
+  config.allocation_period = 10.0;
+  config.record_series = false;
+  double simulated = 0;
+  std::size_t completed = 0, total = 0, deadlocks = 0, replans = 0;
+  for (auto _ : state) {
+    auto r = SimulateOrderStream(f.map, f.routes, *robots, *orders, config);
+    if (!r.ok()) throw std::runtime_error(r.error().message);
+    simulated += r->end_time;
+    completed += r->completed;
+    total += r->orders.size();
+    deadlocks += r->traffic.deadlocks_resolved;
+    replans += r->traffic.replans;
+  }
+  state.counters["speedup"] = benchmark::Counter(simulated, benchmark::Counter::kIsRate);
+  state.counters["completed"] = static_cast<double>(completed) / static_cast<double>(state.iterations());
+  state.counters["orders"] = static_cast<double>(total) / static_cast<double>(state.iterations());
+  state.counters["deadlocks"] = static_cast<double>(deadlocks) / static_cast<double>(state.iterations());
+  state.counters["replans"] = static_cast<double>(replans) / static_cast<double>(state.iterations());
+}
+BENCHMARK(BM_Simulate)->Arg(18)->Arg(100)->Arg(500)->Unit(benchmark::kMillisecond)
+    ->UseRealTime()->Iterations(2);
+
+}  // namespace
+}  // namespace dispatch::engine
+
+BENCHMARK_MAIN();
