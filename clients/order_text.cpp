@@ -102,7 +102,11 @@ std::string DescribeEvent(const v1::OrderEvent& e) {
     s += StateName(e.state());
   }
   if (!e.robot_ids().empty()) s += " [" + Join(e.robot_ids()) + "]";
-  if (!e.detail().empty()) s += " " + e.detail();
+  if (!e.detail().empty()) {
+    // Long details (e.g. a stored allocation explanation) are cut: `explain` shows those.
+    constexpr std::size_t kMax = 120;
+    s += " " + (e.detail().size() > kMax ? e.detail().substr(0, kMax) + "..." : e.detail());
+  }
   return s;
 }
 

@@ -13,6 +13,7 @@ PACKAGES=(
   libgrpc++-dev protobuf-compiler-grpc libprotobuf-dev protobuf-compiler
   libsqlite3-dev
   libspdlog-dev libcpp-httplib-dev
+  python3 python3-grpcio python3-protobuf
 )
 
 install_packages() {

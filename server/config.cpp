@@ -43,6 +43,7 @@ std::vector<Key> Keys() {
       MakeKey("heartbeat_timeout", &ServerConfig::heartbeat_timeout),
       MakeKey("offline_grace", &ServerConfig::offline_grace),
       MakeKey("ports_file", &ServerConfig::ports_file),
+      MakeKey("ready_fd", &ServerConfig::ready_fd),
       MakeKey("log_level", &ServerConfig::log_level),
   };
 }
@@ -86,6 +87,9 @@ engine::Status ApplyConfigFile(const std::string& path, ServerConfig& config) {
 engine::Status ValidateServerConfig(const ServerConfig& c) {
   auto port_ok = [](int p) { return p >= 0 && p <= 65535; };
   if (!port_ok(c.grpc_port)) return InvalidArgument("grpc_port must be in 0..65535");
+  if (c.ready_fd < -1 || c.ready_fd == 0 || c.ready_fd == 1 || c.ready_fd == 2) {
+    return InvalidArgument("ready_fd must be -1 (none) or an inherited descriptor >= 3");
+  }
   if (!port_ok(c.http_port)) return InvalidArgument("http_port must be in 0..65535");
   if (c.bind.empty()) return InvalidArgument("bind must not be empty");
   if (c.db.empty()) return InvalidArgument("db must name a SQLite file");
@@ -131,6 +135,8 @@ engine::Result<ParsedCommandLine> ParseCommandLine(int argc, char** argv) {
                  "Seconds offline before a robot's orders are re-allocated")
       ->capture_default_str();
   app.add_option("--ports-file", flags.ports_file, "Write the chosen ports as JSON here");
+  app.add_option("--ready-fd", flags.ready_fd,
+                 "Write the chosen ports as one JSON line to this inherited fd, then close it");
   app.add_option("--log-level", flags.log_level, "trace|debug|info|warn|error")->capture_default_str();
   try {
     app.parse(argc, argv);

@@ -25,6 +25,9 @@ struct ServerConfig {
   double heartbeat_timeout = 5.0;   // wall seconds of silence before a robot is offline
   double offline_grace = 10.0;      // wall seconds offline before its orders are re-allocated
   std::string ports_file;         // written as {"grpc_port":..,"http_port":..} once listening
+  // An inherited file descriptor (e.g. a pipe or FIFO from a script) that gets the same JSON
+  // line once listening, then is closed: readiness without polling. -1 = none.
+  int ready_fd = -1;
   std::string log_level = "info";  // spdlog level name
 };
 

@@ -3,7 +3,11 @@
 #include <grpcpp/grpcpp.h>
 #include <spdlog/spdlog.h>
 
+#include <unistd.h>
+
+#include <cerrno>
 #include <cstdio>
+#include <cstring>
 #include <fstream>
 
 #include "engine/cli/map_source.h"
@@ -18,11 +22,33 @@
 namespace dispatch::server {
 namespace {
 
+std::string PortsJson(const ServerPorts& ports) {
+  return nlohmann::json{{"grpc_port", ports.grpc}, {"http_port", ports.http}}.dump() + "\n";
+}
+
+// Writes the ports line to an inherited descriptor and closes it (the reader sees EOF).
+engine::Status WriteReadyFd(int fd, const ServerPorts& ports) {
+  const std::string line = PortsJson(ports);
+  std::size_t done = 0;
+  while (done < line.size()) {
+    const ssize_t n = ::write(fd, line.data() + done, line.size() - done);
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) {
+      const std::string why = std::strerror(errno);
+      ::close(fd);
+      return engine::IoError("cannot write the ready line to fd " + std::to_string(fd) + ": " + why);
+    }
+    done += static_cast<std::size_t>(n);
+  }
+  ::close(fd);
+  return engine::Ok{};
+}
+
 engine::Status WritePortsFile(const std::string& path, const ServerPorts& ports) {
   const std::string tmp = path + ".tmp";
   {
     std::ofstream out(tmp, std::ios::trunc);
-    out << nlohmann::json{{"grpc_port", ports.grpc}, {"http_port", ports.http}}.dump() << "\n";
+    out << PortsJson(ports);
     if (!out) return engine::IoError("cannot write ports file '" + tmp + "'");
   }
   if (std::rename(tmp.c_str(), path.c_str()) != 0) {
@@ -119,6 +145,9 @@ engine::Result<std::unique_ptr<DispatchServer>> DispatchServer::Start(const Serv
   if (!config.ports_file.empty()) {
     if (auto written = WritePortsFile(config.ports_file, s->ports_); !written.ok()) return written.error();
     spdlog::info("ports written to {}", config.ports_file);
+  }
+  if (config.ready_fd >= 0) {
+    if (auto written = WriteReadyFd(config.ready_fd, s->ports_); !written.ok()) return written.error();
   }
   return s;
 }
