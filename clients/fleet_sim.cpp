@@ -10,8 +10,10 @@
 // Faults: --drop-every S closes one robot's stream every S wall seconds (round robin) and
 // reconnects it, saying its last applied sequence; --stall and --slow change a robot's
 // motion; --delay-ms delays every robot -> server message. Runs until SIGINT/SIGTERM or
-// --duration wall seconds.
+// --duration wall seconds. --ready-fd N: once every robot has been welcomed, writes
+// "connected N" to the inherited descriptor N and closes it (scripts wait on it, no polling).
 #include <grpcpp/grpcpp.h>
+#include <unistd.h>
 
 #include <CLI/CLI.hpp>
 
@@ -88,6 +90,7 @@ int Main(int argc, char** argv) {
   std::size_t count = 18;
   double speed = 1.0, report_hz = 10.0, tick_hz = 50.0, duration = 0.0, drop_every = 0.0;
   int delay_ms = 0;
+  int ready_fd = -1;
   std::vector<std::string> stall, slow;
   app.add_option("--server", server, "dispatchd gRPC address HOST:PORT")->capture_default_str();
   app.add_option("--robots", count, "Number of robots")->capture_default_str()
@@ -102,6 +105,8 @@ int Main(int argc, char** argv) {
   app.add_option("--drop-every", drop_every, "Fault: drop and reconnect one stream every S s");
   app.add_option("--delay-ms", delay_ms, "Fault: delay every robot message by this many ms")
       ->check(CLI::NonNegativeNumber);
+  app.add_option("--ready-fd", ready_fd, "Write 'connected N' to this inherited fd once all robots are in")
+      ->check(CLI::Range(3, 65535));
   app.add_option("--stall", stall, "Fault: these robots never move (ids, repeat)");
   app.add_option("--slow", slow, "Fault: ID:FACTOR drives at FACTOR x speed (repeat)");
   CLI11_PARSE(app, argc, argv);
@@ -239,6 +244,14 @@ int Main(int argc, char** argv) {
       std::printf("fleet-sim: %zu of %zu robots connected\n", connected, count);
       std::fflush(stdout);
       connected_reported = connected;
+      if (connected == count && ready_fd >= 0) {
+        const std::string line = "connected " + std::to_string(count) + "\n";
+        if (::write(ready_fd, line.data(), line.size()) != static_cast<ssize_t>(line.size())) {
+          std::fprintf(stderr, "fleet-sim: cannot write to --ready-fd %d\n", ready_fd);
+        }
+        ::close(ready_fd);
+        ready_fd = -1;
+      }
     }
     next_tick += tick;
     if (next_tick < Clock::now()) next_tick = Clock::now();  // overloaded: do not spiral

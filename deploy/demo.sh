@@ -1,29 +1,88 @@
 #!/usr/bin/env bash
-# The main job: builds the engine and shows the built-in Chu2024 floor: its summary, a sample
-# of Floyd routes with lengths and travel times, an SVG rendering of the floor, and the
-# auction's allocation of the seed's task tables.
+# The main job: the dispatch service on the built-in Chu2024 floor. Builds everything, shows
+# the engine's seed reproductions briefly, then starts dispatchd (SQLite file on disk),
+# fleet-sim with 18 robots in the parking stations, submits seed 000 Table 1 and then Table 2
+# through wmsctl, prints the results, and keeps the service up until Ctrl-C.
+#
+# Environment: TIME_SCALE (dispatcher seconds per wall second, default 5), GRPC_PORT and
+# HTTP_PORT (default 0: any free port), DEMO_EXIT=1 (stop after the results instead of
+# serving until Ctrl-C).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash deploy/setup.sh build build-release -DCMAKE_BUILD_TYPE=Release -DDISPATCH_BUILD_TESTS=OFF \
   >/dev/null
-bin=build-release/engine/cli/dispatch-map
-echo "== The Chu2024 floor (seed 000 §4.1, reconstructed: engine/map/chu2024_floor.md) =="
-"$bin" summary --map chu2024
-echo
-echo "== Floyd routes (seed 000 §3.1), speed 1 m/s =="
-"$bin" routes --map chu2024
-echo
-"$bin" svg --map chu2024 --out build-release/chu2024.svg
-echo "Open build-release/chu2024.svg in a browser to see the floor."
+bin=build-release
 scenarios=../shared/scenarios
-if [ -f "$scenarios/chu2024-table2.csv" ]; then
-  echo
-  echo "== Auction allocation of seed 000 Table 2, without and with traffic prediction (Tables 3, 4) =="
-  build-release/engine/cli/dispatch-alloc --table "$scenarios/chu2024-table2.csv"
-  echo
-  echo "== Table 1 (mixed single and formation tasks), auction vs. greedy nearest-idle =="
-  build-release/engine/cli/dispatch-alloc --table "$scenarios/chu2024-table1.csv" --zeta 100
-  build-release/engine/cli/dispatch-alloc --table "$scenarios/chu2024-table1.csv" --strategy greedy --zeta 0
-else
-  echo "(no $scenarios beside the repository: the seed task tables are skipped)"
+run=build-release/demo
+rm -rf "$run"
+mkdir -p "$run"
+
+echo "== The Chu2024 floor (seed 000 §4.1, reconstructed: engine/map/chu2024_floor.md) =="
+"$bin/engine/cli/dispatch-map" summary --map chu2024
+"$bin/engine/cli/dispatch-map" svg --map chu2024 --out "$run/chu2024.svg" >/dev/null
+echo "(rendered to $run/chu2024.svg)"
+if [ ! -f "$scenarios/chu2024-table1.csv" ]; then
+  echo "demo: the seed task tables are missing: $scenarios (../shared beside the repository)" >&2
+  exit 1
 fi
+echo
+echo "== Engine: seed 000 Tables 3 and 4, the auction on Table 2 without and with traffic prediction =="
+"$bin/engine/cli/dispatch-alloc" --table "$scenarios/chu2024-table2.csv"
+echo
+echo "== Engine: seed 000 Fig. 8, Table 1 simulated with traffic rules off and on =="
+"$bin/engine/cli/dispatch-sim" plan --table "$scenarios/chu2024-table1.csv" --rules both \
+  --csv "$run/fig8.csv" | grep -E "^Rules|makespan|min pairwise" || true
+echo "(minimum distance over time: $run/fig8.csv)"
+echo
+echo "== Engine: seed 004 §4.3, a head-on conflict on a single lane: wait or re-plan =="
+"$bin/engine/cli/dispatch-sim" headon
+
+echo
+echo "== The service: dispatchd + fleet-sim (18 robots) + wmsctl =="
+server_pid="" fleet_pid=""
+stop() {
+  [ -n "$fleet_pid" ] && kill "$fleet_pid" 2>/dev/null || true
+  [ -n "$server_pid" ] && kill "$server_pid" 2>/dev/null || true
+  wait 2>/dev/null || true
+}
+trap stop EXIT
+trap 'echo; echo "demo: stopping"; exit 0' INT TERM
+mkfifo "$run/ready"
+"$bin/server/dispatchd" --bind 127.0.0.1 --grpc-port "${GRPC_PORT:-0}" --http-port "${HTTP_PORT:-0}" \
+  --db "$run/dispatch.db" --map chu2024 --time-scale "${TIME_SCALE:-5}" \
+  --ready-fd 3 3>"$run/ready" >"$run/dispatchd.log" 2>&1 &
+server_pid=$!
+ports=""
+read -r -t 60 ports <"$run/ready" || true
+if [ -z "$ports" ]; then
+  echo "demo: dispatchd did not start; its log:" >&2
+  cat "$run/dispatchd.log" >&2
+  exit 1
+fi
+grpc=127.0.0.1:$(sed -E 's/.*"grpc_port": *([0-9]+).*/\1/' <<<"$ports")
+http=127.0.0.1:$(sed -E 's/.*"http_port": *([0-9]+).*/\1/' <<<"$ports")
+echo "dispatchd: gRPC $grpc, REST http://$http/api/v1/status, database $run/dispatch.db"
+echo "           (log $run/dispatchd.log, time scale ${TIME_SCALE:-5}x)"
+"$bin/clients/fleet-sim" --server "$grpc" --robots 18 --ready-fd 4 4>"$run/ready" \
+  >"$run/fleet-sim.log" 2>&1 &
+fleet_pid=$!
+connected=""
+read -r -t 60 connected <"$run/ready" || true
+if [ -z "$connected" ]; then
+  echo "demo: fleet-sim did not connect its robots; its log:" >&2
+  cat "$run/fleet-sim.log" >&2
+  exit 1
+fi
+echo "fleet-sim: 18 robots at their parking stations, $connected"
+
+for table in 1 2; do
+  echo
+  echo "-- seed 000 Table $table --"
+  "$bin/clients/wmsctl" --server "$grpc" submit "$scenarios/chu2024-table$table.csv" --wait
+done
+echo
+echo "Orders, robots and the service status: curl http://$http/api/v1/orders, http://$http/api/v1/robots"
+echo "An allocation's reasons: $bin/clients/wmsctl --server $grpc explain <order id>"
+if [ "${DEMO_EXIT:-0}" = 1 ]; then exit 0; fi
+echo "Serving until Ctrl-C."
+wait "$server_pid"

@@ -36,8 +36,16 @@ fi
 grpc_port=$(sed -E 's/.*"grpc_port": *([0-9]+).*/\1/' <<<"$ports")
 http_port=$(sed -E 's/.*"http_port": *([0-9]+).*/\1/' <<<"$ports")
 
-"$fleet_sim" --server "127.0.0.1:$grpc_port" --robots "$robots" >"$work/fleet.log" 2>&1 &
+"$fleet_sim" --server "127.0.0.1:$grpc_port" --robots "$robots" --ready-fd 4 4>"$work/ready" \
+  >"$work/fleet.log" 2>&1 &
 fleet_pid=$!
+connected=""
+read -r -t 60 connected <"$work/ready" || true
+if [ -z "$connected" ]; then
+  echo "fleet-sim did not connect its robots" >&2
+  cat "$work/fleet.log" "$work/server.log" >&2
+  exit 1
+fi
 
 cmd=()
 for a in "$@"; do
