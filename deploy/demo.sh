@@ -47,7 +47,7 @@ stop() {
 }
 trap stop EXIT
 trap 'echo; echo "demo: stopping"; exit 0' INT TERM
-mkfifo "$run/ready"
+mkfifo "$run/ready" "$run/fleet-ready"
 "$bin/server/dispatchd" --bind 127.0.0.1 --grpc-port "${GRPC_PORT:-0}" --http-port "${HTTP_PORT:-0}" \
   --db "$run/dispatch.db" --map chu2024 --time-scale "${TIME_SCALE:-5}" \
   --ready-fd 3 3>"$run/ready" >"$run/dispatchd.log" 2>&1 &
@@ -63,11 +63,12 @@ grpc=127.0.0.1:$(sed -E 's/.*"grpc_port": *([0-9]+).*/\1/' <<<"$ports")
 http=127.0.0.1:$(sed -E 's/.*"http_port": *([0-9]+).*/\1/' <<<"$ports")
 echo "dispatchd: gRPC $grpc, REST http://$http/api/v1/status, database $run/dispatch.db"
 echo "           (log $run/dispatchd.log, time scale ${TIME_SCALE:-5}x)"
-"$bin/clients/fleet-sim" --server "$grpc" --robots 18 --ready-fd 4 4>"$run/ready" \
+"$bin/clients/fleet-sim" --server "$grpc" --robots 18 --ready-fd 4 4>"$run/fleet-ready" \
   >"$run/fleet-sim.log" 2>&1 &
 fleet_pid=$!
 connected=""
-read -r -t 60 connected <"$run/ready" || true
+read -r -t 60 connected <"$run/fleet-ready" || true
+case "$connected" in connected*) ;; *) connected="" ;; esac
 if [ -z "$connected" ]; then
   echo "demo: fleet-sim did not connect its robots; its log:" >&2
   cat "$run/fleet-sim.log" >&2

@@ -22,7 +22,7 @@ cleanup() {
 }
 trap cleanup EXIT
 
-mkfifo "$work/ready"
+mkfifo "$work/ready" "$work/fleet-ready"
 "$dispatchd" --bind 127.0.0.1 --grpc-port 0 --http-port 0 --db "$work/dispatch.db" \
   --ready-fd 3 "${server_args[@]}" 3>"$work/ready" >"$work/server.log" 2>&1 &
 server_pid=$!
@@ -36,11 +36,12 @@ fi
 grpc_port=$(sed -E 's/.*"grpc_port": *([0-9]+).*/\1/' <<<"$ports")
 http_port=$(sed -E 's/.*"http_port": *([0-9]+).*/\1/' <<<"$ports")
 
-"$fleet_sim" --server "127.0.0.1:$grpc_port" --robots "$robots" --ready-fd 4 4>"$work/ready" \
+"$fleet_sim" --server "127.0.0.1:$grpc_port" --robots "$robots" --ready-fd 4 4>"$work/fleet-ready" \
   >"$work/fleet.log" 2>&1 &
 fleet_pid=$!
 connected=""
-read -r -t 60 connected <"$work/ready" || true
+read -r -t 60 connected <"$work/fleet-ready" || true
+case "$connected" in connected*) ;; *) connected="" ;; esac
 if [ -z "$connected" ]; then
   echo "fleet-sim did not connect its robots" >&2
   cat "$work/fleet.log" "$work/server.log" >&2
