@@ -15,9 +15,10 @@
 //
 // Allocation: the strategy (auction or greedy) runs over the connected robots whenever an
 // order arrives, a robot connects or finishes an order, or an order comes back for
-// re-allocation. Each round builds a fresh engine::FleetState whose robots start where their
-// current plan ends (or where they stand) and when it ends. Orders stay `accepted` while no
-// robot (or fewer than 3 for a formation) is connected.
+// re-allocation. Each round builds a fresh engine::FleetState with every connected robot at
+// its reported point now, replays its remaining orders into its queue (ReplayQueue), then
+// auctions the accepted orders; a new order's waypoints are appended to the robot's plan.
+// Orders stay `accepted` while no robot (or fewer than 3 for a formation) is connected.
 //
 // Robots: Hello registers (snapping the pose to the nearest map point within
 // Options::robot_snap_tolerance); waypoints are numbered over the robot's whole life; every
@@ -134,6 +135,7 @@ class Dispatcher {
     std::optional<Clock::time_point> offline_since;  // set while offline with orders to watch
     storage::AssignmentRecord assignment;  // plan.waypoints[0] anchors; then one segment per order
     bool has_assignment = false;
+    std::uint64_t last_reached = 0;  // highest waypoint sequence reported reached
   };
 
   Dispatcher(std::shared_ptr<const engine::WarehouseMap> map,
@@ -160,6 +162,10 @@ class Dispatcher {
 
   // Allocation and plans (dispatcher_plans.cpp).
   void AllocatePending();
+  // Appends the robot's remaining orders (each as its member's own task; the first one from
+  // the picks it has not reached yet) to its queue in `fleet`, so that bids count the whole
+  // queue (Chu2024 eq. 3) and traffic prediction sees the robot's work.
+  void ReplayQueue(engine::FleetState& fleet, std::size_t index, const RobotRuntime& robot) const;
   // Runs the strategy for one order and commits the award; false if the store failed.
   bool AwardOrder(const engine::Order& order, engine::FleetState& fleet);
   // Removes `order_id` and every later order from the plan; returns the later ones.

@@ -144,13 +144,8 @@ void Dispatcher::AllocatePending() {
     const RobotRuntime& r = robots_.at(id);
     engine::FleetRobot f;
     f.id = id;
-    if (HasOrders(r.assignment, r.has_assignment)) {
-      f.start = r.assignment.plan.waypoints.back().point;
-      f.ready_time = std::max(now, r.assignment.plan.end_time());
-    } else {
-      f.start = r.record.robot.current_point;
-      f.ready_time = now;
-    }
+    f.start = r.record.robot.current_point;
+    f.ready_time = now;
     fleet_robots.push_back(f);
   }
   auto fleet = engine::FleetState::Create(map_, routes_, fleet_robots, options_.allocation);
@@ -159,11 +154,39 @@ void Dispatcher::AllocatePending() {
     return;
   }
   engine::FleetState state = std::move(fleet).value();
+  for (std::size_t i = 0; i < ids.size(); ++i) ReplayQueue(state, i, robots_.at(ids[i]));
   for (const auto& view : pending) {
     const engine::Order& order = view->record.order;
     if (static_cast<std::size_t>(order.team_size()) > ids.size()) continue;
     if (!AwardOrder(order, state)) {
       retry_allocation_ = true;  // the store failed: try again on the next tick
+      return;
+    }
+  }
+}
+
+void Dispatcher::ReplayQueue(engine::FleetState& fleet, std::size_t index, const RobotRuntime& r) const {
+  if (!HasOrders(r.assignment, r.has_assignment)) return;
+  const auto& plan = r.assignment;
+  for (std::size_t k = 0; k < plan.order_ids.size(); ++k) {
+    auto view = Find(plan.order_ids[k]);
+    if (!view) return;
+    const engine::Order& order = view->record.order;
+    std::vector<engine::PointId> picks = order.picks;
+    if (k == 0) {  // only the picks still ahead of the robot
+      picks.clear();
+      for (std::size_t w = 1; w < SegmentStart(plan, 1) && w < plan.plan.waypoints.size(); ++w) {
+        const auto& wp = plan.plan.waypoints[w];
+        if (wp.action == engine::WaypointAction::kPick && static_cast<std::uint64_t>(wp.seq) > r.last_reached) {
+          picks.push_back(wp.point);
+        }
+      }
+      if (picks.empty()) picks.push_back(order.drop);  // picked: only the drop is left
+    }
+    auto assigned = fleet.AssignSingle(index, order.id, fleet.TaskOf(picks, order.drop, order.work_time));
+    if (!assigned.ok()) {
+      spdlog::warn("allocation: queue of {} replayed up to {} only: {}", r.record.robot.id, order.id,
+                   assigned.error().message);
       return;
     }
   }
@@ -205,9 +228,15 @@ bool Dispatcher::AwardOrder(const engine::Order& order, engine::FleetState& flee
       from = 0;
     }
     c.first_new = static_cast<std::uint64_t>(next_seq);
+    // The replayed queue (see ReplayQueue) re-times the robot's remaining work from now; the
+    // new segment never starts before the robot's actual plan ends.
+    const double shift = c.fresh || from >= fp.size()
+                             ? 0.0
+                             : std::max(0.0, c.assignment.plan.end_time() - fp[from - 1].departure());
     for (std::size_t k = from; k < fp.size(); ++k) {
       engine::Waypoint wp = fp[k];
       wp.seq = static_cast<int>(next_seq++);
+      wp.eta += shift;
       c.assignment.plan.waypoints.push_back(wp);
     }
     c.assignment.order_ids.push_back(order.id);

@@ -65,6 +65,7 @@ void Dispatcher::DoRobotMessage(const std::shared_ptr<RobotLink>& link, const Ro
       }
       if (m.state && *m.state != engine::RobotState::kOffline) r->record.robot.state = *m.state;
       if (m.battery) r->record.robot.battery = *m.battery;
+      r->last_reached = std::max(r->last_reached, m.sequence);
       break;
     }
     case RobotInbound::Kind::kWaypointReached: DoWaypointReached(*r, m); break;
@@ -181,6 +182,7 @@ void Dispatcher::DoWaypointReached(RobotRuntime& r, const RobotInbound& m) {
   for (std::size_t i = 0; i < w.size(); ++i) {
     if (static_cast<std::uint64_t>(w[i].seq) != m.sequence) continue;
     r.record.robot.current_point = w[i].point;
+    r.last_reached = std::max(r.last_reached, m.sequence);
     if (std::isfinite(m.pose.position.x()) && std::isfinite(m.pose.position.y())) r.record.robot.pose = m.pose;
     if (w[i].action == engine::WaypointAction::kPick) {
       const std::string order = OrderOfWaypoint(r.assignment, i);

@@ -178,8 +178,10 @@ TEST_F(OrderFlowTest, EveryConnectedRobotBidsAndTheLowestBidWins) {
   const auto& best = why.bids(0).total() <= why.bids(1).total() ? why.bids(0) : why.bids(1);
   EXPECT_EQ(assigned_b->robot_ids(0), best.robot_id());
   EXPECT_TRUE(best.winner());
-  // R1's bid includes the order already in its queue.
-  EXPECT_GT(why.bids(0).ready_time(), 0.0);
+  // R1's bid counts the order already in its queue (Chu2024 eq. 3: n_c over the whole
+  // queue, t_w = 5 s per pick and drop): 4 task points against R2's 2.
+  EXPECT_DOUBLE_EQ(why.bids(0).work_time(), 20.0);
+  EXPECT_DOUBLE_EQ(why.bids(1).work_time(), 10.0);
 }
 
 TEST_F(OrderFlowTest, OrdersWaitAcceptedUntilARobotConnects) {
