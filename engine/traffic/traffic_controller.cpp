@@ -23,6 +23,8 @@ struct RobotState {
   std::vector<ArcId> arcs;     // arcs[k]: route[k] -> route[k + 1]
   std::size_t pos = 0;
   bool working = false, loaded = false, removed = false;
+  int group = 0, group2 = 0;  // > 0: robots sharing a group (a formation) may come closer
+  double envelope = 0.0;  // extra clearance (a formation's D_f), <= config.max_envelope
   double work_end = 0.0;
   bool idle = true;
   std::vector<int> corridors;  // held corridor reservations
@@ -58,7 +60,8 @@ struct TrafficController::Impl {
   TrafficControllerConfig config;
   LaneCorridors lanes;
   IntersectionGrants grants{0};
-  std::vector<std::vector<PointId>> near;  // points closer than point_clearance
+  // Points closer than point_clearance + 2 * max_envelope, with their distance.
+  std::vector<std::vector<std::pair<PointId, double>>> near;
   std::vector<int> holder;                 // per point
   std::vector<CorridorState> cstate;
   std::vector<RobotState> robots;
@@ -90,9 +93,20 @@ struct TrafficController::Impl {
   int PointBlocker(PointId q, std::size_t r) const {
     const int h = holder[static_cast<std::size_t>(q)];
     if (h >= 0 && static_cast<std::size_t>(h) != r) return h;
-    for (PointId n : near[static_cast<std::size_t>(q)]) {
+    // Chu2024 eqs. (10)-(12): eps1 between singles, eps1 + D_f single-formation, eps1 + 2 D_f
+    // between formations: each agent's envelope adds to the clearance.
+    const RobotState& me = robots[r];
+    auto mates = [&](const RobotState& o) {
+      return (me.group > 0 && (o.group == me.group || o.group2 == me.group)) ||
+             (me.group2 > 0 && (o.group == me.group2 || o.group2 == me.group2));
+    };
+    const double own = config.point_clearance + robots[r].envelope - 1e-9;
+    for (const auto& [n, d] : near[static_cast<std::size_t>(q)]) {
       const int hn = holder[static_cast<std::size_t>(n)];
-      if (hn >= 0 && static_cast<std::size_t>(hn) != r) return hn;
+      if (hn < 0 || static_cast<std::size_t>(hn) == r) continue;
+      const RobotState& other = robots[static_cast<std::size_t>(hn)];
+      if (mates(other)) continue;
+      if (d < own + other.envelope) return hn;
     }
     return -1;
   }
@@ -328,8 +342,19 @@ struct TrafficController::Impl {
   bool StepAside(std::size_t r, const std::vector<PointId>& keep_clear) {
     RobotState& x = robots[r];
     if (x.removed || x.working || x.next != kNoPoint || x.pos + 1 < x.route.size()) return false;
+    // Kept clear: the given points, the service point it leaves (the next robot, or
+    // formation, to serve there must be able to come), and every point within
+    // point_clearance + max_envelope of those.
+    std::vector<PointId> keep = keep_clear;
+    if (IsServicePoint(M().point(x.at).kind)) keep.push_back(x.at);
     auto clear = [&](PointId p) {
-      return std::find(keep_clear.begin(), keep_clear.end(), p) == keep_clear.end();
+      for (PointId k : keep) {
+        if (p == k) return false;
+        for (const auto& [n, d] : near[static_cast<std::size_t>(k)]) {
+          if (n == p && d < config.point_clearance + config.max_envelope) return false;
+        }
+      }
+      return true;
     };
     if (Siding(x.at) && clear(x.at)) return false;
     if (++stamp == 0) {
@@ -577,6 +602,9 @@ struct TrafficController::Impl {
 };
 
 Status TrafficControllerConfig::Validate() const {
+  if (!std::isfinite(max_envelope) || max_envelope < 0) {
+    return InvalidArgument("traffic controller: max_envelope must be finite and >= 0");
+  }
   for (double v : {speed, t_w1, t_w2, blocked_after}) {
     if (!std::isfinite(v) || v <= 0) {
       return InvalidArgument("traffic controller: speed and waits must be finite and > 0");
@@ -613,7 +641,7 @@ Result<TrafficController> TrafficController::Create(std::shared_ptr<const Wareho
   impl->seen.assign(n, 0);
   // Clearance neighbours by a uniform grid of cell size point_clearance.
   impl->near.assign(n, {});
-  const double cell = config.point_clearance;
+  const double cell = config.point_clearance + 2.0 * config.max_envelope;
   if (cell > 0) {
     std::unordered_map<long long, std::vector<PointId>> grid;
     auto key = [&](long long ix, long long iy) { return ix * 1000003LL + iy; };
@@ -633,10 +661,8 @@ Result<TrafficController> TrafficController::Create(std::shared_ptr<const Wareho
           auto it = grid.find(key(ix + dx, iy + dy));
           if (it == grid.end()) continue;
           for (PointId q : it->second) {
-            if (static_cast<std::size_t>(q) != p &&
-                (m.points()[static_cast<std::size_t>(q)].position - xy).norm() < cell - 1e-9) {
-              impl->near[p].push_back(q);
-            }
+            const double d = (m.points()[static_cast<std::size_t>(q)].position - xy).norm();
+            if (static_cast<std::size_t>(q) != p && d < cell - 1e-9) impl->near[p].push_back({q, d});
           }
         }
       }
@@ -650,7 +676,7 @@ TrafficController::TrafficController(TrafficController&&) noexcept = default;
 TrafficController& TrafficController::operator=(TrafficController&&) noexcept = default;
 TrafficController::~TrafficController() = default;
 
-Result<std::size_t> TrafficController::AddRobot(const std::string& id, PointId at) {
+Result<std::size_t> TrafficController::AddRobot(const std::string& id, PointId at, int group) {
   Impl& s = *impl_;
   if (id.empty()) return InvalidArgument("traffic: empty robot id");
   if (at < 0 || static_cast<std::size_t>(at) >= s.M().point_count()) {
@@ -662,6 +688,7 @@ Result<std::size_t> TrafficController::AddRobot(const std::string& id, PointId a
   x.id = id;
   x.at = at;
   x.route = {at};
+  x.group = std::max(0, group);
   s.robots.push_back(std::move(x));
   const int b = s.PointBlocker(at, r);
   if (b >= 0) {
@@ -697,6 +724,13 @@ void TrafficController::SetWorking(std::size_t r, bool working, double work_end)
 }
 void TrafficController::SetLoaded(std::size_t r, bool loaded) { impl_->robots.at(r).loaded = loaded; }
 void TrafficController::SetIdle(std::size_t r, bool idle) { impl_->robots.at(r).idle = idle; }
+void TrafficController::SetGroup(std::size_t r, int group, int second) {
+  impl_->robots.at(r).group = std::max(0, group);
+  impl_->robots.at(r).group2 = std::max(0, second);
+}
+void TrafficController::SetEnvelope(std::size_t r, double extra) {
+  impl_->robots.at(r).envelope = std::clamp(extra, 0.0, impl_->config.max_envelope);
+}
 TrafficDecision TrafficController::Request(std::size_t r, double t) {
   return impl_->Request(r, t);
 }
@@ -709,6 +743,32 @@ void TrafficController::LeftPoint(std::size_t r) {
 }
 void TrafficController::Arrived(std::size_t r, double /*t*/) { impl_->Arrived(r); }
 void TrafficController::Remove(std::size_t r) { impl_->Remove(r); }
+Status TrafficController::Place(std::size_t r, PointId at) {
+  Impl& s = *impl_;
+  if (r >= s.robots.size()) return InvalidArgument("traffic: unknown robot index");
+  RobotState& x = s.robots[r];
+  if (!x.removed) return Error{ErrorCode::kFailedPrecondition, "traffic: robot " + x.id + " is on the floor"};
+  if (at < 0 || static_cast<std::size_t>(at) >= s.M().point_count()) {
+    return NotFound("traffic: robot " + x.id + " placed at an unknown point");
+  }
+  const int b = s.PointBlocker(at, r);
+  if (b >= 0) {
+    return InvalidArgument("traffic: robot " + x.id + " placed at " + s.Name(at) + " held by " +
+                           s.robots[static_cast<std::size_t>(b)].id);
+  }
+  x.removed = false;
+  x.at = at;
+  x.next = kNoPoint;
+  x.route = {at};
+  x.arcs.clear();
+  x.pos = 0;
+  x.working = x.loaded = false;
+  x.idle = true;
+  s.ClearWait(x);
+  s.holder[static_cast<std::size_t>(at)] = static_cast<int>(r);
+  return Ok{};
+}
+bool TrafficController::removed(std::size_t r) const { return impl_->robots.at(r).removed; }
 const std::string& TrafficController::why(std::size_t r) const { return impl_->robots.at(r).why; }
 std::string TrafficController::Describe(std::size_t r) const {
   const Impl& s = *impl_;
@@ -726,6 +786,9 @@ std::string TrafficController::Describe(std::size_t r) const {
 }
 
 bool TrafficController::StepAside(std::size_t r) { return impl_->StepAside(r, {}); }
+bool TrafficController::StepAside(std::size_t r, const std::vector<PointId>& keep_clear) {
+  return impl_->StepAside(r, keep_clear);
+}
 
 std::size_t TrafficController::ResolveDeadlocks(double t) { return impl_->ResolveDeadlocks(t); }
 const TrafficStats& TrafficController::stats() const { return impl_->stats; }

@@ -68,6 +68,8 @@ struct TrafficControllerConfig {
   double t_w1 = 10.0;            // s: corridor (head-on) wait before re-planning
   double t_w2 = 20.0;            // s: held point / grant wait before re-planning
   double blocked_after = 120.0;  // s of waiting with no alternative -> blocked
+  // Largest extra clearance of an agent (SetEnvelope): a formation's D_f = 0.4 / sqrt(3) m.
+  double max_envelope = 0.25;
   bool intersection_grants = true;
   HeadOnPolicy head_on = HeadOnPolicy::kChooseFaster;
   Status Validate() const;
@@ -102,8 +104,9 @@ class TrafficController {
   TrafficController& operator=(TrafficController&&) noexcept;
   ~TrafficController();
 
-  // Places a robot standing at `at` (which it holds). Errors: unknown point, point held.
-  Result<std::size_t> AddRobot(const std::string& id, PointId at);
+  // Places a robot standing at `at` (which it holds), in `group` (see SetGroup). Errors:
+  // unknown point, point held.
+  Result<std::size_t> AddRobot(const std::string& id, PointId at, int group = 0);
   std::size_t robot_count() const;
   const std::string& robot_id(std::size_t r) const;
 
@@ -121,6 +124,15 @@ class TrafficController {
   void SetLoaded(std::size_t r, bool loaded);
   // Idle: no work assigned. Only idle robots are nudged aside for others.
   void SetIdle(std::size_t r, bool idle);
+  // Robots sharing a group (> 0; 0 = none), e.g. the members of a formation assembling at
+  // its rendezvous or leaving its drop point (Chu2024 §3.2), do not keep point_clearance from
+  // one another: a point is still held by one robot at a time, but its near points held by
+  // groupmates do not block. A robot may be in two groups (leaving one team, joining another).
+  void SetGroup(std::size_t r, int group, int second = 0);
+  // Extra clearance of an agent bigger than one robot (a formation: D_f, its members' distance
+  // from the centre; clamped to max_envelope). Two agents' points conflict when closer than
+  // point_clearance + both envelopes (Chu2024 eqs. (10)-(12): eps1, eps2, eps3).
+  void SetEnvelope(std::size_t r, double extra);
 
   // The robot stands at At(r) and wants to drive to its next route point at time t.
   // kGo: reservations taken, drive the arc (Next(r)) and call Arrived; kWait: stay (why() says
@@ -133,14 +145,24 @@ class TrafficController {
   void Arrived(std::size_t r, double t);
   // Removes the robot from the floor (fault, or it left): releases everything it holds.
   void Remove(std::size_t r);
+  // Puts a removed robot back on the floor, standing at `at` with no route (so a long-running
+  // owner reuses indices instead of adding robots). Errors: not removed, unknown point, the
+  // point (or one within point_clearance) held by another robot.
+  Status Place(std::size_t r, PointId at);
+  bool removed(std::size_t r) const;
   const std::string& why(std::size_t r) const;  // reason of the last kWait / kBlocked
   // "R3 at 'c9' -> 'c8' route 'c9' 'c8' ... waiting on R4 (point 'c8' held by R4)".
   std::string Describe(std::size_t r) const;
 
   // Sends an idle robot (no route, not working) to the nearest free "siding": a point that is
   // not a service point, not inside a corridor and not an intersection point, within 40 points
-  // (breadth-first). False when it already stands on one or none is found.
+  // (breadth-first), and not within point_clearance + max_envelope of the service point it
+  // leaves (so the next robot or formation can be served there). False when it already
+  // stands on one or none is found.
   bool StepAside(std::size_t r);
+  // The same, also keeping clear `keep_clear` and every point within point_clearance +
+  // max_envelope of them.
+  bool StepAside(std::size_t r, const std::vector<PointId>& keep_clear);
   // Breaks wait-for cycles and nudges idle robots that block others. Returns cycles broken.
   std::size_t ResolveDeadlocks(double t);
 
