@@ -300,6 +300,22 @@ void OutboundToProto(const RobotOutbound& m, pb::ServerMessage* out) {
       c->set_reason(m.reason);
       break;
     }
+    case RobotOutbound::Kind::kGrant: {
+      auto* g = out->mutable_grant();
+      g->set_intersection_id(m.intersection_id);
+      g->set_intersection_name(m.intersection_name);
+      g->set_release_up_to_sequence(m.released_up_to);
+      break;
+    }
+    case RobotOutbound::Kind::kHold: {
+      auto* h = out->mutable_hold();
+      h->set_stop_at_sequence(m.stop_at_sequence);
+      h->set_reason(m.reason);
+      break;
+    }
+    case RobotOutbound::Kind::kResume:
+      out->mutable_resume()->set_release_up_to_sequence(m.released_up_to);
+      break;
   }
 }
 

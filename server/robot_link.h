@@ -52,7 +52,7 @@ struct OutboundWaypoint {
 };
 
 struct RobotOutbound {
-  enum class Kind { kWelcome, kAssignment, kPlanUpdate, kCancel };
+  enum class Kind { kWelcome, kAssignment, kPlanUpdate, kCancel, kGrant, kHold, kResume };
   Kind kind = Kind::kWelcome;
   std::uint64_t sequence = 0;
   double server_time = 0.0;
@@ -69,8 +69,14 @@ struct RobotOutbound {
   std::vector<OutboundWaypoint> waypoints;
   std::uint64_t released_up_to = 0;
   std::vector<std::string> formation_members;
-  // kCancel (order_ids above: the cancelled orders)
+  // kCancel (order_ids above: the cancelled orders), kHold: why
   std::string reason;
+  // kGrant (released_up_to above: the new horizon; intersection -1 for a plain lane release),
+  // kResume (released_up_to above)
+  int intersection_id = -1;
+  std::string intersection_name;
+  // kHold: stop at this waypoint sequence (0: at once)
+  std::uint64_t stop_at_sequence = 0;
 };
 
 class RobotLink {
