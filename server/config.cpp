@@ -42,6 +42,10 @@ std::vector<Key> Keys() {
       MakeKey("heartbeat_interval", &ServerConfig::heartbeat_interval),
       MakeKey("heartbeat_timeout", &ServerConfig::heartbeat_timeout),
       MakeKey("offline_grace", &ServerConfig::offline_grace),
+      MakeKey("traffic_control", &ServerConfig::traffic_control),
+      MakeKey("t_w1", &ServerConfig::t_w1),
+      MakeKey("t_w2", &ServerConfig::t_w2),
+      MakeKey("blocked_after", &ServerConfig::blocked_after),
       MakeKey("ports_file", &ServerConfig::ports_file),
       MakeKey("ready_fd", &ServerConfig::ready_fd),
       MakeKey("log_level", &ServerConfig::log_level),
@@ -108,6 +112,9 @@ engine::Status ValidateServerConfig(const ServerConfig& c) {
   if (!std::isfinite(c.offline_grace) || c.offline_grace < 0) {
     return InvalidArgument("offline_grace must be >= 0");
   }
+  for (auto [name, v] : {std::pair{"t_w1", c.t_w1}, {"t_w2", c.t_w2}, {"blocked_after", c.blocked_after}}) {
+    if (!positive(v)) return InvalidArgument(std::string(name) + " must be > 0 seconds");
+  }
   return engine::Ok{};
 }
 
@@ -133,6 +140,15 @@ engine::Result<ParsedCommandLine> ParseCommandLine(int argc, char** argv) {
       ->capture_default_str();
   app.add_option("--offline-grace", flags.offline_grace,
                  "Seconds offline before a robot's orders are re-allocated")
+      ->capture_default_str();
+  app.add_option("--traffic-control", flags.traffic_control,
+                 "Release waypoints through the traffic controller (grants, holds, detours)")
+      ->capture_default_str();
+  app.add_option("--t-w1", flags.t_w1, "Head-on wait before re-planning, dispatcher s")->capture_default_str();
+  app.add_option("--t-w2", flags.t_w2, "Wait on a held point before re-planning, dispatcher s")
+      ->capture_default_str();
+  app.add_option("--blocked-after", flags.blocked_after,
+                 "Waiting with no alternative this long marks a robot blocked, dispatcher s")
       ->capture_default_str();
   app.add_option("--ports-file", flags.ports_file, "Write the chosen ports as JSON here");
   app.add_option("--ready-fd", flags.ready_fd,

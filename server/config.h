@@ -24,6 +24,12 @@ struct ServerConfig {
   double heartbeat_interval = 1.0;  // wall seconds between robot heartbeats
   double heartbeat_timeout = 5.0;   // wall seconds of silence before a robot is offline
   double offline_grace = 10.0;      // wall seconds offline before its orders are re-allocated
+  // Traffic control (SPEC §3.5): release waypoints through the engine's TrafficController
+  // (grants, holds, detours); false sends every waypoint released.
+  bool traffic_control = true;
+  double t_w1 = 10.0;           // s: head-on (single-lane) wait before re-planning (Wang2019)
+  double t_w2 = 20.0;           // s: wait on a held point or grant before re-planning
+  double blocked_after = 120.0; // s of waiting with no alternative -> robot blocked (fault)
   std::string ports_file;         // written as {"grpc_port":..,"http_port":..} once listening
   // An inherited file descriptor (e.g. a pipe or FIFO from a script) that gets the same JSON
   // line once listening, then is closed: readiness without polling. -1 = none.

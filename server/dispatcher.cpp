@@ -44,6 +44,12 @@ engine::Result<std::unique_ptr<Dispatcher>> Dispatcher::Create(
   }
   std::unique_ptr<Dispatcher> d(new Dispatcher(std::move(map), std::move(routes), store,
                                                std::move(options), std::move(allocator)));
+  if (d->options_.traffic_control) {
+    if (auto valid = d->options_.traffic.Validate(); !valid.ok()) return valid.error();
+    auto gate = TrafficGate::Create(d->map_, d->routes_, d->options_.traffic);
+    if (!gate.ok()) return gate.error();
+    d->gate_ = std::move(gate).value();
+  }
   if (auto recovered = d->Recover(); !recovered.ok()) return recovered.error();
   d->Publish();
   return d;
@@ -174,7 +180,9 @@ double Dispatcher::Now() const {
 }
 
 void Dispatcher::Loop() {
-  const double tick_s = std::clamp(options_.heartbeat_timeout / 10.0, 0.01, 0.5);
+  // Ticks also run the traffic controller for robots that report nothing new (a dwell ends,
+  // a held point frees up): at least 20 times per wall second.
+  const double tick_s = std::clamp(options_.heartbeat_timeout / 10.0, 0.01, gate_ ? 0.05 : 0.5);
   const auto tick = std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(tick_s));
   auto next_tick = Clock::now() + tick;
   for (;;) {
@@ -191,6 +199,7 @@ void Dispatcher::Loop() {
       Tick();
       next_tick = Clock::now() + tick;
     }
+    StepTraffic();
     // Publish first, then let replies, robot messages and journal events out: whoever hears
     // of a change finds it in the snapshot.
     if (dirty_) Publish();
@@ -227,6 +236,22 @@ void Dispatcher::Publish() {
       view.waypoints = r.assignment.plan.waypoints.size();
     }
     snap->robots.emplace(id, std::move(view));
+  }
+  if (gate_) {
+    TrafficView& t = snap->traffic;
+    t.enabled = true;
+    t.grants = traffic_counts_.grants;
+    t.holds = traffic_counts_.holds;
+    t.replans = traffic_counts_.replans;
+    t.deadlocks_resolved = gate_->stats().deadlocks_resolved;
+    t.head_on_conflicts = gate_->stats().head_on_conflicts;
+    t.nudges = gate_->stats().nudges;
+    if (std::isfinite(min_distance_.distance)) {
+      t.min_distance = min_distance_.distance;
+      t.min_pair_a = min_distance_.a;
+      t.min_pair_b = min_distance_.b;
+      t.min_time = min_distance_.time;
+    }
   }
   std::atomic_store(&snapshot_, std::shared_ptr<const Snapshot>(std::move(snap)));
   dirty_ = false;

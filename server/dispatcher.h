@@ -21,9 +21,13 @@
 // Orders stay `accepted` while no robot (or fewer than 3 for a formation) is connected.
 //
 // Robots: Hello registers (snapping the pose to the nearest map point within
-// Options::robot_snap_tolerance); waypoints are numbered over the robot's whole life; every
-// waypoint is sent released (intersection grants and holds come with the traffic controller
-// in a later slice). Progress: a pick (waypoint reached or picked event) moves the order to
+// Options::robot_snap_tolerance); waypoints are numbered over the robot's whole life
+// (AssignmentRecord::released_up_to keeps the highest sequence ever issued). Traffic control
+// (dispatcher_traffic.cpp, TrafficGate): plans are sent with only the waypoints at the
+// robot's point released; after every batch the gate runs the TrafficController and its
+// releases go out as Grants (Resume after a Hold), its waits as Holds with the reason, its
+// detours as PlanUpdates; a robot blocked with no alternative loses its orders (assigned ones
+// are re-allocated, in-progress ones fail) and is marked fault. Progress: a pick (waypoint reached or picked event) moves the order to
 // in_progress, the drop of every team member completes it. A robot silent for
 // heartbeat_timeout goes offline (stream closed); after offline_grace more its assigned
 // orders go back to accepted and are re-allocated, and its in_progress orders fail (the load
@@ -49,9 +53,11 @@
 #include "engine/allocation/allocator.h"
 #include "engine/fleet/order.h"
 #include "engine/routing/route_table.h"
+#include "engine/traffic/traffic_controller.h"
 #include "server/robot_link.h"
 #include "server/service_status.h"
 #include "server/snapshot.h"
+#include "server/traffic_gate.h"
 #include "server/watch_hub.h"
 #include "storage/store.h"
 
@@ -67,6 +73,10 @@ struct DispatcherOptions {
   engine::SnapOptions snap;          // order stops
   double robot_snap_tolerance = 1.0;  // metres from a Hello pose to its nearest point
   std::string map_version;
+  // Traffic control (server/traffic_gate.h): waypoints released point by point through the
+  // engine's TrafficController. Off: every waypoint is sent released (no grants or holds).
+  bool traffic_control = true;
+  engine::TrafficControllerConfig traffic;
 };
 
 struct SubmitReply {
@@ -113,6 +123,9 @@ class Dispatcher {
   void OnRobotMessage(std::shared_ptr<RobotLink> link, RobotInbound message);
   // The stream ended (client gone or cancelled).
   void OnRobotGone(std::shared_ptr<RobotLink> link);
+
+  // Loop thread only (e.g. from Call): each robot's traffic state in one line.
+  std::vector<std::pair<std::string, std::string>> TrafficLines() const;
 
   // Runs `fn` on the loop thread.
   void Post(std::function<void()> fn);
@@ -200,6 +213,13 @@ class Dispatcher {
   void Tick();
   void Publish();
 
+  // Traffic control (dispatcher_traffic.cpp).
+  GatePlan GatePlanOf(const RobotRuntime& robot) const;
+  void SyncGate(const RobotRuntime& robot);  // tells the gate the robot's current plan
+  void StepTraffic();
+  void ApplyGateEffect(GateEffect& effect);
+  std::uint64_t ReleasedUpTo(const RobotRuntime& robot) const;
+
   const std::shared_ptr<const engine::WarehouseMap> map_;
   const std::shared_ptr<const engine::RouteTable> routes_;
   storage::Store& store_;
@@ -218,6 +238,7 @@ class Dispatcher {
 
   // Loop-thread state (no lock: only the loop touches it after Start).
   std::unique_ptr<engine::Allocator> allocator_;
+  std::unique_ptr<TrafficGate> gate_;  // null when traffic control is off
   Clock::time_point wall_start_;
   double time_base_ = 0.0;  // dispatcher seconds at wall_start_
   std::vector<std::shared_ptr<const OrderView>> orders_;
@@ -230,6 +251,11 @@ class Dispatcher {
   bool dirty_ = true;
   std::vector<std::function<void()>> deferred_;  // effects of the current batch
   bool retry_allocation_ = false;
+  MinDistance min_distance_;
+  Clock::time_point next_distance_sample_{};
+  struct {
+    std::uint64_t grants = 0, holds = 0, replans = 0;
+  } traffic_counts_;
 };
 
 }  // namespace dispatch::server

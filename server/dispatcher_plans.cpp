@@ -89,14 +89,14 @@ RobotOutbound Dispatcher::PlanMessage(const RobotRuntime& robot, bool full,
   m.plan_id = a.plan_id;
   m.from_sequence = from_sequence;
   m.order_ids = a.order_ids;
-  // Every waypoint is released: intersection grants and holds come with the traffic
-  // controller in a later slice.
+  // Released: what the traffic gate has released so far (everything without traffic control).
+  const std::uint64_t released = ReleasedUpTo(robot);
   for (std::size_t i = 0; i < a.plan.waypoints.size(); ++i) {
     const auto& w = a.plan.waypoints[i];
     if (!full && static_cast<std::uint64_t>(w.seq) < from_sequence) continue;
-    m.waypoints.push_back({w, OrderOfWaypoint(a, i), true});
+    m.waypoints.push_back({w, OrderOfWaypoint(a, i), static_cast<std::uint64_t>(w.seq) <= released});
   }
-  m.released_up_to = a.plan.waypoints.empty() ? 0 : static_cast<std::uint64_t>(a.plan.waypoints.back().seq);
+  m.released_up_to = released;
   for (const auto& id : a.order_ids) {
     auto view = Find(id);
     if (view && view->record.order.formation) {
@@ -125,7 +125,7 @@ void Dispatcher::AllocatePending() {
   std::vector<std::string> ids;
   for (const auto& [id, r] : robots_) {
     if (r.link && r.record.robot.current_point != engine::kNoPoint &&
-        r.record.robot.state != engine::RobotState::kFault) {
+        r.record.robot.state != engine::RobotState::kFault && (!gate_ || gate_->Available(id))) {
       ids.push_back(id);
     }
   }
@@ -145,6 +145,10 @@ void Dispatcher::AllocatePending() {
     engine::FleetRobot f;
     f.id = id;
     f.start = r.record.robot.current_point;
+    if (gate_ && !HasOrders(r.assignment, r.has_assignment)) {
+      // A new plan starts where the traffic controller has the robot (standing or arriving).
+      if (const engine::PointId p = gate_->StartPoint(id); p != engine::kNoPoint) f.start = p;
+    }
     f.ready_time = now;
     fleet_robots.push_back(f);
   }
@@ -286,8 +290,10 @@ bool Dispatcher::AwardOrder(const engine::Order& order, engine::FleetState& flee
     r.assignment = std::move(c.assignment);
     r.has_assignment = true;
     r.record.robot.task_queue = r.assignment.order_ids;
-    SendTo(r, PlanMessage(r, c.fresh, c.first_new));
   }
+  // The gate learns every member's plan before any is sent (a formation needs all three).
+  for (auto& c : changes) SyncGate(*c.robot);
+  for (auto& c : changes) SendTo(*c.robot, PlanMessage(*c.robot, c.fresh, c.first_new));
   spdlog::info("order {} assigned: {}", order.id, award->reason);
   dirty_ = true;
   return true;
@@ -383,6 +389,7 @@ bool Dispatcher::ReleaseOrders(const std::vector<std::string>& order_ids,
     cancel.order_ids = removed[robot_id];
     cancel.reason = reason;
     SendTo(r, std::move(cancel));
+    SyncGate(r);
   }
   dirty_ = true;
   return true;

@@ -63,9 +63,13 @@ void Dispatcher::DoRobotMessage(const std::shared_ptr<RobotLink>& link, const Ro
       } else {
         r->record.robot.current_point = map_->NearestPoint(m.pose.position);
       }
-      if (m.state && *m.state != engine::RobotState::kOffline) r->record.robot.state = *m.state;
+      if (m.state && *m.state != engine::RobotState::kOffline &&
+          r->record.robot.state != engine::RobotState::kFault) {
+        r->record.robot.state = *m.state;
+      }
       if (m.battery) r->record.robot.battery = *m.battery;
       r->last_reached = std::max(r->last_reached, m.sequence);
+      if (gate_) gate_->Report(r->record.robot.id, m.pose.position, m.sequence, Now());
       break;
     }
     case RobotInbound::Kind::kWaypointReached: DoWaypointReached(*r, m); break;
@@ -91,14 +95,23 @@ void Dispatcher::DoHello(const std::shared_ptr<RobotLink>& link, const RobotInbo
   if (!std::isfinite(xy.x()) || !std::isfinite(xy.y()) || !std::isfinite(hello.pose.heading)) {
     return reject(StatusCode::kInvalidArgument, "robot " + hello.robot_id + ": pose is not finite");
   }
+  // On the map: within the tolerance of a point, or of a lane (a robot that stopped between
+  // two points, e.g. when its stream broke: it stands for the point it was driving to).
   double distance = 0.0;
-  const engine::PointId point = map_->NearestPoint(xy, std::nullopt, &distance);
+  engine::PointId point = map_->NearestPoint(xy, std::nullopt, &distance);
   if (point == engine::kNoPoint || distance > options_.robot_snap_tolerance) {
-    std::string nearest = point == engine::kNoPoint ? "none" : "'" + map_->point(point).name + "' " + Fixed(distance) + " m away";
-    return reject(StatusCode::kInvalidArgument,
-                  "robot " + hello.robot_id + ": pose (" + Fixed(xy.x()) + ", " + Fixed(xy.y()) +
-                      ") is not on the map (nearest point " + nearest + ", tolerance " +
-                      Fixed(options_.robot_snap_tolerance) + " m)");
+    double lane_distance = 0.0;
+    auto on_lane = map_->NearestArcPosition(xy, &lane_distance);
+    if (on_lane.ok() && lane_distance <= options_.robot_snap_tolerance) {
+      point = map_->arc(on_lane->arc).to;
+    } else {
+      std::string nearest = point == engine::kNoPoint ? "none" : "'" + map_->point(point).name + "' " + Fixed(distance) + " m away";
+      return reject(StatusCode::kInvalidArgument,
+                    "robot " + hello.robot_id + ": pose (" + Fixed(xy.x()) + ", " + Fixed(xy.y()) +
+                        ") is not on the map (nearest point " + nearest + ", nearest lane " +
+                        (on_lane.ok() ? Fixed(lane_distance) + " m away" : std::string("none")) +
+                        ", tolerance " + Fixed(options_.robot_snap_tolerance) + " m)");
+    }
   }
   auto [it, inserted] = robots_.try_emplace(hello.robot_id);
   RobotRuntime& r = it->second;
@@ -150,6 +163,10 @@ void Dispatcher::DoHello(const std::shared_ptr<RobotLink>& link, const RobotInbo
   welcome.heartbeat_timeout = options_.heartbeat_timeout;
   welcome.resume_from_sequence = record.last_acked_sequence + 1;
   welcome.map_version = options_.map_version;
+  if (gate_) {
+    gate_->Connect(hello.robot_id, xy, point);
+    SyncGate(r);
+  }
   SendTo(r, std::move(welcome));
   // Resume: the robot gets its whole current plan again (it skips waypoints it has passed).
   if (resend) SendTo(r, PlanMessage(r, true, 0));
@@ -183,6 +200,7 @@ void Dispatcher::DoWaypointReached(RobotRuntime& r, const RobotInbound& m) {
     if (static_cast<std::uint64_t>(w[i].seq) != m.sequence) continue;
     r.record.robot.current_point = w[i].point;
     r.last_reached = std::max(r.last_reached, m.sequence);
+    if (gate_) gate_->Reached(r.record.robot.id, m.sequence, Now());
     if (std::isfinite(m.pose.position.x()) && std::isfinite(m.pose.position.y())) r.record.robot.pose = m.pose;
     if (w[i].action == engine::WaypointAction::kPick) {
       const std::string order = OrderOfWaypoint(r.assignment, i);
@@ -247,6 +265,7 @@ void Dispatcher::DoTaskEvent(RobotRuntime& r, const RobotInbound& m) {
   if (trimmed) {
     r.assignment = std::move(plan);
     r.record.robot.task_queue = r.assignment.order_ids;
+    SyncGate(r);
   }
   auto copy = std::make_shared<OrderView>(*view);
   copy->dropped_by = std::move(dropped);
@@ -270,6 +289,7 @@ void Dispatcher::MarkOffline(RobotRuntime& r, const std::string& why) {
   r.record.robot.state = engine::RobotState::kOffline;
   r.offline_since = Clock::now();
   dirty_ = true;
+  if (gate_) gate_->Disconnect(r.record.robot.id);
   if (auto saved = store_.UpsertRobot(r.record); !saved.ok()) {
     spdlog::warn("robot {} offline state not stored: {}", r.record.robot.id, saved.error().message);
   }

@@ -21,6 +21,7 @@ RestServer::RestServer(RestHandlers handlers)
   s.Get("/readyz", [&h](const httplib::Request&, httplib::Response& res) { Reply(res, h.Ready()); });
   s.Get("/api/v1/status", [&h](const httplib::Request&, httplib::Response& res) { Reply(res, h.Status()); });
   s.Get("/api/v1/robots", [&h](const httplib::Request&, httplib::Response& res) { Reply(res, h.Robots()); });
+  s.Get("/api/v1/traffic", [&h](const httplib::Request&, httplib::Response& res) { Reply(res, h.Traffic()); });
   s.Get(R"(/api/v1/robots/([^/]+))", [&h](const httplib::Request& req, httplib::Response& res) {
     Reply(res, h.Robot(req.matches[1]));
   });

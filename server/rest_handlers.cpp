@@ -93,6 +93,20 @@ RestReply RestHandlers::Status() const {
   for (const auto& o : snap->orders) orders[engine::OrderStateName(o->record.order.state)] = orders[engine::OrderStateName(o->record.order.state)].get<int>() + 1;
   int connected = 0;
   for (const auto& [id, r] : snap->robots) connected += r.connected ? 1 : 0;
+  const TrafficView& t = snap->traffic;
+  json traffic = {{"control", t.enabled},
+                  {"grants", t.grants},
+                  {"holds", t.holds},
+                  {"replans", t.replans},
+                  {"deadlocks_resolved", t.deadlocks_resolved},
+                  {"head_on_conflicts", t.head_on_conflicts},
+                  {"nudges", t.nudges},
+                  {"min_robot_distance", nullptr}};
+  if (t.min_distance >= 0) {
+    traffic["min_robot_distance"] = {{"distance", t.min_distance},
+                                     {"robots", {t.min_pair_a, t.min_pair_b}},
+                                     {"time", t.min_time}};
+  }
   return {200,
           {{"map", snap->map_name},
            {"map_version", snap->map_version},
@@ -101,7 +115,18 @@ RestReply RestHandlers::Status() const {
            {"time_scale", snap->time_scale},
            {"snapshot", snap->version},
            {"orders", orders},
-           {"robots", {{"total", snap->robots.size()}, {"connected", connected}}}}};
+           {"robots", {{"total", snap->robots.size()}, {"connected", connected}}},
+           {"traffic", traffic}}};
+}
+
+RestReply RestHandlers::Traffic() {
+  using Lines = std::vector<std::pair<std::string, std::string>>;
+  Lines lines = dispatcher_.Call<Lines>([this](std::function<void(Lines)> done) {
+    done(dispatcher_.TrafficLines());
+  });
+  json robots = json::object();
+  for (const auto& [id, line] : lines) robots[id] = line;
+  return {200, {{"robots", robots}}};
 }
 
 RestReply RestHandlers::Robots() const {

@@ -30,6 +30,8 @@ class RestHandlers {
   RestReply Robot(const std::string& id) const;
   // state: a lower-case order state name, or nullopt for all.
   RestReply Orders(const std::optional<std::string>& state) const;
+  // GET /api/v1/traffic: every robot's traffic state (where, route, what it waits on).
+  RestReply Traffic();
   RestReply Order(const std::string& id) const;
   // body: {"client_order_id": "...", "picks": ["P1-1-1" | {"x":..,"y":..}, ...],
   //        "drop": "D1" | {"x":..,"y":..}, "priority": 0, "formation": false,

@@ -113,6 +113,11 @@ engine::Result<std::unique_ptr<DispatchServer>> DispatchServer::Start(const Serv
   options.heartbeat_interval = config.heartbeat_interval;
   options.heartbeat_timeout = config.heartbeat_timeout;
   options.offline_grace = config.offline_grace;
+  options.traffic_control = config.traffic_control;
+  options.traffic.speed = allocation.speed;
+  options.traffic.t_w1 = config.t_w1;
+  options.traffic.t_w2 = config.t_w2;
+  options.traffic.blocked_after = config.blocked_after;
   options.map_version = recorded->content_hash;
   auto dispatcher = Dispatcher::Create(map, shared_routes, *s->store_, options);
   if (!dispatcher.ok()) return dispatcher.error();

@@ -44,6 +44,20 @@ struct RobotView {
   std::size_t waypoints = 0;  // in its current plan
 };
 
+// The traffic layer's counters and the closest two robots seen (server/traffic_gate.h).
+struct TrafficView {
+  bool enabled = false;
+  std::uint64_t grants = 0;    // releases sent as Grant messages
+  std::uint64_t holds = 0;     // Hold messages
+  std::uint64_t replans = 0;   // legs re-planned on the controller's word (detours, back-offs)
+  std::size_t deadlocks_resolved = 0;
+  std::size_t head_on_conflicts = 0;
+  std::size_t nudges = 0;
+  double min_distance = -1.0;  // m between robot centres of different agents; < 0: none yet
+  std::string min_pair_a, min_pair_b;
+  double min_time = 0.0;
+};
+
 struct Snapshot {
   std::uint64_t version = 0;  // increases with every publish
   double time = 0.0;          // dispatcher seconds at publish
@@ -55,6 +69,7 @@ struct Snapshot {
   std::unordered_map<std::string, std::size_t> by_id;         // order id -> index
   std::unordered_map<std::string, std::size_t> by_client_id;  // client id -> index
   std::map<std::string, RobotView> robots;                    // by id
+  TrafficView traffic;
 
   std::shared_ptr<const OrderView> FindOrder(const std::string& id) const {
     auto it = by_id.find(id);

@@ -213,14 +213,39 @@ class FakeRobot {
     }
   }
 
-  // Reports every waypoint of `waypoints` in order, with picked/dropped task events.
-  void Follow(const google::protobuf::RepeatedPtrField<pb::TimedWaypoint>& waypoints) {
+  // Reports every waypoint of `waypoints` in order, with picked/dropped task events, each only
+  // once the release horizon covers it: `released_up_to` at first, then raised by the Grant and
+  // Resume messages the server sends (traffic control). A state report goes with every
+  // waypoint. Returns the Grants received, or -1 when no release came in time.
+  int Follow(const google::protobuf::RepeatedPtrField<pb::TimedWaypoint>& waypoints,
+             std::uint64_t released_up_to) {
+    int grants = 0;
+    const auto deadline = std::chrono::steady_clock::now() + kTimeout;
     for (const auto& w : waypoints) {
+      while (w.sequence() > released_up_to) {
+        const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(deadline - std::chrono::steady_clock::now());
+        if (left.count() <= 0) return -1;
+        auto m = messages_.Pop(left);
+        if (!m) return -1;
+        last_sequence_ = m->sequence();
+        if (m->has_grant()) {
+          ++grants;
+          released_up_to = std::max<std::uint64_t>(released_up_to, m->grant().release_up_to_sequence());
+        } else if (m->has_resume()) {
+          released_up_to = std::max<std::uint64_t>(released_up_to, m->resume().release_up_to_sequence());
+        }
+      }
+      pb::RobotMessage report;
+      auto* r = report.mutable_state_report();
+      r->mutable_pose()->set_x(w.x());
+      r->mutable_pose()->set_y(w.y());
+      r->set_state(pb::ROBOT_STATE_MOVING);
+      r->set_last_waypoint_sequence(w.sequence());
       pb::RobotMessage reached;
       reached.mutable_waypoint_reached()->set_sequence(w.sequence());
       reached.mutable_waypoint_reached()->mutable_pose()->set_x(w.x());
       reached.mutable_waypoint_reached()->mutable_pose()->set_y(w.y());
-      ASSERT_TRUE(stream_->Write(reached));
+      if (!stream_->Write(reached)) return -1;
       if (w.action() == pb::WAYPOINT_ACTION_PICK || w.action() == pb::WAYPOINT_ACTION_DROP) {
         pb::RobotMessage event;
         auto* e = event.mutable_task_event();
@@ -229,9 +254,11 @@ class FakeRobot {
                                                            : pb::TASK_EVENT_TYPE_DROPPED);
         e->set_point_id(w.point_id());
         e->set_waypoint_sequence(w.sequence());
-        ASSERT_TRUE(stream_->Write(event));
+        if (!stream_->Write(event)) return -1;
       }
+      if (!stream_->Write(report)) return -1;
     }
+    return grants;
   }
   void Heartbeat() {
     pb::RobotMessage m;

@@ -1,0 +1,143 @@
+// Dispatcher: traffic control on the wire. The TrafficGate (server/traffic_gate.h) runs the
+// engine's TrafficController on what robots report; here its effects become Grant, Hold,
+// Resume and PlanUpdate messages, and blocked robots give their orders back.
+#include <spdlog/spdlog.h>
+
+#include <algorithm>
+
+#include "server/dispatcher.h"
+
+namespace dispatch::server {
+
+GatePlan Dispatcher::GatePlanOf(const RobotRuntime& r) const {
+  GatePlan g;
+  const auto& w = r.assignment.plan.waypoints;
+  g.waypoints = w;
+  for (std::size_t i = 0; i < w.size(); ++i) g.order_of.push_back(OrderOfWaypoint(r.assignment, i));
+  for (const auto& id : r.assignment.order_ids) {
+    auto view = Find(id);
+    if (view && view->record.order.formation) g.teams[id] = view->record.robots;
+  }
+  g.next_sequence = static_cast<std::uint64_t>(r.assignment.released_up_to) + 1;
+  if (!w.empty()) g.next_sequence = std::max<std::uint64_t>(g.next_sequence, w.back().seq + 1);
+  return g;
+}
+
+void Dispatcher::SyncGate(const RobotRuntime& r) {
+  if (!gate_) return;
+  spdlog::debug("plan of {}: {} waypoints, orders {}", r.record.robot.id, r.assignment.plan.waypoints.size(),
+                r.assignment.order_ids.size());
+  if (r.has_assignment) {
+    gate_->SetPlan(r.record.robot.id, GatePlanOf(r));
+  } else {
+    gate_->SetPlan(r.record.robot.id, GatePlan{});
+  }
+}
+
+std::uint64_t Dispatcher::ReleasedUpTo(const RobotRuntime& r) const {
+  const auto& w = r.assignment.plan.waypoints;
+  if (!gate_) return w.empty() ? 0 : static_cast<std::uint64_t>(w.back().seq);
+  return gate_->ReleasedUpTo(r.record.robot.id);
+}
+
+std::vector<std::pair<std::string, std::string>> Dispatcher::TrafficLines() const {
+  std::vector<std::pair<std::string, std::string>> out;
+  for (const auto& [id, r] : robots_) {
+    out.emplace_back(id, gate_ ? gate_->Describe(id) : std::string("traffic control off"));
+  }
+  return out;
+}
+
+void Dispatcher::StepTraffic() {
+  if (!gate_) return;
+  const double now = Now();
+  std::vector<GateEffect> effects = gate_->Step(now);
+  for (GateEffect& e : effects) ApplyGateEffect(e);
+  if (const auto wall = Clock::now(); wall >= next_distance_sample_) {  // 20 Hz: reports come at ~10
+    gate_->SampleDistances(now);
+    next_distance_sample_ = wall + std::chrono::milliseconds(50);
+  }
+  const MinDistance& d = gate_->min_distance();
+  if (d.distance != min_distance_.distance || d.time != min_distance_.time) {
+    if (d.distance < options_.traffic.point_clearance - 1e-6) {
+      spdlog::warn("robots {} and {} {:.3f} m apart (closer than eps1): {} | {}", d.a, d.b, d.distance,
+                   gate_->Describe(d.a), gate_->Describe(d.b));
+    }
+    min_distance_ = d;
+    dirty_ = true;
+  }
+}
+
+void Dispatcher::ApplyGateEffect(GateEffect& e) {
+  RobotRuntime* r = RobotOf(e.robot);
+  if (!r) return;
+  switch (e.kind) {
+    case GateEffect::Kind::kRelease: {
+      RobotOutbound m;
+      m.released_up_to = e.release_up_to;
+      if (e.resume) {
+        m.kind = RobotOutbound::Kind::kResume;
+      } else {
+        m.kind = RobotOutbound::Kind::kGrant;
+        m.intersection_id = e.intersection;
+        if (e.intersection >= 0 && static_cast<std::size_t>(e.intersection) < map_->intersections().size()) {
+          m.intersection_name = map_->intersections()[static_cast<std::size_t>(e.intersection)].name;
+        } else {
+          m.intersection_id = -1;
+        }
+        ++traffic_counts_.grants;
+      }
+      SendTo(*r, std::move(m));
+      break;
+    }
+    case GateEffect::Kind::kHold: {
+      RobotOutbound m;
+      m.kind = RobotOutbound::Kind::kHold;
+      m.stop_at_sequence = e.hold_at;
+      m.reason = e.reason;
+      ++traffic_counts_.holds;
+      spdlog::debug("hold {}: {}", e.robot, e.reason);
+      SendTo(*r, std::move(m));
+      break;
+    }
+    case GateEffect::Kind::kRewrite: {
+      storage::AssignmentRecord a = r->assignment;
+      a.plan.waypoints = std::move(e.waypoints);
+      if (!a.plan.waypoints.empty()) {
+        a.released_up_to = std::max<std::int64_t>(a.released_up_to, a.plan.waypoints.back().seq);
+      }
+      a.updated_time = Now();
+      if (auto saved = store_.SaveAssignment(a); !saved.ok()) {
+        // The robot drives the new leg all the same (the controller has it); a restart falls
+        // back to the stored plan and re-routes from where the robot stands.
+        spdlog::warn("re-planned leg of {} not stored: {}", e.robot, saved.error().message);
+      }
+      r->assignment = std::move(a);
+      r->has_assignment = true;
+      ++traffic_counts_.replans;
+      spdlog::debug("re-plan {} from waypoint {}: {} waypoints", e.robot, e.from_sequence,
+                    r->assignment.plan.waypoints.size());
+      SendTo(*r, PlanMessage(*r, false, e.from_sequence));
+      dirty_ = true;
+      break;
+    }
+    case GateEffect::Kind::kBlocked: {
+      spdlog::warn("robot {} blocked: {} ({})", e.robot, e.reason, gate_->Describe(e.robot));
+      for (const auto& [id, other] : robots_) spdlog::info("traffic: {}", gate_->Describe(id));
+      r->record.robot.state = engine::RobotState::kFault;
+      dirty_ = true;
+      if (!r->has_assignment || r->assignment.order_ids.empty()) break;
+      ServiceStatus status;
+      auto target = [](const OrderView& v) {
+        return v.record.order.state == engine::OrderState::kInProgress ? engine::OrderState::kFailed
+                                                                       : engine::OrderState::kAccepted;
+      };
+      if (ReleaseOrders(r->assignment.order_ids, target, "robot " + e.robot + " blocked: " + e.reason, &status)) {
+        retry_allocation_ = true;
+      }
+      break;
+    }
+  }
+}
+
+}  // namespace dispatch::server

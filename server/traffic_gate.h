@@ -1,0 +1,137 @@
+// TrafficGate: the engine's TrafficController (SPEC §3.5) driven by the dispatcher loop from
+// what robots report, turned into releases of their timed waypoints (issue 5 §1: waypoints
+// beyond the next point are sent unreleased; a Grant releases them).
+//
+// Model. Every connected robot is an agent of the controller standing at (or driving to) a
+// map point. A robot's plan is cut into legs: from the point it stands at to its next stop (a
+// pick, a drop, a wait with dwell, a formation's rendezvous, or the plan's end). The leg's
+// points are the controller route; when the controller says kGo for the next point, the gate
+// releases the robot's waypoints up to the last one at that point (kRelease). The robot
+// reports WaypointReached at that point: the gate calls Arrived. A robot never asks to leave
+// a point before it has reached the last waypoint there and its dwell (work) is over.
+// Waiting robots get a Hold with the controller's reason once, and a release with `resume`
+// when they may go again. A detour, back-off or nudge of the controller rewrites the leg's
+// waypoints (kRewrite: the new plan; the dispatcher stores it and sends a PlanUpdate). A robot
+// with no alternative for too long is reported (kBlocked) and stays put.
+//
+// Formations (Chu2024 §3.2, issue 4 §3). Members drive their approach legs alone. At the
+// point before the first pick P a member joins the team: the team's own agent (one agent
+// with the formation's envelope) takes P, the member leaves the controller and is released
+// into its slot. When all three stand in their slots the team agent drives the centre's route
+// (members released in lockstep, team Arrived when all three reached the point); after the
+// drop the members go back into the controller one by one at the drop point (the next one
+// when the previous has left it; an idle member steps aside to a siding).
+//
+// Offline robots stay in the controller where they were (they physically block the floor
+// until they come back or an operator moves them); on reconnect an agent that stands
+// elsewhere is re-placed and its leg re-routed from there.
+//
+// Minimum distance: the smallest centre distance between two reported robots of different
+// agents (formation members of one team excluded), kept with the pair and the time.
+//
+// Not thread-safe: one owner (the dispatcher loop).
+#pragma once
+
+#include <Eigen/Core>
+
+#include <cstdint>
+#include <limits>
+#include <map>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "engine/common/result.h"
+#include "engine/fleet/plan.h"
+#include "engine/map/warehouse_map.h"
+#include "engine/routing/route_table.h"
+#include "engine/traffic/traffic_controller.h"
+
+namespace dispatch::server {
+
+struct GateEffect {
+  enum class Kind { kRelease, kHold, kRewrite, kBlocked };
+  Kind kind = Kind::kRelease;
+  std::string robot;
+  // kRelease: waypoints up to this sequence may be driven to. intersection >= 0 when the
+  // release enters an intersection's inner region (a Grant of that intersection); resume when
+  // the robot was held before (send Resume).
+  std::uint64_t release_up_to = 0;
+  int intersection = -1;
+  bool resume = false;
+  // kHold, kBlocked: why; kHold: stop at this waypoint sequence.
+  std::string reason;
+  std::uint64_t hold_at = 0;
+  // kRewrite: the robot's whole new plan (same orders and stops); waypoints from
+  // from_sequence on are new.
+  std::vector<engine::Waypoint> waypoints;
+  std::uint64_t from_sequence = 0;
+};
+
+// A robot's plan as the dispatcher holds it.
+struct GatePlan {
+  std::vector<engine::Waypoint> waypoints;  // seq = the robot's life-long waypoint sequence
+  std::vector<std::string> order_of;        // per waypoint: the order it serves ("" if none)
+  // Formation orders among them: order id -> members, leader first.
+  std::map<std::string, std::vector<std::string>> teams;
+  std::uint64_t next_sequence = 1;  // the first waypoint sequence never issued
+};
+
+struct MinDistance {
+  double distance = std::numeric_limits<double>::infinity();
+  std::string a, b;
+  double time = 0.0;
+};
+
+struct GateAgentView {
+  std::string robot;  // or "team:<order>" for a formation agent
+  engine::PointId at = engine::kNoPoint, next = engine::kNoPoint;
+  bool waiting = false;
+  std::string why;
+  std::uint64_t released_up_to = 0;
+};
+
+class TrafficGate {
+ public:
+  static engine::Result<std::unique_ptr<TrafficGate>> Create(
+      std::shared_ptr<const engine::WarehouseMap> map,
+      std::shared_ptr<const engine::RouteTable> routes, engine::TrafficControllerConfig config);
+  ~TrafficGate();
+  TrafficGate(const TrafficGate&) = delete;
+  TrafficGate& operator=(const TrafficGate&) = delete;
+
+  // The robot's stream is up; it stands near `xy` (nearest point `point`).
+  void Connect(const std::string& robot, const Eigen::Vector2d& xy, engine::PointId point);
+  // The stream is gone: the robot keeps its place but asks for nothing.
+  void Disconnect(const std::string& robot);
+  // The robot's plan changed (award, cancel, drop trimmed, restart).
+  void SetPlan(const std::string& robot, GatePlan plan);
+  void Reached(const std::string& robot, std::uint64_t sequence, double t);
+  // A state report: position and the last waypoint passed.
+  void Report(const std::string& robot, const Eigen::Vector2d& xy, std::uint64_t last_waypoint,
+              double t);
+  // Runs the controller for every agent and returns what to tell the robots.
+  std::vector<GateEffect> Step(double t);
+  // Updates the minimum distance from the robots' last reported positions (O(robots)).
+  void SampleDistances(double t);
+
+  // False while the robot still stands in a finished formation's slot, waiting to leave it.
+  bool Available(const std::string& robot) const;
+  // Where a new plan of the robot must start: the point it drives to, or stands at.
+  engine::PointId StartPoint(const std::string& robot) const;
+  // Highest waypoint sequence released to the robot.
+  std::uint64_t ReleasedUpTo(const std::string& robot) const;
+  const MinDistance& min_distance() const;
+  const engine::TrafficStats& stats() const;
+  std::vector<GateAgentView> Agents() const;
+  // One line on the robot's traffic state (for logs): where, route, what it waits on.
+  std::string Describe(const std::string& robot) const;
+
+ private:
+  struct Impl;
+  explicit TrafficGate(std::unique_ptr<Impl> impl);
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace dispatch::server

@@ -1,0 +1,133 @@
+// TrafficGate's state, shared by traffic_gate.cpp (solo agents) and traffic_gate_teams.cpp
+// (formations). Internal to the server; see traffic_gate.h for the model.
+#pragma once
+
+#include <functional>
+#include <optional>
+#include <map>
+#include <set>
+#include <string>
+#include <unordered_map>
+#include <vector>
+
+#include "server/traffic_gate.h"
+
+namespace dispatch::server {
+
+// One robot as the gate knows it.
+struct GateBot {
+  std::string id;
+  int ctl = -1;  // its controller agent (on the floor unless it is in a team or was removed)
+  bool connected = false;
+  bool synced = false;  // a state report since it connected (its last waypoint is known)
+  GatePlan plan;
+  std::unordered_map<std::uint64_t, std::size_t> index;  // waypoint sequence -> plan index
+  long idx = -1;                 // plan index of the last waypoint reached (-1: none)
+  std::uint64_t reached_seq = 0;  // highest waypoint sequence reached
+  double reach_time = 0.0;        // when it reached idx
+  std::uint64_t released = 0;     // highest waypoint sequence released
+  Eigen::Vector2d xy = Eigen::Vector2d::Zero();
+  bool has_xy = false;
+  bool left = false;      // LeftPoint done for the current drive
+  bool held = false;      // a Hold was sent for the current wait
+  bool resume_pending = false;  // reconnected: resend Resume if it was held
+  bool blocked = false;   // kBlocked reported for the current wait
+  bool stepped_aside = false;
+  engine::PointId home = engine::kNoPoint;  // the parking point it first connected at
+  std::string team;       // the formation order whose team it has joined ("": none)
+  // The team it left (at point former_at), until it has driven out of the team's envelope.
+  std::string former_team;
+  engine::PointId former_at = engine::kNoPoint;
+  std::uint64_t leave_seq = 0;  // leaving a team: the waypoint it was placed at (to reach first)
+  std::vector<engine::PointId> leg;  // the controller route as last set or adopted
+  long leg_stop = -1;     // plan index of the leg's last waypoint (-1: none)
+  bool leg_stale = true;  // recompute the leg before the next request
+};
+
+// One formation team (Chu2024 §3.2): the members, leader first, and their shared agent.
+struct GateTeam {
+  enum class Phase { kForming, kMoving, kLeaving };
+  std::string order;
+  std::vector<std::string> members;
+  int ctl = -1;  // the team agent (pooled controller index)
+  Phase phase = Phase::kForming;
+  std::set<std::string> joined;
+  long k = 0;        // formation index of the first waypoint of the run the team stands at
+  long next_k = -1;  // formation index of the first waypoint at the point it drives to
+  std::vector<engine::PointId> leg;
+  long leg_stop = -1;  // formation index of the leg's stop
+  bool leg_stale = true;
+  bool left = false;
+  bool blocked = false;
+  engine::PointId drop = engine::kNoPoint;  // where the team leaves from
+  std::map<std::string, std::uint64_t> drop_seq;  // member -> sequence of its drop waypoint
+};
+
+struct GateImpl {
+  struct TeamSpan {
+    long join = -1, first_pick = -1, drop = -1;
+    engine::PointId rendezvous = engine::kNoPoint;
+    std::uint64_t seq_first_pick = 0, seq_drop = 0;
+  };
+
+  GateImpl(std::shared_ptr<const engine::WarehouseMap> map, std::shared_ptr<const engine::RouteTable> routes,
+           engine::TrafficControllerConfig config, engine::TrafficController ctl);
+
+  std::shared_ptr<const engine::WarehouseMap> map;
+  std::shared_ptr<const engine::RouteTable> routes;
+  engine::TrafficControllerConfig config;
+  engine::TrafficController ctl;
+  std::map<std::string, GateBot> bots;
+  std::map<std::string, GateTeam> teams;  // by formation order id
+  std::set<std::string> finished_teams;   // formations that have left their drop point
+  std::vector<std::size_t> team_pool;     // removed team agents, reusable
+  std::size_t team_agents = 0;            // team agents ever added (their ids)
+  MinDistance min_distance;
+  // Per point: a service point other than parking is this point or within point_clearance
+  // of it (an idle robot standing there keeps others from serving).
+  std::vector<bool> blocks_service;
+  static int GroupOf(const std::string& order);  // the controller group of a formation
+
+  // Plans.
+  static long IndexOf(const GateBot& b, std::uint64_t seq);
+  // Last index of the run of waypoints at point p starting at `from` (at most `limit`);
+  // from - 1 when waypoint `from` is not at p.
+  static long RunEnd(const GateBot& b, long from, engine::PointId p, long limit);
+  double Departure(const GateBot& b, long i) const;
+  static bool IsStop(const engine::Waypoint& w);
+  std::optional<TeamSpan> SpanOf(const GateBot& b, const std::string& order) const;
+  long NextJoin(const GateBot& b, long from, std::string* order) const;
+  void Reindex(GateBot& b);
+  using Offset = std::function<Eigen::Vector2d(engine::PointId from, engine::PointId to)>;
+  long RewriteLeg(GateBot& b, long cut, const std::vector<engine::PointId>& route, long resume, double t,
+                  std::vector<GateEffect>& out, const Offset& offset = {});
+
+  // Effects.
+  void Release(GateBot& b, long upto, int intersection, std::vector<GateEffect>& out);
+  void Hold(GateBot& b, const std::string& why, std::vector<GateEffect>& out);
+
+  // Solo agents (traffic_gate.cpp).
+  bool OnFloor(const GateBot& b) const;
+  bool PlaceBot(GateBot& b, engine::PointId at);
+  bool PlaceNear(GateBot& b);
+  void StepSolo(GateBot& b, double t, std::vector<GateEffect>& out);
+  void RequestSolo(GateBot& b, double t, std::vector<GateEffect>& out);
+  void AdoptRoute(GateBot& b, double t, std::vector<GateEffect>& out);
+  void OnReached(GateBot& b, std::uint64_t seq, double t);
+  std::pair<std::string, std::string> TeamKeys(const GateBot& b) const;
+  void SampleDistances(double t);
+
+  // Teams (traffic_gate_teams.cpp).
+  void SyncTeams(GateBot& b);
+  void JoinTeam(GateBot& b, const std::string& order, double t, std::vector<GateEffect>& out);
+  void StepTeams(double t, std::vector<GateEffect>& out);
+  void StepTeamsAfterDeadlocks(double t, std::vector<GateEffect>& out);
+  void BreakTeam(GateTeam& team);
+  bool StepLeaving(GateTeam& team, double t, std::vector<GateEffect>& out);
+};
+
+struct TrafficGate::Impl : GateImpl {
+  using GateImpl::GateImpl;
+};
+
+}  // namespace dispatch::server

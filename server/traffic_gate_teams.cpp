@@ -1,0 +1,452 @@
+// TrafficGate: formation teams (Chu2024 §3.2; issue 4 §3: "the traffic controller treats the
+// formation as one agent with its envelope; grants are held for the whole formation").
+// See traffic_gate.h for the phases: forming at the rendezvous point, moving as one agent,
+// leaving the drop point one member at a time.
+#include <spdlog/spdlog.h>
+
+#include <algorithm>
+#include <cmath>
+
+#include "engine/fleet/formation.h"
+#include "server/traffic_gate_impl.h"
+
+namespace dispatch::server {
+
+using engine::PointId;
+using engine::TrafficDecision;
+
+namespace {
+
+// A member's formation index -> plan index, or -1 when its plan no longer holds the order.
+struct MemberView {
+  GateBot* bot = nullptr;
+  long first_pick = -1;  // plan index of formation index 0
+  long length = 0;       // formation waypoints
+};
+
+}  // namespace
+
+void GateImpl::SyncTeams(GateBot& b) {
+  std::set<std::string> in_plan(b.plan.order_of.begin(), b.plan.order_of.end());
+  for (const auto& [order, members] : b.plan.teams) {
+    if (!in_plan.count(order) || members.size() != static_cast<std::size_t>(engine::kFormationTeamSize)) continue;
+    if (finished_teams.count(order)) continue;  // its drop is done (a late drop report may follow)
+    GateTeam& team = teams[order];
+    if (team.order.empty()) {
+      team.order = order;
+      team.members = members;
+    }
+  }
+  // The team it has joined lost its order: after the drop (the plan was trimmed) the team
+  // leaves; before it (cancelled, failed) it breaks up.
+  if (!b.team.empty() && !in_plan.count(b.team)) {
+    auto it = teams.find(b.team);
+    if (it == teams.end()) {
+      b.team.clear();
+    } else {
+      auto drop = it->second.drop_seq.find(b.id);
+      if (drop != it->second.drop_seq.end() && b.reached_seq >= drop->second) {
+        it->second.phase = GateTeam::Phase::kLeaving;
+      } else if (it->second.phase != GateTeam::Phase::kLeaving) {
+        BreakTeam(it->second);
+        teams.erase(it);
+      }
+    }
+  }
+  // A forming team one of whose members lost the order cannot form any more.
+  for (auto it = teams.begin(); it != teams.end();) {
+    GateTeam& team = it->second;
+    const bool mine = std::find(team.members.begin(), team.members.end(), b.id) != team.members.end();
+    if (mine && team.phase == GateTeam::Phase::kForming && !in_plan.count(team.order)) {
+      BreakTeam(team);
+      it = teams.erase(it);
+    } else {
+      ++it;
+    }
+  }
+}
+
+void GateImpl::BreakTeam(GateTeam& team) {
+  spdlog::debug("formation {} broken up", team.order);
+  if (team.ctl >= 0 && !ctl.removed(static_cast<std::size_t>(team.ctl))) {
+    ctl.Remove(static_cast<std::size_t>(team.ctl));
+  }
+  if (team.ctl >= 0) team_pool.push_back(static_cast<std::size_t>(team.ctl));
+  team.ctl = -1;
+  for (const std::string& id : team.members) {
+    auto it = bots.find(id);
+    if (it == bots.end() || it->second.team != team.order) continue;
+    it->second.team.clear();  // StepSolo puts it back on the floor where it stands
+    it->second.former_team = team.order;
+    it->second.former_at = engine::kNoPoint;  // broken up on the way: until its next point
+    it->second.leg_stale = true;
+  }
+}
+
+void GateImpl::JoinTeam(GateBot& b, const std::string& order, double t, std::vector<GateEffect>& out) {
+  auto it = teams.find(order);
+  auto span = SpanOf(b, order);
+  if (it == teams.end() || !span) return;
+  GateTeam& team = it->second;
+  if (team.phase != GateTeam::Phase::kForming) return;
+  const auto r = static_cast<std::size_t>(b.ctl);
+  const PointId p = span->rendezvous;
+  if (team.ctl < 0 || ctl.removed(static_cast<std::size_t>(team.ctl))) {
+    const bool on_p = ctl.At(r) == p;
+    if (on_p) ctl.Remove(r);  // it stands on the rendezvous point itself: the team takes it over
+    bool placed = false;
+    const int group = GroupOf(order);
+    if (team.ctl >= 0) {
+      ctl.SetGroup(static_cast<std::size_t>(team.ctl), group);
+      placed = ctl.Place(static_cast<std::size_t>(team.ctl), p).ok();
+    } else if (!team_pool.empty()) {
+      const std::size_t pooled = team_pool.back();
+      ctl.SetGroup(pooled, group);
+      placed = ctl.Place(pooled, p).ok();
+      if (placed) {
+        team_pool.pop_back();
+        team.ctl = static_cast<int>(pooled);
+      }
+    } else {
+      auto added = ctl.AddRobot("formation-" + std::to_string(++team_agents), p, group);
+      placed = added.ok();
+      if (placed) team.ctl = static_cast<int>(*added);
+    }
+    if (!placed) {
+      if (on_p) (void)ctl.Place(r, p);
+      Hold(b, "formation " + order + ": rendezvous point '" + map->point(p).name + "' is occupied", out);
+      return;
+    }
+    const auto tr = static_cast<std::size_t>(team.ctl);
+    ctl.SetIdle(tr, false);
+    ctl.SetEnvelope(tr, engine::FormationRadius());
+    ctl.SetWorking(tr, true, t + 3600.0);  // assembling: never asked to yield
+  }
+  // Into its slot: the rendezvous run up to the formation's first pick. It keeps its point
+  // until it is clear of it (StepTeams), then the team agent stands for it.
+  Release(b, span->first_pick, map->IntersectionOf(p), out);
+  b.team = order;
+  b.leg_stale = true;
+  team.joined.insert(b.id);
+  (void)t;
+}
+
+void GateImpl::StepTeams(double t, std::vector<GateEffect>& out) {
+  for (auto it = teams.begin(); it != teams.end();) {
+    GateTeam& team = it->second;
+    // Members as they stand now.
+    std::vector<MemberView> m;
+    bool complete = true;
+    for (const std::string& id : team.members) {
+      auto b = bots.find(id);
+      if (b == bots.end()) {
+        complete = false;
+        break;
+      }
+      MemberView v;
+      v.bot = &b->second;
+      auto span = SpanOf(b->second, team.order);
+      if (span) {
+        v.first_pick = span->first_pick;
+        v.length = span->drop - span->first_pick + 1;
+        team.drop_seq[id] = span->seq_drop;
+        team.drop = b->second.plan.waypoints[static_cast<std::size_t>(span->drop)].point;
+      }
+      m.push_back(v);
+    }
+    if (!complete) {
+      ++it;
+      continue;
+    }
+    // Joined members leave the controller once clear of the point they joined from.
+    for (const MemberView& v : m) {
+      GateBot& b = *v.bot;
+      if (b.team != team.order || !OnFloor(b)) continue;
+      const auto r = static_cast<std::size_t>(b.ctl);
+      const bool clear = !b.has_xy || (b.xy - map->point(ctl.At(r)).position).norm() >= config.point_clearance;
+      if (clear || (v.first_pick >= 0 && b.idx >= v.first_pick - 1)) ctl.Remove(r);
+    }
+    if (team.phase == GateTeam::Phase::kForming) {
+      bool ready = team.joined.size() == team.members.size();
+      for (const MemberView& v : m) ready = ready && v.first_pick >= 0 && v.bot->idx >= v.first_pick;
+      if (!ready) {
+        ++it;
+        continue;
+      }
+      team.phase = GateTeam::Phase::kMoving;
+      team.k = 0;
+      team.leg_stale = true;
+      ctl.SetLoaded(static_cast<std::size_t>(team.ctl), true);
+    }
+    const auto tr = static_cast<std::size_t>(team.ctl);
+    if (team.phase == GateTeam::Phase::kMoving) {
+      long length = m[0].length;
+      for (const MemberView& v : m) length = std::min(length, v.length);
+      bool members_ok = length > 0;
+      for (const MemberView& v : m) members_ok = members_ok && v.first_pick >= 0;
+      if (!members_ok) {  // the drop was trimmed already: the team has arrived
+        team.phase = GateTeam::Phase::kLeaving;
+      } else {
+        const GateBot& lead = *m[0].bot;
+        auto point_at = [&](long k) { return lead.plan.waypoints[static_cast<std::size_t>(m[0].first_pick + k)].point; };
+        auto run_end = [&](long k) {
+          const PointId p = point_at(k);
+          while (k + 1 < length && point_at(k + 1) == p) ++k;
+          return k;
+        };
+        auto release_all = [&](long k, int intersection) {
+          for (const MemberView& v : m) Release(*v.bot, v.first_pick + k, intersection, out);
+        };
+        auto all_reached = [&](long k) {
+          for (const MemberView& v : m) {
+            if (v.bot->idx < v.first_pick + k) return false;
+          }
+          return true;
+        };
+        const PointId next = ctl.Next(tr);
+        if (next != engine::kNoPoint) {
+          if (!team.left) {
+            // Every member clear of the point by eps2 (Chu2024 eq. (11)): whoever is given the
+            // point next (a single robot, or a formation's centre) keeps its distance.
+            const Eigen::Vector2d& at = map->point(ctl.At(tr)).position;
+            bool clear = true;
+            for (const MemberView& v : m) {
+              clear = clear && v.bot->has_xy &&
+                      (v.bot->xy - at).norm() >= config.point_clearance + engine::FormationRadius();
+            }
+            if (clear) {
+              ctl.LeftPoint(tr);
+              team.left = true;
+            }
+          }
+          if (team.next_k >= 0 && all_reached(team.next_k)) {
+            ctl.Arrived(tr, t);
+            team.k = team.next_k;
+            team.next_k = -1;
+            team.leg = ctl.RemainingRoute(tr);
+          }
+        }
+        if (ctl.Next(tr) == engine::kNoPoint) {
+          const long rk = run_end(team.k);
+          release_all(rk, -1);
+          double departure = 0.0;
+          for (const MemberView& v : m) departure = std::max(departure, Departure(*v.bot, v.first_pick + rk));
+          const bool done_here = all_reached(rk);
+          if (done_here && t >= departure) {
+            ctl.SetWorking(tr, false);
+            if (rk + 1 >= length) {
+              team.phase = GateTeam::Phase::kLeaving;
+            } else {
+              if (team.leg_stale || !ctl.HasRoute(tr)) {
+                long s = rk + 1;
+                while (s + 1 < length &&
+                       !IsStop(lead.plan.waypoints[static_cast<std::size_t>(m[0].first_pick + s)])) {
+                  ++s;
+                }
+                std::vector<PointId> leg{point_at(rk)};
+                for (long k = rk + 1; k <= s; ++k) {
+                  if (point_at(k) != leg.back()) leg.push_back(point_at(k));
+                }
+                if (!ctl.SetRoute(tr, leg).ok()) {
+                  for (const MemberView& v : m) Hold(*v.bot, "formation " + team.order + ": bad route", out);
+                  ++it;
+                  continue;
+                }
+                team.leg = ctl.RemainingRoute(tr);
+                team.leg_stop = s;
+                team.leg_stale = false;
+              }
+              const TrafficDecision d = ctl.Request(tr, t);
+              if (d == TrafficDecision::kGo) {
+                team.left = false;
+                team.blocked = false;
+                const PointId to = ctl.Next(tr);
+                long nk = rk + 1;
+                while (nk < length && point_at(nk) != to) ++nk;
+                team.next_k = nk < length ? nk : -1;
+                if (team.next_k >= 0) release_all(run_end(team.next_k), map->IntersectionOf(to));
+              } else if (d != TrafficDecision::kReplanned) {  // a detour is adopted after deadlocks
+                const std::string why = (d == TrafficDecision::kBlocked ? "blocked: " : "") + ctl.why(tr);
+                if (d == TrafficDecision::kBlocked && !team.blocked) {
+                  team.blocked = true;
+                  GateEffect e;
+                  e.kind = GateEffect::Kind::kBlocked;
+                  e.robot = team.members.front();
+                  e.reason = "formation " + team.order + ": " + ctl.why(tr);
+                  out.push_back(std::move(e));
+                }
+                for (const MemberView& v : m) Hold(*v.bot, "formation " + team.order + ": " + why, out);
+              }
+            }
+          } else if (done_here || all_reached(team.k)) {
+            ctl.SetWorking(tr, true, departure);
+          }
+        }
+      }
+    }
+    if (team.phase == GateTeam::Phase::kLeaving && StepLeaving(team, t, out)) {
+      finished_teams.insert(team.order);
+      it = teams.erase(it);
+      continue;
+    }
+    ++it;
+  }
+}
+
+// After the drop the members go back into the controller one at a time while the team agent
+// still holds the drop point D (and so every point near it): a member with work ahead is placed
+// at the first point of its onward route, an idle one at a free neighbour of D; the last one
+// takes D itself from the team agent. True when every member is back.
+bool GateImpl::StepLeaving(GateTeam& team, double t, std::vector<GateEffect>& out) {
+  const int group = GroupOf(team.order);
+  const bool agent_on_floor = team.ctl >= 0 && !ctl.removed(static_cast<std::size_t>(team.ctl));
+
+  const PointId d = team.drop;
+  std::vector<GateBot*> pending;
+  for (const std::string& id : team.members) {
+    auto b = bots.find(id);
+    if (b != bots.end() && b->second.team == team.order) pending.push_back(&b->second);
+  }
+  // Members with somewhere to go leave first (an idle one may stay on D).
+  auto onward = [&](const GateBot& b) -> long {
+    for (long j = std::max(0L, b.idx + 1); j < static_cast<long>(b.plan.waypoints.size()); ++j) {
+      if (b.plan.waypoints[static_cast<std::size_t>(j)].point != d) return j;
+    }
+    return -1;
+  };
+  std::stable_sort(pending.begin(), pending.end(),
+                   [&](const GateBot* a, const GateBot* b) { return (onward(*a) >= 0) > (onward(*b) >= 0); });
+  auto back = [&](GateBot& b) {
+    // Until it has left the formation's envelope it still stands in its slot, D_f off the point.
+    ctl.SetEnvelope(static_cast<std::size_t>(b.ctl), engine::FormationRadius());
+    b.team.clear();
+    b.former_team = team.order;
+    b.former_at = d;
+    b.leg_stale = true;
+    b.left = false;
+  };
+  auto place = [&](GateBot& b, PointId at) {
+    if (b.ctl >= 0) ctl.SetGroup(static_cast<std::size_t>(b.ctl), group);
+    if (b.ctl < 0) {
+      auto added = ctl.AddRobot(b.id, at, group);
+      if (!added.ok()) return false;
+      b.ctl = static_cast<int>(*added);
+      return true;
+    }
+    if (!ctl.removed(static_cast<std::size_t>(b.ctl))) ctl.Remove(static_cast<std::size_t>(b.ctl));
+    return ctl.Place(static_cast<std::size_t>(b.ctl), at).ok();
+  };
+  for (std::size_t k = 0; k < pending.size(); ++k) {
+    GateBot& b = *pending[k];
+    if (d == engine::kNoPoint) {  // no agent to leave from (e.g. after a restart): where it stands
+      if (PlaceNear(b)) back(b);
+      spdlog::debug("formation {}: {} placed near where it stands", team.order, b.id);
+      continue;
+    }
+    const bool last = k + 1 == pending.size();
+    if (last) {
+      // The team agent keeps D (and its envelope over the slots) until the others have
+      // driven to the points they were placed at.
+      const double envelope = config.point_clearance + engine::FormationRadius();
+      for (const std::string& id : team.members) {
+        const GateBot& o = bots.at(id);
+        if (&o == &b || !o.team.empty()) continue;
+        const bool out = o.reached_seq >= o.leave_seq ||
+                         (o.has_xy && (o.xy - map->point(d).position).norm() >= envelope);
+        if (!out) return false;
+      }
+      if (agent_on_floor) ctl.Remove(static_cast<std::size_t>(team.ctl));
+      if (!place(b, d)) {
+        if (agent_on_floor) (void)ctl.Place(static_cast<std::size_t>(team.ctl), d);
+        return false;
+      }
+      if (team.ctl >= 0) team_pool.push_back(static_cast<std::size_t>(team.ctl));
+      team.ctl = -1;
+      back(b);
+      spdlog::debug("formation {}: {} takes '{}' over, the team is done", team.order, b.id, map->point(d).name);
+      return true;
+    }
+    const long j = onward(b);
+    PointId target = j >= 0 ? b.plan.waypoints[static_cast<std::size_t>(j)].point : engine::kNoPoint;
+    if (target == engine::kNoPoint) {
+      for (engine::ArcId a : map->out_arcs(d)) {
+        const PointId q = map->arc(a).to;
+        if (!IsServicePoint(map->point(q).kind) && map->IntersectionOf(q) < 0) {
+          target = q;
+          break;
+        }
+      }
+    }
+    if (target == engine::kNoPoint || !place(b, target)) return false;  // retried next step
+    spdlog::debug("formation {}: {} leaves '{}' for '{}' (onward waypoint {})", team.order, b.id,
+                  map->point(d).name, map->point(target).name, j);
+    long first_new = j;
+    if (j < 0) {  // idle: a move to the neighbour
+      RewriteLeg(b, static_cast<long>(b.plan.waypoints.size()) - 1, {d, target}, -1, t, out);
+      first_new = static_cast<long>(b.plan.waypoints.size()) - 1;
+    }
+    b.leave_seq = static_cast<std::uint64_t>(b.plan.waypoints[static_cast<std::size_t>(first_new)].seq);
+    if (first_new - 1 > b.idx) {  // the waypoints still at D are passed on the way out
+      b.idx = first_new - 1;
+      b.reached_seq = std::max<std::uint64_t>(b.reached_seq, b.plan.waypoints[static_cast<std::size_t>(b.idx)].seq);
+    }
+    back(b);
+  }
+  return pending.empty() || d == engine::kNoPoint;
+}
+
+// A detour of a moving team (head-on, timeouts, deadlocks): every member's waypoints follow
+// the new centre route with its rigid offset (eq. (9)) for each segment's heading.
+void GateImpl::StepTeamsAfterDeadlocks(double t, std::vector<GateEffect>& out) {
+  for (auto& [order, team] : teams) {
+    if (team.phase != GateTeam::Phase::kMoving || team.ctl < 0) continue;
+    const auto tr = static_cast<std::size_t>(team.ctl);
+    if (ctl.removed(tr) || ctl.Next(tr) != engine::kNoPoint) continue;
+    const std::vector<PointId> route = ctl.RemainingRoute(tr);
+    if (route.size() < 2 || route == team.leg) continue;
+    for (std::size_t i = 0; i < team.members.size(); ++i) {
+      auto b = bots.find(team.members[i]);
+      if (b == bots.end()) continue;
+      GateBot& bot = b->second;
+      auto span = SpanOf(bot, order);
+      if (!span) continue;
+      const long length = span->drop - span->first_pick + 1;
+      const PointId here_point = route.front();
+      long rk = team.k;
+      while (rk + 1 < length &&
+             bot.plan.waypoints[static_cast<std::size_t>(span->first_pick + rk + 1)].point == here_point) {
+        ++rk;
+      }
+      const long stop = team.leg_stop;
+      const bool to_stop = stop > rk && stop < length &&
+                           bot.plan.waypoints[static_cast<std::size_t>(span->first_pick + stop)].point == route.back();
+      const long resume = to_stop ? span->first_pick + stop : span->first_pick + rk + 1;
+      const Offset offset = [this, i](PointId from, PointId to) {
+        const Eigen::Vector2d d = map->point(to).position - map->point(from).position;
+        const double heading = d.norm() > 1e-9 ? std::atan2(d.y(), d.x()) : 0.0;
+        return engine::FormationOffsets(heading)[i];
+      };
+      RewriteLeg(bot, span->first_pick + rk, route, resume < static_cast<long>(bot.plan.waypoints.size()) ? resume : -1,
+                 t, out, offset);
+    }
+    // The new stop's formation index is the same for every member (same rewrite).
+    auto lead = bots.find(team.members.front());
+    if (lead != bots.end()) {
+      auto span = SpanOf(lead->second, order);
+      if (span) {
+        long s = -1;
+        for (long k = team.k; k < span->drop - span->first_pick + 1; ++k) {
+          if (lead->second.plan.waypoints[static_cast<std::size_t>(span->first_pick + k)].point == route.back()) {
+            s = k;
+            break;
+          }
+        }
+        team.leg_stop = s;
+      }
+    }
+    team.leg = route;
+    team.leg_stale = false;
+  }
+}
+
+}  // namespace dispatch::server
