@@ -6,23 +6,40 @@
 //
 //   fleet-sim --server 127.0.0.1:50051 --robots 18
 //   fleet-sim --server ... --robots 18 --drop-every 20 --stall R3 --slow R5:0.5 --delay-ms 50
+//   fleet-sim --server ... --robots 2 --first 5      # R5 and R6 on start points 5 and 6
 //
-// Faults: --drop-every S closes one robot's stream every S wall seconds (round robin) and
-// reconnects it, saying its last applied sequence; --stall and --slow change a robot's
-// motion; --delay-ms delays every robot -> server message. Runs until SIGINT/SIGTERM or
-// --duration wall seconds. --ready-fd N: once every robot has been welcomed, writes
-// "connected N" to the inherited descriptor N and closes it (scripts wait on it, no polling).
+// --first K: this process runs robots RK..R(K+N-1) on start points K..K+N-1, so several
+// fleet-sim processes can make up one fleet (e.g. robots that join later).
+//
+// Faults: --drop-every S closes one robot's stream every S wall seconds (round robin, muted
+// robots skipped) and reconnects it, saying its last applied sequence; --stall and --slow
+// change a robot's motion; --delay-ms delays every robot -> server message.
+// --mute ID:AFTER: AFTER wall seconds after start, robot ID goes silent for good, as a robot
+// that died: it stops moving and stops sending anything (no reports, heartbeats, acks or
+// events) but keeps its stream open, so only the server's heartbeat timeout notices it;
+// when the server then closes the stream, the robot does not reconnect.
+// --control-fd N: reads commands, one a line, from the inherited descriptor N while running
+// (tests trigger faults at a chosen moment, not by the clock): "mute ID" (as --mute, now),
+// "drop ID" (as one --drop-every drop, for that robot). Unknown commands are reported on
+// stderr; EOF just ends the commands.
+// Runs until SIGINT/SIGTERM or --duration wall seconds. --ready-fd N: once every robot has
+// been welcomed, writes "connected N" to the inherited descriptor N and closes it (scripts
+// wait on it, no polling).
 #include <grpcpp/grpcpp.h>
+#include <fcntl.h>
 #include <unistd.h>
 
 #include <CLI/CLI.hpp>
 
 #include <atomic>
+#include <cerrno>
 #include <chrono>
 #include <csignal>
 #include <cstdio>
 #include <map>
 #include <memory>
+#include <optional>
+#include <sstream>
 #include <string>
 #include <thread>
 #include <vector>
@@ -55,6 +72,7 @@ struct Slot {
   std::uint64_t acked = 0;
   int connects = 0;
   std::string last_error;
+  std::optional<Clock::time_point> mute_at;  // --mute
 
   double Now(Clock::time_point wall) const {
     return welcome_server_time + Seconds(wall - welcome_wall) * time_scale;
@@ -84,17 +102,76 @@ std::vector<v1::MapPoint> StartPoints(const v1::Map& map, std::size_t count, std
   return out;
 }
 
+// Non-blocking line reader for --control-fd.
+class ControlReader {
+ public:
+  explicit ControlReader(int fd) : fd_(fd) {
+    if (fd_ >= 0) ::fcntl(fd_, F_SETFL, ::fcntl(fd_, F_GETFL) | O_NONBLOCK);
+  }
+  ~ControlReader() {
+    if (fd_ >= 0) ::close(fd_);
+  }
+  ControlReader(const ControlReader&) = delete;
+  ControlReader& operator=(const ControlReader&) = delete;
+  // Complete lines read so far.
+  std::vector<std::string> Poll() {
+    std::vector<std::string> lines;
+    if (fd_ < 0) return lines;
+    char buf[512];
+    for (;;) {
+      const ssize_t n = ::read(fd_, buf, sizeof buf);
+      if (n > 0) {
+        pending_.append(buf, static_cast<std::size_t>(n));
+        continue;
+      }
+      if (n == 0 || (errno != EAGAIN && errno != EWOULDBLOCK && errno != EINTR)) {
+        ::close(fd_);  // EOF (or a broken descriptor): no more commands
+        fd_ = -1;
+      }
+      break;
+    }
+    for (std::size_t nl; (nl = pending_.find('\n')) != std::string::npos;) {
+      lines.push_back(pending_.substr(0, nl));
+      pending_.erase(0, nl + 1);
+    }
+    return lines;
+  }
+
+ private:
+  int fd_;
+  std::string pending_;
+};
+
+void Mute(Slot& s, const char* how) {
+  if (s.robot->muted()) return;
+  s.robot->set_muted();
+  if (s.stream) s.stream->DiscardPending();
+  std::printf("fleet-sim: fault: %s goes silent (%s); its stream stays open\n", s.robot->id().c_str(), how);
+  std::fflush(stdout);
+}
+
+void Drop(Slot& s) {
+  if (s.stream && !s.stream->done()) {
+    std::printf("fleet-sim: fault: dropping %s's stream\n", s.robot->id().c_str());
+    std::fflush(stdout);
+    s.stream->Close();
+  }
+}
+
 int Main(int argc, char** argv) {
   CLI::App app{"fleet-sim: simulated robots on real gRPC streams"};
   std::string server = "127.0.0.1:50051";
   std::size_t count = 18;
   double speed = 1.0, report_hz = 10.0, tick_hz = 50.0, duration = 0.0, drop_every = 0.0;
   int delay_ms = 0;
-  int ready_fd = -1;
-  std::vector<std::string> stall, slow;
+  int ready_fd = -1, control_fd = -1;
+  std::size_t first = 1;
+  std::vector<std::string> stall, slow, mute;
   app.add_option("--server", server, "dispatchd gRPC address HOST:PORT")->capture_default_str();
   app.add_option("--robots", count, "Number of robots")->capture_default_str()
       ->check(CLI::Range(std::size_t{1}, std::size_t{100000}));
+  app.add_option("--first", first, "Number of the first robot: runs R<first>.. on start points <first>..")
+      ->capture_default_str()->check(CLI::Range(std::size_t{1}, std::size_t{100000}));
   app.add_option("--speed", speed, "Robot speed, m/s")->capture_default_str()
       ->check(CLI::PositiveNumber);
   app.add_option("--report-hz", report_hz, "State reports per wall second")->capture_default_str()
@@ -109,6 +186,13 @@ int Main(int argc, char** argv) {
       ->check(CLI::Range(3, 65535));
   app.add_option("--stall", stall, "Fault: these robots never move (ids, repeat)");
   app.add_option("--slow", slow, "Fault: ID:FACTOR drives at FACTOR x speed (repeat)");
+  app.add_option("--mute", mute,
+                 "Fault: ID:AFTER - after AFTER wall seconds robot ID stops moving and sending anything, "
+                 "keeping its stream open (the server's heartbeat timeout must notice); it never "
+                 "reconnects once the server closes the stream (repeat)");
+  app.add_option("--control-fd", control_fd,
+                 "Read fault commands from this inherited fd, one a line: 'mute ID', 'drop ID'")
+      ->check(CLI::Range(3, 65535));
   CLI11_PARSE(app, argc, argv);
 
   std::signal(SIGINT, OnSignal);
@@ -127,16 +211,17 @@ int Main(int argc, char** argv) {
     }
   }
   std::string error;
-  const std::vector<v1::MapPoint> starts = StartPoints(map.map(), count, &error);
+  std::vector<v1::MapPoint> starts = StartPoints(map.map(), first - 1 + count, &error);
   if (!error.empty()) {
     std::fprintf(stderr, "fleet-sim: %s\n", error.c_str());
     return 1;
   }
+  starts.erase(starts.begin(), starts.begin() + static_cast<std::ptrdiff_t>(first - 1));
   auto fleet_stub = v1::FleetService::NewStub(channel);
   std::vector<Slot> slots(count);
   std::map<std::string, std::size_t> by_id;
   for (std::size_t i = 0; i < count; ++i) {
-    const std::string id = "R" + std::to_string(i + 1);
+    const std::string id = "R" + std::to_string(first + i);
     slots[i].robot = std::make_unique<SimRobot>(
         id, Eigen::Vector2d(starts[i].position().x(), starts[i].position().y()), speed);
     by_id[id] = i;
@@ -160,13 +245,30 @@ int Main(int argc, char** argv) {
     }
     slots[by_id[id]].robot->set_slow_factor(factor);
   }
+  const Clock::time_point start = Clock::now();
+  for (const std::string& spec : mute) {
+    const auto colon = spec.find(':');
+    const std::string id = spec.substr(0, colon);
+    double after = -1.0;
+    try {
+      after = colon == std::string::npos ? -1.0 : std::stod(spec.substr(colon + 1));
+    } catch (const std::exception&) {
+    }
+    if (!by_id.count(id) || !(after >= 0.0)) {
+      std::fprintf(stderr, "fleet-sim: --mute wants ID:AFTER with a known id and AFTER >= 0 seconds, got '%s'\n",
+                   spec.c_str());
+      return 1;
+    }
+    slots[by_id[id]].mute_at =
+        start + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(after));
+  }
+  ControlReader control(control_fd);
   std::printf("fleet-sim: %zu robots on map '%s' (version %s), server %s\n", count,
               map.map().name().c_str(), map.version().c_str(), server.c_str());
   std::fflush(stdout);
 
   const auto tick = std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(1.0 / tick_hz));
   const auto report_every = std::chrono::duration<double>(1.0 / report_hz);
-  const Clock::time_point start = Clock::now();
   Clock::time_point next_tick = start, next_drop = start + std::chrono::duration_cast<Clock::duration>(
                                                                 std::chrono::duration<double>(drop_every));
   std::size_t drop_cursor = 0;
@@ -175,16 +277,54 @@ int Main(int argc, char** argv) {
   while (!g_stop) {
     const Clock::time_point now = Clock::now();
     if (duration > 0.0 && Seconds(now - start) >= duration) break;
+    for (const std::string& line : control.Poll()) {
+      std::istringstream words(line);
+      std::string verb, id, extra;
+      words >> verb >> id >> extra;
+      if (verb.empty()) continue;
+      auto it = by_id.find(id);
+      if ((verb != "mute" && verb != "drop") || it == by_id.end() || !extra.empty()) {
+        std::fprintf(stderr, "fleet-sim: --control-fd: ignored '%s' (want 'mute ID' or 'drop ID')\n",
+                     line.c_str());
+        continue;
+      }
+      if (verb == "mute") {
+        Mute(slots[it->second], "control command");
+      } else if (!slots[it->second].robot->muted()) {
+        Drop(slots[it->second]);
+      }
+    }
+    for (Slot& s : slots) {
+      if (s.mute_at && now >= *s.mute_at) {
+        Mute(s, "--mute");
+        s.mute_at.reset();
+      }
+    }
     if (drop_every > 0.0 && now >= next_drop) {
-      Slot& s = slots[drop_cursor++ % count];
-      if (s.stream && !s.stream->done()) {
-        std::printf("fleet-sim: fault: dropping %s's stream\n", s.robot->id().c_str());
-        s.stream->Close();
+      for (std::size_t tries = 0; tries < count; ++tries) {
+        Slot& s = slots[drop_cursor++ % count];
+        if (s.robot->muted()) continue;
+        Drop(s);
+        break;
       }
       next_drop = now + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(drop_every));
     }
     std::size_t connected = 0;
     for (Slot& s : slots) {
+      if (s.robot->muted()) {
+        // Dead: reads nothing, sends nothing, never reconnects; the stream ends when the
+        // server gives up on it (heartbeat timeout).
+        if (s.stream) {
+          s.stream->TakeReceived();
+          if (s.stream->done()) {
+            std::printf("fleet-sim: %s (silent): the server closed its stream: %s\n",
+                        s.robot->id().c_str(), s.stream->status().error_message().c_str());
+            std::fflush(stdout);
+            s.stream.reset();
+          }
+        }
+        continue;
+      }
       if (s.stream && s.stream->done()) {
         const grpc::Status st = s.stream->status();
         if (!st.ok() && st.error_code() != grpc::StatusCode::CANCELLED &&

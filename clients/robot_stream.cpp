@@ -27,6 +27,11 @@ void RobotStream::Send(const v1::RobotMessage& message) {
   MaybeStartWrite();
 }
 
+void RobotStream::DiscardPending() {
+  std::lock_guard<std::mutex> lock(mu_);
+  outgoing_.clear();
+}
+
 void RobotStream::Pump() { MaybeStartWrite(); }
 
 void RobotStream::MaybeStartWrite() {

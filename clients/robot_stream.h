@@ -33,6 +33,8 @@ class RobotStream final : public grpc::ClientBidiReactor<v1::RobotMessage, v1::S
   ~RobotStream() override;
 
   void Send(const v1::RobotMessage& message);
+  // Forgets the messages queued and not yet being written (a robot that went silent).
+  void DiscardPending();
   // Sends the messages whose delay has passed (call it from the owner's loop).
   void Pump();
   std::vector<v1::ServerMessage> TakeReceived();

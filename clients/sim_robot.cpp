@@ -7,6 +7,7 @@ namespace dispatch::clients {
 namespace {
 
 constexpr double kArriveEps = 1e-9;
+constexpr std::size_t kMaxFinishedDrops = 64;
 
 Eigen::Vector2d Xy(const v1::TimedWaypoint& w) { return {w.x(), w.y()}; }
 
@@ -53,6 +54,16 @@ void SimRobot::AdoptWaypoints(const google::protobuf::RepeatedPtrField<v1::Timed
   }
 }
 
+void SimRobot::RepeatFinishedDrops(
+    const google::protobuf::RepeatedPtrField<v1::TimedWaypoint>& wps) {
+  for (const v1::TimedWaypoint& w : wps) {
+    if (w.action() != v1::WAYPOINT_ACTION_DROP || w.order_id().empty()) continue;
+    for (const auto& [seq, order] : finished_drops_) {
+      if (seq == w.sequence() && order == w.order_id()) repeats_.push_back(TaskEventFor(w));
+    }
+  }
+}
+
 bool SimRobot::Apply(const v1::ServerMessage& message) {
   if (message.sequence() != 0 && message.sequence() <= last_applied_) return false;
   last_applied_ = std::max(last_applied_, message.sequence());
@@ -60,6 +71,7 @@ bool SimRobot::Apply(const v1::ServerMessage& message) {
     case v1::ServerMessage::kAssignment: {
       const v1::Assignment& a = message.assignment();
       waypoints_.clear();
+      RepeatFinishedDrops(a.waypoints());
       AdoptWaypoints(a.waypoints());
       released_up_to_ = std::max(released_up_to_, a.released_up_to_sequence());
       break;
@@ -69,6 +81,7 @@ bool SimRobot::Apply(const v1::ServerMessage& message) {
       while (!waypoints_.empty() && waypoints_.back().wp.sequence() >= u.from_sequence()) {
         waypoints_.pop_back();
       }
+      RepeatFinishedDrops(u.waypoints());
       AdoptWaypoints(u.waypoints());
       released_up_to_ = std::max(released_up_to_, u.released_up_to_sequence());
       break;
@@ -125,11 +138,25 @@ void SimRobot::ArriveAt(Waypoint& w, double time, std::vector<v1::RobotMessage>&
     dwell_until_ = time + w.wp.dwell();
     dwell_wp_ = w.wp;
   } else if (IsTask(w.wp)) {
-    out.push_back(TaskEventFor(w.wp));
+    Finished(w.wp, out);
   }
 }
 
+void SimRobot::Finished(const v1::TimedWaypoint& w, std::vector<v1::RobotMessage>& out) {
+  out.push_back(TaskEventFor(w));
+  if (w.action() != v1::WAYPOINT_ACTION_DROP) return;
+  finished_drops_.emplace_back(w.sequence(), w.order_id());
+  if (finished_drops_.size() > kMaxFinishedDrops) finished_drops_.pop_front();
+}
+
 void SimRobot::Step(double now, std::vector<v1::RobotMessage>& out) {
+  if (muted_) {
+    current_speed_ = 0.0;
+    repeats_.clear();
+    return;
+  }
+  for (v1::RobotMessage& m : repeats_) out.push_back(std::move(m));
+  repeats_.clear();
   if (!started_) {
     started_ = true;
     now_ = now;
@@ -142,7 +169,7 @@ void SimRobot::Step(double now, std::vector<v1::RobotMessage>& out) {
       if (dwell_until_ > now_) break;
       dwelling_ = false;
       t = std::max(t, dwell_until_);
-      if (IsTask(dwell_wp_)) out.push_back(TaskEventFor(dwell_wp_));
+      if (IsTask(dwell_wp_)) Finished(dwell_wp_, out);
       continue;
     }
     if (waypoints_.empty()) break;

@@ -15,8 +15,17 @@
 // (or at a waypoint) until Resume; Cancel voids the named orders' waypoints (all when none
 // are named): the robot stops at its next waypoint and keeps what remains.
 //
+// Lost events. The server does not acknowledge robot messages, so an event sent just before
+// a stream broke (or a server crash) may be lost. A lost drop would leave its order open for
+// ever, so when the server sends a plan (Assignment or PlanUpdate) that still holds a drop
+// waypoint this robot has already finished for the same order, the robot reports that
+// TaskEvent again (from the next Step). The server ignores repeats. Lost WaypointReached and
+// picked events need no repeat: state reports carry the last waypoint, and a drop starts an
+// order that missed its pick.
+//
 // Faults for tests of the server: a stalled robot does not move (it still talks); a slow
-// robot drives at speed * slow_factor.
+// robot drives at speed * slow_factor; a muted robot is dead: it neither moves nor produces
+// events from then on (fleet-sim also stops sending anything for it, see fleet_sim.cpp).
 //
 // Not thread-safe: one owner (fleet-sim's loop) drives it.
 #pragma once
@@ -26,6 +35,7 @@
 #include <cstdint>
 #include <deque>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "warehouse/dispatch/v1/fleet.pb.h"
@@ -50,6 +60,9 @@ class SimRobot {
 
   void set_stalled(bool stalled) { stalled_ = stalled; }
   void set_slow_factor(double factor) { slow_factor_ = factor; }
+  // Permanent: a muted robot stands still and Step produces nothing.
+  void set_muted() { muted_ = true; }
+  bool muted() const { return muted_; }
 
   // The first message of a stream.
   v1::RobotMessage Hello() const;
@@ -69,7 +82,11 @@ class SimRobot {
   };
   void AdoptWaypoints(const google::protobuf::RepeatedPtrField<v1::TimedWaypoint>& wps);
   void ArriveAt(Waypoint& w, double time, std::vector<v1::RobotMessage>& out);
+  // A pick or drop finished: reports it (and remembers drops, see "Lost events").
+  void Finished(const v1::TimedWaypoint& w, std::vector<v1::RobotMessage>& out);
   bool MayDriveTo(const Waypoint& w) const;
+  // Queues drop events to report again for finished drops that `wps` still holds.
+  void RepeatFinishedDrops(const google::protobuf::RepeatedPtrField<v1::TimedWaypoint>& wps);
 
   std::string id_;
   Eigen::Vector2d position_;
@@ -90,6 +107,10 @@ class SimRobot {
   v1::TimedWaypoint dwell_wp_;
   bool stalled_ = false;
   double slow_factor_ = 1.0;
+  bool muted_ = false;
+  // Drops finished (waypoint sequence -> order id), the most recent kMaxFinishedDrops.
+  std::deque<std::pair<std::uint64_t, std::string>> finished_drops_;
+  std::vector<v1::RobotMessage> repeats_;  // events to report again at the next Step
 };
 
 }  // namespace dispatch::clients

@@ -142,6 +142,49 @@ TEST(SimRobotTest, RepeatedMessagesAreHarmless) {
   EXPECT_EQ(r.Hello().hello().last_acked_sequence(), 7u);
 }
 
+TEST(SimRobotTest, ReportsAFinishedDropAgainWhenTheServerStillPlansIt) {
+  SimRobot r("R1", {0, 0}, 1.0);
+  r.Apply(Plan(1));
+  Events run;
+  StepTo(r, 0.0, 10.5, 0.1, run);  // standing at the drop, working: not finished yet
+  EXPECT_TRUE(r.Apply(Plan(2)));  // a re-sent plan (reconnect) while the drop is under way
+  StepTo(r, 10.6, 12.0, 0.1, run);
+  EXPECT_EQ(run.Names(),
+            (std::vector<std::string>{"wp1", "wp2", "wp3", "picked", "wp4", "dropped"}));
+  // The server re-sends the plan with the finished drop (it missed the event): reported again,
+  // once, for the same order; nothing is driven again.
+  EXPECT_TRUE(r.Apply(Plan(3)));
+  StepTo(r, 12.1, 14.0, 0.1, run);
+  EXPECT_EQ(run.Names(), (std::vector<std::string>{"wp1", "wp2", "wp3", "picked", "wp4",
+                                                   "dropped", "dropped"}));
+  EXPECT_EQ(run.events.back().task_event().order_id(), "o1");
+  EXPECT_EQ(run.events.back().task_event().waypoint_sequence(), 4u);
+  EXPECT_TRUE(r.idle());
+  // A plan that no longer holds that drop (the server got it) repeats nothing.
+  v1::ServerMessage next = Plan(4);
+  for (auto& w : *next.mutable_assignment()->mutable_waypoints()) w.set_sequence(w.sequence() + 10);
+  r.Apply(next);
+  const std::size_t before = run.events.size();
+  StepTo(r, 14.1, 14.2, 0.1, run);
+  for (std::size_t i = before; i < run.events.size(); ++i) {
+    EXPECT_FALSE(run.events[i].has_task_event());
+  }
+}
+
+TEST(SimRobotTest, MutedRobotStandsStillAndReportsNothing) {
+  SimRobot r("R1", {0, 0}, 1.0);
+  r.Apply(Plan(1));
+  Events run;
+  StepTo(r, 0.0, 1.0, 0.1, run);
+  r.set_muted();
+  EXPECT_TRUE(r.muted());
+  const std::size_t before = run.events.size();
+  StepTo(r, 1.1, 20.0, 0.1, run);
+  EXPECT_NEAR(r.position().x(), 1.0, 1e-6);
+  EXPECT_EQ(run.events.size(), before);
+  EXPECT_EQ(r.speed(), 0.0);
+}
+
 TEST(SimRobotTest, CancelStopsAtTheNextWaypointWithoutWorking) {
   SimRobot r("R1", {0, 0}, 1.0);
   r.Apply(Plan(1));
