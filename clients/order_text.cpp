@@ -125,8 +125,8 @@ std::string DescribeOrder(const v1::Order& o) {
 }
 
 std::string OrderTableHeader() {
-  return Format("%-10s %-24s %-12s %-14s %9s %9s %9s", "order", "client id", "state", "robots",
-                "created", "finished", "took (s)");
+  return Format("%-10s %-24s %-12s %-14s %9s %9s %9s %9s", "order", "client id", "state", "robots",
+                "created", "finished", "took (s)", "dist (m)");
 }
 
 std::string OrderTableRow(const v1::Order& o) {
@@ -135,9 +135,10 @@ std::string OrderTableRow(const v1::Order& o) {
     finished = Format("%.2f", o.finished_time());
     took = Format("%.2f", o.finished_time() - o.created_time());
   }
-  return Format("%-10s %-24s %-12s %-14s %9.2f %9s %9s", o.id().c_str(),
+  const std::string distance = o.state() == v1::ORDER_STATE_COMPLETED ? Format("%.1f", o.distance()) : "-";
+  return Format("%-10s %-24s %-12s %-14s %9.2f %9s %9s %9s", o.id().c_str(),
                 o.client_order_id().c_str(), StateName(o.state()), Join(o.robot_ids()).c_str(),
-                o.created_time(), finished.c_str(), took.c_str());
+                o.created_time(), finished.c_str(), took.c_str(), distance.c_str());
 }
 
 std::string DescribeExplanation(const v1::AllocationExplanation& ex) {

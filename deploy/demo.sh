@@ -82,7 +82,20 @@ for table in 1 2; do
   "$bin/clients/wmsctl" --server "$grpc" submit "$scenarios/chu2024-table$table.csv" --wait
 done
 echo
-echo "Orders, robots and the service status: curl http://$http/api/v1/orders, http://$http/api/v1/robots"
+# The traffic layer's account (dispatchd's /api/v1/status): the closest two robots of different
+# agents it saw (formation members of one team are one agent), grants, holds, re-plans.
+python3 - "http://$http/api/v1/status" <<'PY'
+import json, sys, urllib.request
+t = json.load(urllib.request.urlopen(sys.argv[1], timeout=10))["traffic"]
+d = t["min_robot_distance"]
+if d:
+    print(f"Minimum robot distance seen: {d['distance']:.3f} m ({' and '.join(d['robots'])} at t = {d['time']:.1f} s; eps1 = 0.6 m)")
+print(f"Traffic control: {t['grants']} grants, {t['holds']} holds, {t['replans']} re-planned legs, "
+      f"{t['deadlocks_resolved']} deadlocks resolved")
+PY
+echo
+echo "Orders, robots, traffic and the service status: curl http://$http/api/v1/orders, http://$http/api/v1/robots,"
+echo "  http://$http/api/v1/traffic, http://$http/api/v1/status"
 echo "An allocation's reasons: $bin/clients/wmsctl --server $grpc explain <order id>"
 if [ "${DEMO_EXIT:-0}" = 1 ]; then exit 0; fi
 echo "Serving until Ctrl-C."

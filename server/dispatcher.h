@@ -149,6 +149,7 @@ class Dispatcher {
     storage::AssignmentRecord assignment;  // plan.waypoints[0] anchors; then one segment per order
     bool has_assignment = false;
     std::uint64_t last_reached = 0;  // highest waypoint sequence reported reached
+    std::optional<Eigen::Vector2d> last_xy;  // where it reached its last waypoint
   };
 
   Dispatcher(std::shared_ptr<const engine::WarehouseMap> map,
@@ -252,6 +253,7 @@ class Dispatcher {
   std::vector<std::function<void()>> deferred_;  // effects of the current batch
   bool retry_allocation_ = false;
   MinDistance min_distance_;
+  std::unordered_map<std::string, double> order_distance_;  // metres driven, open orders
   Clock::time_point next_distance_sample_{};
   struct {
     std::uint64_t grants = 0, holds = 0, replans = 0;

@@ -199,6 +199,13 @@ void Dispatcher::DoWaypointReached(RobotRuntime& r, const RobotInbound& m) {
   for (std::size_t i = 0; i < w.size(); ++i) {
     if (static_cast<std::uint64_t>(w[i].seq) != m.sequence) continue;
     r.record.robot.current_point = w[i].point;
+    if (m.sequence > r.last_reached) {  // distance driven, for the order it serves
+      if (r.last_xy) {
+        const std::string order = OrderOfWaypoint(r.assignment, i);
+        if (!order.empty()) order_distance_[order] += (w[i].xy - *r.last_xy).norm();
+      }
+      r.last_xy = w[i].xy;
+    }
     r.last_reached = std::max(r.last_reached, m.sequence);
     if (gate_) gate_->Reached(r.record.robot.id, m.sequence, Now());
     if (std::isfinite(m.pose.position.x()) && std::isfinite(m.pose.position.y())) r.record.robot.pose = m.pose;
@@ -273,6 +280,11 @@ void Dispatcher::DoTaskEvent(RobotRuntime& r, const RobotInbound& m) {
     copy->record.order.state = engine::OrderState::kCompleted;
     copy->record.updated_time = now;
     copy->finished_time = now;
+    auto driven = order_distance_.find(m.order_id);
+    if (driven != order_distance_.end()) {
+      copy->distance = driven->second;
+      order_distance_.erase(driven);
+    }
   }
   Put(copy);
   if (event) Journal(*event);

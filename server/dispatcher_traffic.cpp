@@ -123,7 +123,7 @@ void Dispatcher::ApplyGateEffect(GateEffect& e) {
     }
     case GateEffect::Kind::kBlocked: {
       spdlog::warn("robot {} blocked: {} ({})", e.robot, e.reason, gate_->Describe(e.robot));
-      for (const auto& [id, other] : robots_) spdlog::info("traffic: {}", gate_->Describe(id));
+      for (const auto& [id, other] : robots_) spdlog::debug("traffic: {}", gate_->Describe(id));
       r->record.robot.state = engine::RobotState::kFault;
       dirty_ = true;
       if (!r->has_assignment || r->assignment.order_ids.empty()) break;

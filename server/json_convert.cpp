@@ -116,6 +116,7 @@ nlohmann::json OrderToJson(const OrderView& view, const engine::WarehouseMap& ma
             {"created_time", o.created_time},
             {"updated_time", view.record.updated_time},
             {"finished_time", view.finished_time ? json(*view.finished_time) : json(nullptr)},
+            {"distance", view.distance},
             {"reason", view.record.reason}};
   if (explain) {
     j["allocation"] = view.explanation ? AllocationToJson(*view.explanation, map) : json(nullptr);

@@ -33,6 +33,7 @@ struct OrderView {
   std::optional<AllocationRecord> explanation;  // the auction behind the award
   std::optional<double> finished_time;  // set once terminal
   std::set<std::string> dropped_by;     // team members that reported the drop
+  double distance = 0.0;  // metres driven for it (set when it completes)
 };
 
 struct RobotView {

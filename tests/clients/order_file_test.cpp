@@ -112,7 +112,9 @@ TEST(OrderTextTest, StatesRoundTripAndTables) {
   o.add_robot_ids("R6");
   o.set_created_time(1.0);
   o.set_finished_time(59.5);
+  o.set_distance(42.25);
   const std::string row = OrderTableRow(o);
+  EXPECT_NE(row.find("42.2"), std::string::npos) << row;  // the distance column
   EXPECT_NE(row.find("completed"), std::string::npos);
   EXPECT_NE(row.find("R5 R6"), std::string::npos);
   EXPECT_NE(row.find("58.50"), std::string::npos);
