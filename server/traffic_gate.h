@@ -27,7 +27,9 @@
 // elsewhere is re-placed and its leg re-routed from there.
 //
 // Minimum distance: the smallest centre distance between two reported robots of different
-// agents (formation members of one team excluded), kept with the pair and the time.
+// agents, kept with the pair and the time. Members of one team count as one agent from their
+// approach to the rendezvous until the formation has dissolved: after the drop, until every
+// former member has driven out of the team's envelope (eps1 + D_f) around the drop point.
 //
 // Not thread-safe: one owner (the dispatcher loop).
 #pragma once
