@@ -91,10 +91,14 @@ void GateImpl::Release(GateBot& b, long upto, int intersection, std::vector<Gate
   const auto seq = static_cast<std::uint64_t>(b.plan.waypoints[static_cast<std::size_t>(upto)].seq);
   if (seq <= b.released) return;
   b.released = seq;
+  SendRelease(b, intersection, out);
+}
+
+void GateImpl::SendRelease(GateBot& b, int intersection, std::vector<GateEffect>& out) {
   GateEffect e;
   e.kind = GateEffect::Kind::kRelease;
   e.robot = b.id;
-  e.release_up_to = seq;
+  e.release_up_to = b.released;
   e.intersection = intersection;
   e.resume = b.held;
   b.held = false;
@@ -604,13 +608,8 @@ std::vector<GateEffect> TrafficGate::Step(double t) {
   for (auto& [id, b] : s.bots) {
     if (!b.resume_pending || !b.connected) continue;
     b.resume_pending = false;
-    GateEffect e;
-    e.kind = GateEffect::Kind::kRelease;
-    e.robot = b.id;
-    e.release_up_to = b.released;
-    e.resume = true;
-    b.held = false;
-    out.push_back(std::move(e));
+    b.held = true;  // sent as a Resume
+    s.SendRelease(b, -1, out);
   }
   s.StepTeams(t, out);
   for (auto& [id, b] : s.bots) s.StepSolo(b, t, out);
@@ -671,25 +670,5 @@ std::string TrafficGate::Describe(const std::string& robot) const {
 
 const MinDistance& TrafficGate::min_distance() const { return impl_->min_distance; }
 const engine::TrafficStats& TrafficGate::stats() const { return impl_->ctl.stats(); }
-
-std::vector<GateAgentView> TrafficGate::Agents() const {
-  const Impl& s = *impl_;
-  std::vector<GateAgentView> out;
-  for (std::size_t r = 0; r < s.ctl.robot_count(); ++r) {
-    if (s.ctl.removed(r)) continue;
-    GateAgentView v;
-    v.robot = s.ctl.robot_id(r);
-    v.at = s.ctl.At(r);
-    v.next = s.ctl.Next(r);
-    v.why = s.ctl.why(r);
-    auto it = s.bots.find(v.robot);
-    if (it != s.bots.end()) {
-      v.released_up_to = it->second.released;
-      v.waiting = it->second.held;
-    }
-    out.push_back(std::move(v));
-  }
-  return out;
-}
 
 }  // namespace dispatch::server

@@ -86,14 +86,6 @@ struct MinDistance {
   double time = 0.0;
 };
 
-struct GateAgentView {
-  std::string robot;  // or "team:<order>" for a formation agent
-  engine::PointId at = engine::kNoPoint, next = engine::kNoPoint;
-  bool waiting = false;
-  std::string why;
-  std::uint64_t released_up_to = 0;
-};
-
 class TrafficGate {
  public:
   static engine::Result<std::unique_ptr<TrafficGate>> Create(
@@ -126,7 +118,6 @@ class TrafficGate {
   std::uint64_t ReleasedUpTo(const std::string& robot) const;
   const MinDistance& min_distance() const;
   const engine::TrafficStats& stats() const;
-  std::vector<GateAgentView> Agents() const;
   // One line on the robot's traffic state (for logs): where, route, what it waits on.
   std::string Describe(const std::string& robot) const;
 

@@ -104,6 +104,8 @@ struct GateImpl {
 
   // Effects.
   void Release(GateBot& b, long upto, int intersection, std::vector<GateEffect>& out);
+  // A kRelease of b's current horizon (a Resume when it was held).
+  void SendRelease(GateBot& b, int intersection, std::vector<GateEffect>& out);
   void Hold(GateBot& b, const std::string& why, std::vector<GateEffect>& out);
 
   // Solo agents (traffic_gate.cpp).
