@@ -373,6 +373,7 @@ Result<WarehouseMap> MapBuilder::Build(const MapBuildOptions& options) const {
       }
     }
   }
+  map.point_grid_ = PointGrid(map.points_);
   return map;
 }
 

@@ -99,6 +99,10 @@ PointId WarehouseMap::NearestPoint(const Eigen::Vector2d& xy, std::optional<Poin
                                    double* distance) const {
   double best = std::numeric_limits<double>::infinity();
   PointId best_id = kNoPoint;
+  if (!kind && point_grid_.Nearest(points_, xy, &best_id, &best)) {
+    if (distance) *distance = best;
+    return best_id;
+  }
   for (std::size_t i = 0; i < points_.size(); ++i) {
     if (kind && points_[i].kind != *kind) continue;
     const double dist = (points_[i].position - xy).norm();

@@ -25,6 +25,7 @@
 #include <vector>
 
 #include "engine/common/result.h"
+#include "engine/map/point_grid.h"
 
 namespace dispatch::engine {
 
@@ -135,7 +136,8 @@ class WarehouseMap {
   Eigen::Vector2d PositionOf(const ArcPosition& pos) const;
   // (x, y) -> the nearest (arc, offset), with its distance; error on a map without arcs.
   Result<ArcPosition> NearestArcPosition(const Eigen::Vector2d& xy, double* distance = nullptr) const;
-  // The nearest point (optionally of one kind) to (x, y); kNoPoint if none.
+  // The nearest point (optionally of one kind) to (x, y); kNoPoint if none. The lowest id
+  // among points at the same distance. Without a kind: a grid lookup (point_grid.h).
   PointId NearestPoint(const Eigen::Vector2d& xy, std::optional<PointKind> kind = std::nullopt,
                        double* distance = nullptr) const;
 
@@ -156,6 +158,7 @@ class WarehouseMap {
   std::vector<int> intersection_of_;
   std::unordered_map<std::string, PointId> point_index_;
   std::unordered_map<std::string, ZoneId> zone_index_;
+  PointGrid point_grid_;  // built by MapBuilder once the points are final
 };
 
 }  // namespace dispatch::engine

@@ -1,0 +1,40 @@
+// PointGrid: a uniform-grid index of a map's points for nearest-point queries
+// (WarehouseMap::NearestPoint), so snapping a robot's reported position costs
+// O(points in a few cells) instead of a scan of every point: on a 38k-cell LoRR floor with
+// 500 robots reporting at 10 Hz the scan alone saturated a core.
+//
+// Cells of edge ~ sqrt(2 * bounding-box area / points) (about two points a cell), points in
+// CSR order. Nearest() searches square rings of cells outward from the query's cell and stops
+// once no unvisited cell can hold a closer point; among points at the same distance it
+// returns the lowest id, like a scan in id order. Immutable after construction; thread-safe.
+#pragma once
+
+#include <Eigen/Core>
+
+#include <cstdint>
+#include <vector>
+
+namespace dispatch::engine {
+
+struct Point;
+using PointId = std::int32_t;
+
+class PointGrid {
+ public:
+  PointGrid() = default;
+  explicit PointGrid(const std::vector<Point>& points);
+
+  // The nearest of `points` (the vector the grid was built from) to xy and its distance.
+  // False when the grid cannot answer: no points, or xy not finite or outside the points'
+  // bounding box (the caller scans instead).
+  bool Nearest(const std::vector<Point>& points, const Eigen::Vector2d& xy, PointId* id, double* distance) const;
+
+ private:
+  Eigen::Vector2d lo_ = Eigen::Vector2d::Zero(), hi_ = Eigen::Vector2d::Zero();
+  double cell_ = 1.0, inv_cell_ = 1.0;
+  long cols_ = 0, rows_ = 0;
+  std::vector<std::uint32_t> begin_;  // per cell (row-major), then one past the end
+  std::vector<PointId> ids_;          // point ids by cell, ascending within a cell
+};
+
+}  // namespace dispatch::engine

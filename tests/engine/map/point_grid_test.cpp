@@ -1,0 +1,78 @@
+// PointGrid answers nearest-point queries exactly as a scan in id order would: the nearest
+// point, the lowest id among equally near ones, on random point sets (clustered, on a line,
+// with duplicates) and for queries anywhere in the bounding box, on points and on cell edges.
+#include "engine/map/point_grid.h"
+
+#include <gtest/gtest.h>
+
+#include <limits>
+#include <random>
+
+#include "engine/map/warehouse_map.h"
+
+namespace dispatch::engine {
+namespace {
+
+std::pair<PointId, double> Scan(const std::vector<Point>& points, const Eigen::Vector2d& xy) {
+  double best = std::numeric_limits<double>::infinity();
+  PointId id = kNoPoint;
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    const double d = (points[i].position - xy).norm();
+    if (d < best) best = d, id = static_cast<PointId>(i);
+  }
+  return {id, best};
+}
+
+std::vector<Point> RandomPoints(std::mt19937& rng, int n, int shape) {
+  std::uniform_real_distribution<double> u(-50.0, 150.0);
+  std::vector<Point> points(static_cast<std::size_t>(n));
+  for (auto& p : points) {
+    switch (shape) {
+      case 0: p.position = {u(rng), u(rng)}; break;                            // scattered
+      case 1: p.position = {std::round(u(rng)), std::round(u(rng) / 10)}; break;  // grid rows, duplicates
+      case 2: p.position = {u(rng), 3.0}; break;                               // on a line
+      default: p.position = {u(rng) / 100, u(rng) / 100}; break;               // one tight cluster
+    }
+  }
+  return points;
+}
+
+TEST(PointGridTest, AgreesWithAScanInIdOrder) {
+  std::mt19937 rng(7);
+  for (int shape = 0; shape < 4; ++shape) {
+    for (int n : {1, 2, 17, 500}) {
+      const std::vector<Point> points = RandomPoints(rng, n, shape);
+      const PointGrid grid(points);
+      Eigen::Vector2d lo = points[0].position, hi = lo;
+      for (const auto& p : points) lo = lo.cwiseMin(p.position), hi = hi.cwiseMax(p.position);
+      std::uniform_real_distribution<double> ux(lo.x(), hi.x()), uy(lo.y(), hi.y());
+      for (int q = 0; q < 400; ++q) {
+        Eigen::Vector2d xy = q % 4 == 0 ? points[rng() % points.size()].position : Eigen::Vector2d(ux(rng), uy(rng));
+        PointId id = kNoPoint;
+        double d = 0;
+        ASSERT_TRUE(grid.Nearest(points, xy, &id, &d)) << "shape " << shape << " n " << n;
+        const auto [want, want_d] = Scan(points, xy);
+        ASSERT_EQ(id, want) << "shape " << shape << " n " << n << " at " << xy.transpose();
+        ASSERT_EQ(d, want_d);
+      }
+    }
+  }
+}
+
+TEST(PointGridTest, DeclinesWhatItCannotAnswer) {
+  std::vector<Point> points(3);
+  points[0].position = {0, 0};
+  points[1].position = {10, 0};
+  points[2].position = {10, 10};
+  const PointGrid grid(points);
+  PointId id = kNoPoint;
+  double d = 0;
+  EXPECT_FALSE(grid.Nearest(points, {-1, 5}, &id, &d));  // outside the bounding box
+  EXPECT_FALSE(grid.Nearest(points, {std::nan(""), 5}, &id, &d));
+  EXPECT_FALSE(PointGrid().Nearest({}, {0, 0}, &id, &d));
+  ASSERT_TRUE(grid.Nearest(points, {9, 9}, &id, &d));
+  EXPECT_EQ(id, 2);
+}
+
+}  // namespace
+}  // namespace dispatch::engine
