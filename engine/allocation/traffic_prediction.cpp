@@ -257,8 +257,34 @@ void TrafficPredictor::SetPlan(const std::string& robot, const Plan& plan) {
     next.first_bucket = first;
     if (last_plus_one > first) {
       next.zones.reserve(last_plus_one - first);
+      // Plan::PositionAt at increasing times with a cursor (amortised O(1) per bucket instead
+      // of a binary search), and ZoneAt only when the position moved (a robot standing for
+      // many buckets at a pick costs one lookup). Same results as calling them directly.
+      const auto& w = plan.waypoints;
+      std::size_t upper = 0;  // first waypoint with eta > t
+      Eigen::Vector2d last_xy(std::numeric_limits<double>::quiet_NaN(), 0.0);
+      ZoneId last_zone = -1;
       for (std::size_t b = first; b < last_plus_one; ++b) {
-        next.zones.push_back(ZoneAt(plan.PositionAt(BucketStart(b))));
+        const double t = BucketStart(b);
+        Eigen::Vector2d xy;
+        if (t <= w.front().eta) {
+          xy = w.front().xy;
+        } else {
+          while (upper < w.size() && !(t < w[upper].eta)) ++upper;
+          const Waypoint& from = w[upper - 1];
+          if (upper == w.size() || t <= from.departure()) {
+            xy = from.xy;
+          } else {
+            const Waypoint& to = w[upper];
+            const double span = to.eta - from.departure();
+            xy = span <= 0.0 ? to.xy : Eigen::Vector2d(from.xy + ((t - from.departure()) / span) * (to.xy - from.xy));
+          }
+        }
+        if (!(xy == last_xy)) {
+          last_zone = ZoneAt(xy);
+          last_xy = xy;
+        }
+        next.zones.push_back(last_zone);
       }
       next.tail = next.zones.size();
       while (next.tail > 0 && next.zones[next.tail - 1] == next.zones.back()) --next.tail;

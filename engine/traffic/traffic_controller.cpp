@@ -793,5 +793,6 @@ bool TrafficController::StepAside(std::size_t r, const std::vector<PointId>& kee
 std::size_t TrafficController::ResolveDeadlocks(double t) { return impl_->ResolveDeadlocks(t); }
 const TrafficStats& TrafficController::stats() const { return impl_->stats; }
 const LaneCorridors& TrafficController::corridors() const { return impl_->lanes; }
+const IntersectionGrants& TrafficController::grants() const { return impl_->grants; }
 
 }  // namespace dispatch::engine

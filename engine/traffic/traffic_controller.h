@@ -168,6 +168,8 @@ class TrafficController {
 
   const TrafficStats& stats() const;
   const LaneCorridors& corridors() const;
+  // Intersection grants (guard i = map intersection i): holders and queues by agent id.
+  const IntersectionGrants& grants() const;
 
  private:
   struct Impl;
