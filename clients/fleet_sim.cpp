@@ -31,11 +31,13 @@
 
 #include <CLI/CLI.hpp>
 
+#include <algorithm>
 #include <atomic>
 #include <cerrno>
 #include <chrono>
 #include <csignal>
 #include <cstdio>
+#include <fstream>
 #include <map>
 #include <memory>
 #include <optional>
@@ -76,6 +78,41 @@ struct Slot {
 
   double Now(Clock::time_point wall) const {
     return welcome_server_time + Seconds(wall - welcome_wall) * time_scale;
+  }
+};
+
+// What a run measured (printed at exit, --stats-out as JSON).
+struct FleetStats {
+  std::size_t robots = 0;
+  std::size_t connects = 0;
+  // Wall ms a robot stood ready to drive on (arrived, planned departure passed, not held)
+  // until the Grant or Resume that released it arrived: the dispatcher's release latency as
+  // robots see it, from the report to the reply. Waits announced by a Hold are traffic
+  // waits and not counted.
+  std::vector<double> release_waits_ms;
+
+  double Percentile(double q) const {
+    if (release_waits_ms.empty()) return 0.0;
+    std::vector<double> v = release_waits_ms;
+    const auto k = static_cast<std::size_t>(q * static_cast<double>(v.size() - 1) + 0.5);
+    std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(k), v.end());
+    return v[k];
+  }
+  std::string Summary() const {
+    char buf[256];
+    std::snprintf(buf, sizeof buf,
+                  "%zu robots, %zu connects; release latency over %zu waits: p50 %.1f ms, p99 %.1f ms, max %.1f ms",
+                  robots, connects, release_waits_ms.size(), Percentile(0.5), Percentile(0.99), Percentile(1.0));
+    return buf;
+  }
+  std::string Json() const {
+    char buf[512];
+    std::snprintf(buf, sizeof buf,
+                  "{\"robots\": %zu, \"connects\": %zu, \"release_latency_ms\": {\"count\": %zu, "
+                  "\"p50\": %.3f, \"p90\": %.3f, \"p99\": %.3f, \"max\": %.3f}}",
+                  robots, connects, release_waits_ms.size(), Percentile(0.5), Percentile(0.9), Percentile(0.99),
+                  Percentile(1.0));
+    return buf;
   }
 };
 
@@ -167,6 +204,8 @@ int Main(int argc, char** argv) {
   int ready_fd = -1, control_fd = -1;
   std::size_t first = 1;
   std::vector<std::string> stall, slow, mute;
+  std::string stats_out;
+  FleetStats stats;
   app.add_option("--server", server, "dispatchd gRPC address HOST:PORT")->capture_default_str();
   app.add_option("--robots", count, "Number of robots")->capture_default_str()
       ->check(CLI::Range(std::size_t{1}, std::size_t{100000}));
@@ -190,6 +229,9 @@ int Main(int argc, char** argv) {
                  "Fault: ID:AFTER - after AFTER wall seconds robot ID stops moving and sending anything, "
                  "keeping its stream open (the server's heartbeat timeout must notice); it never "
                  "reconnects once the server closes the stream (repeat)");
+  app.add_option("--stats-out", stats_out,
+                 "At exit write JSON figures here: release latency (ms a robot stood ready waiting for "
+                 "a Grant or Resume, Holds excluded), robots, reconnects");
   app.add_option("--control-fd", control_fd,
                  "Read fault commands from this inherited fd, one a line: 'mute ID', 'drop ID'")
       ->check(CLI::Range(3, 65535));
@@ -346,7 +388,8 @@ int Main(int argc, char** argv) {
         s.last_sent = now;
         ++s.connects;
       }
-      for (const v1::ServerMessage& m : s.stream->TakeReceived()) {
+      for (const RobotStream::Received& received : s.stream->TakeReceived()) {
+        const v1::ServerMessage& m = received.message;
         if (m.has_welcome()) {
           s.welcomed = true;
           s.welcome_server_time = m.welcome().server_time();
@@ -354,7 +397,9 @@ int Main(int argc, char** argv) {
           s.heartbeat_interval = m.welcome().heartbeat_interval() > 0.0 ? m.welcome().heartbeat_interval() : 1.0;
           s.welcome_wall = now;
         }
-        s.robot->Apply(m);
+        std::optional<double> waited;
+        s.robot->Apply(m, s.welcomed ? s.Now(received.time) : -1.0, &waited);
+        if (waited) stats.release_waits_ms.push_back(*waited / s.time_scale * 1000.0);
       }
       if (!s.welcomed) continue;
       ++connected;
@@ -404,6 +449,17 @@ int Main(int argc, char** argv) {
   }
   for (Slot& s : slots) {
     if (s.stream) s.stream->WaitDone();
+  }
+  stats.robots = count;
+  for (const Slot& s : slots) stats.connects += static_cast<std::size_t>(s.connects);
+  std::printf("fleet-sim: %s\n", stats.Summary().c_str());
+  if (!stats_out.empty()) {
+    std::ofstream out(stats_out, std::ios::trunc);
+    out << stats.Json() << "\n";
+    if (!out) {
+      std::fprintf(stderr, "fleet-sim: cannot write --stats-out %s\n", stats_out.c_str());
+      return 1;
+    }
   }
   std::printf("fleet-sim: stopped\n");
   return 0;

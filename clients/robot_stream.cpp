@@ -46,9 +46,9 @@ void RobotStream::MaybeStartWrite() {
   StartWrite(&writing_);
 }
 
-std::vector<v1::ServerMessage> RobotStream::TakeReceived() {
+std::vector<RobotStream::Received> RobotStream::TakeReceived() {
   std::lock_guard<std::mutex> lock(mu_);
-  std::vector<v1::ServerMessage> out;
+  std::vector<Received> out;
   out.swap(received_);
   return out;
 }
@@ -81,7 +81,7 @@ void RobotStream::OnReadDone(bool ok) {
   if (!ok) return;  // the server ended its side; OnDone follows
   {
     std::lock_guard<std::mutex> lock(mu_);
-    received_.push_back(incoming_);
+    received_.push_back({incoming_, std::chrono::steady_clock::now()});
   }
   StartRead(&incoming_);
 }

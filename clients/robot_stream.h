@@ -1,7 +1,8 @@
 // One robot's FleetService.Connect stream in fleet-sim, on gRPC's callback (reactor) API so
 // that hundreds of robots share gRPC's few threads instead of a thread each.
 //
-// Received server messages are queued for the owner (TakeReceived); writes are queued and
+// Received server messages are queued for the owner (TakeReceived), stamped with the time
+// they arrived (for latency figures: the owner polls at its own tick); writes are queued and
 // sent one at a time (gRPC allows one outstanding write per stream). The stream ends when
 // the server ends it, on a network error, or on Close(); then done() is true and status()
 // says why. A reactor is used for one call only: reconnecting means a new RobotStream.
@@ -37,7 +38,11 @@ class RobotStream final : public grpc::ClientBidiReactor<v1::RobotMessage, v1::S
   void DiscardPending();
   // Sends the messages whose delay has passed (call it from the owner's loop).
   void Pump();
-  std::vector<v1::ServerMessage> TakeReceived();
+  struct Received {
+    v1::ServerMessage message;
+    std::chrono::steady_clock::time_point time;  // when gRPC handed it over
+  };
+  std::vector<Received> TakeReceived();
   // Ends the call from the client side (the "dropped stream" fault and shutdown).
   void Close();
   bool done() const;
@@ -68,7 +73,7 @@ class RobotStream final : public grpc::ClientBidiReactor<v1::RobotMessage, v1::S
   bool closed_ = false;
   bool done_ = false;
   grpc::Status status_;
-  std::vector<v1::ServerMessage> received_;
+  std::vector<Received> received_;
 };
 
 }  // namespace dispatch::clients

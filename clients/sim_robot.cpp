@@ -64,9 +64,10 @@ void SimRobot::RepeatFinishedDrops(
   }
 }
 
-bool SimRobot::Apply(const v1::ServerMessage& message) {
+bool SimRobot::Apply(const v1::ServerMessage& message, double now, std::optional<double>* released_after) {
   if (message.sequence() != 0 && message.sequence() <= last_applied_) return false;
   last_applied_ = std::max(last_applied_, message.sequence());
+  const std::uint64_t horizon_before = released_up_to_;
   switch (message.body_case()) {
     case v1::ServerMessage::kAssignment: {
       const v1::Assignment& a = message.assignment();
@@ -116,6 +117,13 @@ bool SimRobot::Apply(const v1::ServerMessage& message) {
     default:
       break;
   }
+  if (held_ || message.has_assignment() || message.has_plan_update() || message.has_cancel()) {
+    ready_since_.reset();  // a traffic wait, or a new plan: not a release it waited for
+  } else if (ready_since_ && released_up_to_ > horizon_before && waypoints_.size() > 1 &&
+             MayDriveTo(waypoints_[1])) {
+    if (released_after && now >= 0.0) *released_after = std::max(0.0, now - *ready_since_);
+    ready_since_.reset();
+  }
   return true;
 }
 
@@ -125,6 +133,7 @@ bool SimRobot::MayDriveTo(const Waypoint& w) const {
 
 void SimRobot::ArriveAt(Waypoint& w, double time, std::vector<v1::RobotMessage>& out) {
   w.arrived = true;
+  w.reported = now_;
   position_ = Xy(w.wp);
   last_reached_ = std::max(last_reached_, w.wp.sequence());
   v1::RobotMessage m;
@@ -169,6 +178,7 @@ void SimRobot::Step(double now, std::vector<v1::RobotMessage>& out) {
       if (dwell_until_ > now_) break;
       dwelling_ = false;
       t = std::max(t, dwell_until_);
+      if (!waypoints_.empty()) waypoints_.front().reported = std::max(waypoints_.front().reported, dwell_until_);
       if (IsTask(dwell_wp_)) Finished(dwell_wp_, out);
       continue;
     }
@@ -177,8 +187,13 @@ void SimRobot::Step(double now, std::vector<v1::RobotMessage>& out) {
     if (front.arrived) {
       if (waypoints_.size() == 1) break;  // plan done: stand here
       if (held_ && (hold_at_ == 0 || hold_at_ <= front.wp.sequence())) break;
-      if (!MayDriveTo(waypoints_[1])) break;
       const double depart = front.wp.eta() + front.wp.dwell();
+      if (!MayDriveTo(waypoints_[1])) {
+        // Ready to go but not released: since the later of its arrival's report and the
+        // planned departure.
+        if (!ready_since_ && depart <= now_) ready_since_ = std::max(front.reported, depart);
+        break;
+      }
       if (depart > now_) break;  // ahead of plan: wait for the planned departure
       t = std::max(t, depart);
       waypoints_.pop_front();

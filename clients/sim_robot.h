@@ -34,6 +34,7 @@
 
 #include <cstdint>
 #include <deque>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -54,6 +55,11 @@ class SimRobot {
   double speed() const { return current_speed_; }
   std::uint64_t last_applied_sequence() const { return last_applied_; }
   bool held() const { return held_; }
+  // Set while the robot stands ready to drive on (arrived, its planned departure passed, not
+  // held) and only the release horizon keeps it: the dispatcher time it became ready. A Hold
+  // clears it (a traffic wait the server announced is not release latency); so does the
+  // release that lets it go (Apply returns the wait it ended through `released_after`).
+  std::optional<double> waiting_for_release_since() const { return ready_since_; }
   // No plan left: standing on its last waypoint (or never given one), not working.
   bool idle() const;
   std::size_t pending_waypoints() const { return waypoints_.size(); }
@@ -67,8 +73,10 @@ class SimRobot {
   // The first message of a stream.
   v1::RobotMessage Hello() const;
   // Applies one server message (see the file comment). Returns false for a message it
-  // ignored as already applied.
-  bool Apply(const v1::ServerMessage& message);
+  // ignored as already applied. `now` (dispatcher time the message arrived, or < 0 when
+  // unknown): when the message releases a robot that stood waiting for it, *released_after
+  // gets how long it waited (dispatcher seconds).
+  bool Apply(const v1::ServerMessage& message, double now = -1.0, std::optional<double>* released_after = nullptr);
   // Advances to dispatcher time `now` (>= the previous call's); appends the events that
   // happened (WaypointReached, TaskEvent) to `out`.
   void Step(double now, std::vector<v1::RobotMessage>& out);
@@ -79,6 +87,7 @@ class SimRobot {
   struct Waypoint {
     v1::TimedWaypoint wp;
     bool arrived = false;
+    double reported = 0.0;  // the step (dispatcher time) whose events reported the arrival
   };
   void AdoptWaypoints(const google::protobuf::RepeatedPtrField<v1::TimedWaypoint>& wps);
   void ArriveAt(Waypoint& w, double time, std::vector<v1::RobotMessage>& out);
@@ -102,6 +111,7 @@ class SimRobot {
   std::uint64_t last_reached_ = 0;
   bool held_ = false;
   std::uint64_t hold_at_ = 0;  // stop at this waypoint (0: at once)
+  std::optional<double> ready_since_;  // see waiting_for_release_since()
   bool dwelling_ = false;
   double dwell_until_ = 0.0;
   v1::TimedWaypoint dwell_wp_;

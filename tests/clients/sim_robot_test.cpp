@@ -106,6 +106,44 @@ TEST(SimRobotTest, StopsAtTheReleaseHorizonUntilAGrant) {
   EXPECT_NEAR(r.position().x(), 3.0, 1e-9);
 }
 
+TEST(SimRobotTest, MeasuresHowLongItStoodReadyForARelease) {
+  SimRobot r("R1", {0, 0}, 1.0);
+  r.Apply(Plan(1, /*release_all=*/false));
+  Events run;
+  StepTo(r, 0.0, 1.5, 0.5, run);
+  EXPECT_FALSE(r.waiting_for_release_since());  // still driving to waypoint 2
+  StepTo(r, 2.0, 3.0, 0.5, run);  // reports waypoint 2 in the step at t = 2
+  ASSERT_TRUE(r.waiting_for_release_since());
+  EXPECT_DOUBLE_EQ(*r.waiting_for_release_since(), 2.0);
+  v1::ServerMessage g;
+  g.set_sequence(2);
+  g.mutable_grant()->set_release_up_to_sequence(3);
+  std::optional<double> waited;
+  r.Apply(g, 3.25, &waited);
+  ASSERT_TRUE(waited);
+  EXPECT_DOUBLE_EQ(*waited, 1.25);
+  EXPECT_FALSE(r.waiting_for_release_since());
+  // At the pick: it drove on from t = 3 (released mid-step), arrived at 5, worked 3 s; ready
+  // from the later of its work's end (8) and the planned departure (4 + 3 = 7).
+  StepTo(r, 3.5, 7.5, 0.5, run);
+  EXPECT_FALSE(r.waiting_for_release_since());  // still working
+  StepTo(r, 8.0, 8.0, 0.5, run);
+  ASSERT_TRUE(r.waiting_for_release_since());
+  EXPECT_DOUBLE_EQ(*r.waiting_for_release_since(), 8.0);
+  // A Hold makes it a traffic wait: the Resume that follows measures nothing.
+  v1::ServerMessage h;
+  h.set_sequence(3);
+  h.mutable_hold()->set_reason("point held");
+  r.Apply(h, 8.0, &waited);
+  EXPECT_FALSE(r.waiting_for_release_since());
+  waited.reset();
+  v1::ServerMessage res;
+  res.set_sequence(4);
+  res.mutable_resume()->set_release_up_to_sequence(4);
+  r.Apply(res, 9.0, &waited);
+  EXPECT_FALSE(waited);
+}
+
 TEST(SimRobotTest, HoldStopsAtOnceAndResumeContinues) {
   SimRobot r("R1", {0, 0}, 1.0);
   r.Apply(Plan(1));
