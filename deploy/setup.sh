@@ -3,6 +3,8 @@
 # is missing) and configures + builds the project into a build folder.
 #   deploy/setup.sh packages            install packages only
 #   deploy/setup.sh build DIR [ARGS..]  packages, then configure DIR with ARGS and build it
+# With DISPATCH_TEST_DEPS=1 it also installs what only the tests use (deploy/test.sh sets it):
+# headless Chromium and python3-websocket for the web map's browser test.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -12,9 +14,12 @@ PACKAGES=(
   libgtest-dev libgmock-dev libbenchmark-dev
   libgrpc++-dev protobuf-compiler-grpc libprotobuf-dev protobuf-compiler
   libsqlite3-dev
-  libspdlog-dev libcpp-httplib-dev
+  libspdlog-dev libcpp-httplib-dev prometheus-cpp-dev
   python3 python3-grpcio python3-protobuf
 )
+if [ "${DISPATCH_TEST_DEPS:-0}" = 1 ]; then
+  PACKAGES+=(chromium python3-websocket)
+fi
 
 install_packages() {
   local missing=()

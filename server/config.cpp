@@ -4,6 +4,7 @@
 #include <nlohmann/json.hpp>
 
 #include <cmath>
+#include <filesystem>
 #include <fstream>
 #include <algorithm>
 #include <functional>
@@ -46,6 +47,7 @@ std::vector<Key> Keys() {
       MakeKey("t_w1", &ServerConfig::t_w1),
       MakeKey("t_w2", &ServerConfig::t_w2),
       MakeKey("blocked_after", &ServerConfig::blocked_after),
+      MakeKey("web_root", &ServerConfig::web_root),
       MakeKey("ports_file", &ServerConfig::ports_file),
       MakeKey("ready_fd", &ServerConfig::ready_fd),
       MakeKey("log_level", &ServerConfig::log_level),
@@ -115,6 +117,9 @@ engine::Status ValidateServerConfig(const ServerConfig& c) {
   for (auto [name, v] : {std::pair{"t_w1", c.t_w1}, {"t_w2", c.t_w2}, {"blocked_after", c.blocked_after}}) {
     if (!positive(v)) return InvalidArgument(std::string(name) + " must be > 0 seconds");
   }
+  if (!c.web_root.empty() && !std::filesystem::is_directory(c.web_root)) {
+    return InvalidArgument("web_root '" + c.web_root + "' is not a folder");
+  }
   return engine::Ok{};
 }
 
@@ -150,6 +155,8 @@ engine::Result<ParsedCommandLine> ParseCommandLine(int argc, char** argv) {
   app.add_option("--blocked-after", flags.blocked_after,
                  "Waiting with no alternative this long marks a robot blocked, dispatcher s")
       ->capture_default_str();
+  app.add_option("--web-root", flags.web_root,
+                 "Serve the web map from this folder instead of the built-in copy");
   app.add_option("--ports-file", flags.ports_file, "Write the chosen ports as JSON here");
   app.add_option("--ready-fd", flags.ready_fd,
                  "Write the chosen ports as one JSON line to this inherited fd, then close it");

@@ -30,6 +30,9 @@ struct ServerConfig {
   double t_w1 = 10.0;           // s: head-on (single-lane) wait before re-planning (Wang2019)
   double t_w2 = 20.0;           // s: wait on a held point or grant before re-planning
   double blocked_after = 120.0; // s of waiting with no alternative -> robot blocked (fault)
+  // Serve the web map's files from this folder instead of the copy built into the binary
+  // ("" = built-in; for working on the page without rebuilding).
+  std::string web_root;
   std::string ports_file;         // written as {"grpc_port":..,"http_port":..} once listening
   // An inherited file descriptor (e.g. a pipe or FIFO from a script) that gets the same JSON
   // line once listening, then is closed: readiness without polling. -1 = none.

@@ -12,6 +12,14 @@
 #include "server/json_convert.h"
 
 namespace dispatch::server {
+namespace {
+
+// Picks per order. Seed tasks have 1-3; the cap keeps one order (and so every ListOrders
+// page and Assignment carrying it) far below gRPC's 4 MiB message limit: an order of
+// 100 000 picks fits in one SubmitOrder but makes every default-sized page unreadable.
+constexpr std::size_t kMaxPicksPerOrder = 100;
+
+}  // namespace
 
 ServiceStatus FromEngineError(const engine::Error& error) {
   switch (error.code) {
@@ -200,17 +208,28 @@ void Dispatcher::Loop() {
       next_tick = Clock::now() + tick;
     }
     StepTraffic();
-    // Publish first, then let replies, robot messages and journal events out: whoever hears
-    // of a change finds it in the snapshot.
-    if (dirty_) Publish();
-    std::vector<std::function<void()>> effects;
-    effects.swap(deferred_);
-    for (auto& effect : effects) effect();
+    Flush();
+    // Allocation runs once per batch, after the batch's replies are out: an order is
+    // acknowledged when it is committed, and the orders of a burst are auctioned together.
+    if (allocation_due_) {
+      AllocatePending();
+      StepTraffic();
+      Flush();
+    }
     if (stopping) {
       std::lock_guard<std::mutex> lock(queue_mu_);
       if (queue_.empty()) break;
     }
   }
+}
+
+void Dispatcher::Flush() {
+  // Publish first, then let replies, robot messages and journal events out: whoever hears of
+  // a change finds it in the snapshot.
+  if (dirty_) Publish();
+  std::vector<std::function<void()>> effects;
+  effects.swap(deferred_);
+  for (auto& effect : effects) effect();
 }
 
 void Dispatcher::Publish() {
@@ -235,9 +254,19 @@ void Dispatcher::Publish() {
       view.plan_id = r.assignment.plan_id;
       view.waypoints = r.assignment.plan.waypoints.size();
     }
+    if (gate_) {
+      GateRobotState traffic = gate_->RobotState(id);
+      view.held = traffic.held;
+      view.hold_reason = std::move(traffic.reason);
+      view.formation = std::move(traffic.formation);
+    }
     snap->robots.emplace(id, std::move(view));
   }
+  snap->zones = ZoneViews(snap->robots);
   if (gate_) {
+    for (auto& g : gate_->Intersections()) {
+      snap->intersections.push_back({std::move(g.holders), std::move(g.waiting)});
+    }
     TrafficView& t = snap->traffic;
     t.enabled = true;
     t.grants = traffic_counts_.grants;
@@ -255,6 +284,28 @@ void Dispatcher::Publish() {
   }
   std::atomic_store(&snapshot_, std::shared_ptr<const Snapshot>(std::move(snap)));
   dirty_ = false;
+}
+
+std::vector<ZoneView> Dispatcher::ZoneViews(const std::map<std::string, RobotView>& robots) const {
+  const auto& zones = map_->zones();
+  std::vector<ZoneView> out(zones.size());
+  for (const auto& [id, view] : robots) {
+    if (!view.connected) continue;
+    const engine::Robot& r = view.robot;
+    long zone = -1;
+    if (r.current_point != engine::kNoPoint) {
+      zone = map_->point(r.current_point).zone;
+    } else {
+      for (std::size_t z = 0; z < zones.size() && zone < 0; ++z) {
+        if (zones[z].Contains(r.pose.position)) zone = static_cast<long>(z);
+      }
+    }
+    if (zone >= 0) out[static_cast<std::size_t>(zone)].robots.push_back(id);
+  }
+  for (std::size_t z = 0; z < zones.size(); ++z) {
+    if (zones[z].area > 0) out[z].density = static_cast<double>(out[z].robots.size()) / zones[z].area;
+  }
+  return out;
 }
 
 std::shared_ptr<const OrderView> Dispatcher::Find(const std::string& order_id) const {
@@ -338,6 +389,12 @@ void Dispatcher::DoSubmit(const engine::OrderRequest& request,
                               "client_order_id is longer than 128 bytes");
     return done(std::move(reply));
   }
+  if (request.picks.size() > kMaxPicksPerOrder) {
+    reply.status = MakeStatus(StatusCode::kInvalidArgument,
+                              "order '" + request.client_id + "' has " + std::to_string(request.picks.size()) +
+                                  " picks; at most " + std::to_string(kMaxPicksPerOrder) + " are allowed");
+    return done(std::move(reply));
+  }
   engine::OrderRequest req = request;
   req.id = req.client_id;  // errors name the order by the client's id
   req.created_time = Now();
@@ -392,7 +449,7 @@ void Dispatcher::DoSubmit(const engine::OrderRequest& request,
     Journal(events->front());
   }
   spdlog::info("order {} ({}) accepted", order.id, order.client_id);
-  AllocatePending();
+  allocation_due_ = true;
 }
 
 void Dispatcher::DoCancel(const std::string& order_id, const std::string& reason,
@@ -423,7 +480,7 @@ void Dispatcher::DoCancel(const std::string& order_id, const std::string& reason
   }
   reply.order = Find(order_id);
   done(std::move(reply));
-  AllocatePending();
+  allocation_due_ = true;
 }
 
 }  // namespace dispatch::server

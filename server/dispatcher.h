@@ -13,9 +13,10 @@
 // plans) are one store transaction. At start the dispatcher recovers orders, explanations,
 // robots and assignments from the store.
 //
-// Allocation: the strategy (auction or greedy) runs over the connected robots whenever an
-// order arrives, a robot connects or finishes an order, or an order comes back for
-// re-allocation. Each round builds a fresh engine::FleetState with every connected robot at
+// Allocation: the strategy (auction or greedy) runs over the connected robots once per batch
+// in which an order arrived, a robot connected or finished an order, or an order came back
+// for re-allocation (after the batch's replies are out, so a burst of orders is auctioned
+// together and SubmitOrder answers once the order is committed). Each round builds a fresh engine::FleetState with every connected robot at
 // its reported point now, replays its remaining orders into its queue (ReplayQueue), then
 // auctions the accepted orders; a new order's waypoints are appended to the robot's plan.
 // Orders stay `accepted` while no robot (or fewer than 3 for a formation) is connected.
@@ -54,6 +55,7 @@
 #include "engine/fleet/order.h"
 #include "engine/routing/route_table.h"
 #include "engine/traffic/traffic_controller.h"
+#include "server/metrics.h"
 #include "server/robot_link.h"
 #include "server/service_status.h"
 #include "server/snapshot.h"
@@ -77,6 +79,9 @@ struct DispatcherOptions {
   // engine's TrafficController. Off: every waypoint is sent released (no grants or holds).
   bool traffic_control = true;
   engine::TrafficControllerConfig traffic;
+  // Where allocation latency and grant waits are observed (optional; must outlive the
+  // dispatcher).
+  ServiceMetrics* metrics = nullptr;
 };
 
 struct SubmitReply {
@@ -89,6 +94,15 @@ struct OrderReply {
   ServiceStatus status;
   std::shared_ptr<const OrderView> order;
 };
+
+// One waypoint of an order's remaining route (for operators: GET /api/v1/orders/{id}).
+struct RouteWaypoint {
+  std::uint64_t seq = 0;
+  Eigen::Vector2d xy = Eigen::Vector2d::Zero();
+  engine::WaypointAction action = engine::WaypointAction::kMove;
+  bool released = false;
+};
+using OrderRoutes = std::map<std::string, std::vector<RouteWaypoint>>;  // by robot id
 
 class Dispatcher {
  public:
@@ -126,6 +140,8 @@ class Dispatcher {
 
   // Loop thread only (e.g. from Call): each robot's traffic state in one line.
   std::vector<std::pair<std::string, std::string>> TrafficLines() const;
+  // Loop thread only: the waypoints of `order_id` its robots have not reached yet.
+  OrderRoutes RoutesOf(const std::string& order_id) const;
 
   // Runs `fn` on the loop thread.
   void Post(std::function<void()> fn);
@@ -150,6 +166,7 @@ class Dispatcher {
     bool has_assignment = false;
     std::uint64_t last_reached = 0;  // highest waypoint sequence reported reached
     std::optional<Eigen::Vector2d> last_xy;  // where it reached its last waypoint
+    std::optional<double> held_since;  // dispatcher seconds of the Hold in force
   };
 
   Dispatcher(std::shared_ptr<const engine::WarehouseMap> map,
@@ -213,6 +230,10 @@ class Dispatcher {
   void StartOrder(const std::string& order_id, const std::string& detail);
   void Tick();
   void Publish();
+  // Publishes the snapshot if anything changed, then runs the deferred effects.
+  void Flush();
+  // Live zone densities from the robots' reported positions (their current point's zone).
+  std::vector<ZoneView> ZoneViews(const std::map<std::string, RobotView>& robots) const;
 
   // Traffic control (dispatcher_traffic.cpp).
   GatePlan GatePlanOf(const RobotRuntime& robot) const;
@@ -252,6 +273,7 @@ class Dispatcher {
   bool dirty_ = true;
   std::vector<std::function<void()>> deferred_;  // effects of the current batch
   bool retry_allocation_ = false;
+  bool allocation_due_ = false;  // an allocation round runs at the end of this batch
   MinDistance min_distance_;
   std::unordered_map<std::string, double> order_distance_;  // metres driven, open orders
   Clock::time_point next_distance_sample_{};

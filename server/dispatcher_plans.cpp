@@ -61,6 +61,30 @@ std::string Dispatcher::OrderOfWaypoint(const storage::AssignmentRecord& plan, s
   return drops < plan.order_ids.size() ? plan.order_ids[drops] : std::string();
 }
 
+OrderRoutes Dispatcher::RoutesOf(const std::string& order_id) const {
+  OrderRoutes out;
+  auto view = Find(order_id);
+  if (!view) return out;
+  for (const auto& robot_id : view->record.robots) {
+    auto it = robots_.find(robot_id);
+    if (it == robots_.end() || !it->second.has_assignment) continue;
+    const RobotRuntime& r = it->second;
+    const auto& a = r.assignment;
+    const std::uint64_t released = ReleasedUpTo(r);
+    auto& route = out[robot_id];
+    std::size_t drops = 0;  // segment k of the plan serves order_ids[k] (see OrderOfWaypoint)
+    for (std::size_t i = 1; i < a.plan.waypoints.size() && drops < a.order_ids.size(); ++i) {
+      const auto& w = a.plan.waypoints[i];
+      const auto seq = static_cast<std::uint64_t>(w.seq);
+      if (a.order_ids[drops] == order_id && seq > r.last_reached) {
+        route.push_back({seq, w.xy, w.action, seq <= released});
+      }
+      if (w.action == engine::WaypointAction::kDrop) ++drops;
+    }
+  }
+  return out;
+}
+
 std::vector<std::string> Dispatcher::CutPlan(storage::AssignmentRecord& plan,
                                              const std::string& order_id) {
   auto it = std::find(plan.order_ids.begin(), plan.order_ids.end(), order_id);
@@ -117,6 +141,7 @@ void Dispatcher::SendTo(RobotRuntime& robot, RobotOutbound message) {
 
 void Dispatcher::AllocatePending() {
   retry_allocation_ = false;
+  allocation_due_ = false;
   std::vector<std::shared_ptr<const OrderView>> pending;
   for (const auto& view : orders_) {
     if (view->record.order.state == engine::OrderState::kAccepted) pending.push_back(view);
@@ -162,7 +187,12 @@ void Dispatcher::AllocatePending() {
   for (const auto& view : pending) {
     const engine::Order& order = view->record.order;
     if (static_cast<std::size_t>(order.team_size()) > ids.size()) continue;
-    if (!AwardOrder(order, state)) {
+    const auto start = Clock::now();
+    const bool stored = AwardOrder(order, state);
+    if (options_.metrics) {
+      options_.metrics->ObserveAllocation(std::chrono::duration<double>(Clock::now() - start).count());
+    }
+    if (!stored) {
       retry_allocation_ = true;  // the store failed: try again on the next tick
       return;
     }

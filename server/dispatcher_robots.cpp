@@ -20,9 +20,18 @@ bool ValidRobotId(const std::string& id) {
 
 std::string Fixed(double v) {
   std::ostringstream out;
-  out.precision(2);
-  out << std::fixed << v;
+  if (std::abs(v) < 1e9) {
+    out.precision(2);
+    out << std::fixed;
+  }
+  out << v;  // 1e+300, not 300 digits
   return out.str();
+}
+
+// Finite and on the floor rectangle, give or take `margin` metres.
+bool OnFloor(const engine::WarehouseMap& map, const Eigen::Vector2d& xy, double margin) {
+  return xy.allFinite() && xy.x() >= map.floor_min().x() - margin && xy.x() <= map.floor_max().x() + margin &&
+         xy.y() >= map.floor_min().y() - margin && xy.y() <= map.floor_max().y() + margin;
 }
 
 }  // namespace
@@ -56,7 +65,12 @@ void Dispatcher::DoRobotMessage(const std::shared_ptr<RobotLink>& link, const Ro
   dirty_ = true;
   switch (m.kind) {
     case RobotInbound::Kind::kState: {
-      if (!std::isfinite(m.pose.position.x()) || !std::isfinite(m.pose.position.y())) return;
+      // A pose off the floor (NaN, 1e300, a wrong frame) is not news about the robot: it
+      // would leave it at no map point and out of every auction. Ignored, like a bad
+      // battery value, which would otherwise fail the robot's next Hello (ValidateRobot).
+      if (!OnFloor(*map_, m.pose.position, options_.robot_snap_tolerance) || !std::isfinite(m.pose.heading)) {
+        return;
+      }
       r->record.robot.pose = m.pose;
       if (m.arc_id && *m.arc_id >= 0 && static_cast<std::size_t>(*m.arc_id) < map_->arcs().size()) {
         r->record.robot.current_point = map_->arc(*m.arc_id).to;
@@ -67,15 +81,28 @@ void Dispatcher::DoRobotMessage(const std::shared_ptr<RobotLink>& link, const Ro
           r->record.robot.state != engine::RobotState::kFault) {
         r->record.robot.state = *m.state;
       }
-      if (m.battery) r->record.robot.battery = *m.battery;
-      r->last_reached = std::max(r->last_reached, m.sequence);
-      if (gate_) gate_->Report(r->record.robot.id, m.pose.position, m.sequence, Now());
+      if (m.battery && *m.battery >= 0.0 && *m.battery <= 1.0) r->record.robot.battery = *m.battery;
+      // A waypoint beyond the highest ever numbered for this robot was never sent, so it
+      // cannot have been passed: such a claim is ignored (the gate would otherwise take the
+      // robot to be at its plan's end and disregard its real progress from then on).
+      std::int64_t numbered = r->assignment.released_up_to;
+      if (!r->assignment.plan.waypoints.empty()) {
+        numbered = std::max<std::int64_t>(numbered, r->assignment.plan.waypoints.back().seq);
+      }
+      const std::uint64_t passed =
+          numbered >= 0 && m.sequence <= static_cast<std::uint64_t>(numbered) ? m.sequence : 0;
+      r->last_reached = std::max(r->last_reached, passed);
+      if (gate_) gate_->Report(r->record.robot.id, m.pose.position, passed, Now());
       break;
     }
     case RobotInbound::Kind::kWaypointReached: DoWaypointReached(*r, m); break;
     case RobotInbound::Kind::kTaskEvent: DoTaskEvent(*r, m); break;
     case RobotInbound::Kind::kAck:
-      r->record.last_acked_sequence = std::max(r->record.last_acked_sequence, m.sequence);
+      // An ack of a sequence never sent is ignored: believed, it would skip what is sent
+      // next and (beyond 2^63) make the robot's record unstorable.
+      if (m.sequence < r->record.next_sequence) {
+        r->record.last_acked_sequence = std::max(r->record.last_acked_sequence, m.sequence);
+      }
       break;
     case RobotInbound::Kind::kHeartbeat:
     case RobotInbound::Kind::kHello: break;
@@ -134,6 +161,9 @@ void Dispatcher::DoHello(const std::shared_ptr<RobotLink>& link, const RobotInbo
   record.robot.pose.position = xy;
   record.robot.current_point = point;
   record.robot.state = engine::RobotState::kIdle;
+  if (record.robot.battery && !(*record.robot.battery >= 0.0 && *record.robot.battery <= 1.0)) {
+    record.robot.battery.reset();  // stored by an older server that took any report
+  }
   record.kind = hello.robot_kind.empty() ? "differential" : hello.robot_kind;
   record.last_seen = Now();
   record.last_acked_sequence = std::max(record.last_acked_sequence, hello.last_acked_sequence);
@@ -171,7 +201,7 @@ void Dispatcher::DoHello(const std::shared_ptr<RobotLink>& link, const RobotInbo
   // Resume: the robot gets its whole current plan again (it skips waypoints it has passed).
   if (resend) SendTo(r, PlanMessage(r, true, 0));
   spdlog::info("robot {} connected at '{}'", hello.robot_id, map_->point(point).name);
-  AllocatePending();
+  allocation_due_ = true;
 }
 
 void Dispatcher::StartOrder(const std::string& order_id, const std::string& detail) {
@@ -289,7 +319,7 @@ void Dispatcher::DoTaskEvent(RobotRuntime& r, const RobotInbound& m) {
   Put(copy);
   if (event) Journal(*event);
   if (complete) spdlog::info("order {} completed", m.order_id);
-  AllocatePending();
+  allocation_due_ = true;
 }
 
 void Dispatcher::MarkOffline(RobotRuntime& r, const std::string& why) {
@@ -341,7 +371,7 @@ void Dispatcher::Tick() {
       retry_allocation_ = true;
     }
   }
-  if (retry_allocation_) AllocatePending();
+  if (retry_allocation_) allocation_due_ = true;
 }
 
 }  // namespace dispatch::server

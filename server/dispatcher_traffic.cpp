@@ -13,7 +13,14 @@ GatePlan Dispatcher::GatePlanOf(const RobotRuntime& r) const {
   GatePlan g;
   const auto& w = r.assignment.plan.waypoints;
   g.waypoints = w;
-  for (std::size_t i = 0; i < w.size(); ++i) g.order_of.push_back(OrderOfWaypoint(r.assignment, i));
+  // As OrderOfWaypoint, in one pass: waypoint 0 anchors, then segment k serves order_ids[k].
+  g.order_of.reserve(w.size());
+  std::size_t drops = 0;
+  for (std::size_t i = 0; i < w.size(); ++i) {
+    const auto& ids = r.assignment.order_ids;
+    g.order_of.push_back(i == 0 || drops >= ids.size() ? std::string() : ids[drops]);
+    if (i > 0 && w[i].action == engine::WaypointAction::kDrop) ++drops;
+  }
   for (const auto& id : r.assignment.order_ids) {
     auto view = Find(id);
     if (view && view->record.order.formation) g.teams[id] = view->record.robots;
@@ -71,10 +78,15 @@ void Dispatcher::StepTraffic() {
 void Dispatcher::ApplyGateEffect(GateEffect& e) {
   RobotRuntime* r = RobotOf(e.robot);
   if (!r) return;
+  dirty_ = true;  // the snapshot shows grants and holds (intersections, robots' hold state)
   switch (e.kind) {
     case GateEffect::Kind::kRelease: {
       RobotOutbound m;
       m.released_up_to = e.release_up_to;
+      if (r->held_since) {
+        if (options_.metrics) options_.metrics->ObserveGrantWait(Now() - *r->held_since);
+        r->held_since.reset();
+      }
       if (e.resume) {
         m.kind = RobotOutbound::Kind::kResume;
       } else {
@@ -96,6 +108,7 @@ void Dispatcher::ApplyGateEffect(GateEffect& e) {
       m.stop_at_sequence = e.hold_at;
       m.reason = e.reason;
       ++traffic_counts_.holds;
+      if (!r->held_since) r->held_since = Now();
       spdlog::debug("hold {}: {}", e.robot, e.reason);
       SendTo(*r, std::move(m));
       break;

@@ -7,6 +7,18 @@
 namespace dispatch::server {
 namespace {
 
+// Status messages travel in a trailer and clients refuse large metadata ("received initial
+// metadata size exceeds limit", which would hide the error); messages echo client input (a
+// point name, an id), so they are cut to a size every client accepts.
+grpc::Status Fitted(grpc::Status status) {
+  constexpr std::size_t kMaxMessage = 1024;
+  const std::string& m = status.error_message();
+  if (m.size() <= kMaxMessage) return status;
+  std::size_t cut = kMaxMessage;
+  while (cut > 0 && (static_cast<unsigned char>(m[cut]) & 0xC0) == 0x80) --cut;  // keep UTF-8 whole
+  return {status.error_code(), m.substr(0, cut) + "... (" + std::to_string(m.size()) + " bytes)"};
+}
+
 class RobotSession;
 
 // The dispatcher's handle on a session; outlives it (the session detaches in OnDone).
@@ -42,7 +54,7 @@ class RobotSession final
     auto message = RobotInboundFromProto(in_);
     if (!message.ok()) {
       dispatcher_.OnRobotGone(link_);
-      RequestFinish(ToGrpcStatus(FromEngineError(message.error())));
+      RequestFinish(Fitted(ToGrpcStatus(FromEngineError(message.error()))));
       return;
     }
     dispatcher_.OnRobotMessage(link_, std::move(message).value());
@@ -70,7 +82,7 @@ void SessionLink::Send(RobotOutbound message) {
 
 void SessionLink::Close(ServiceStatus status) {
   std::lock_guard<std::mutex> lock(mu_);
-  if (session_) session_->RequestFinish(ToGrpcStatus(status));
+  if (session_) session_->RequestFinish(Fitted(ToGrpcStatus(status)));
 }
 
 }  // namespace

@@ -139,7 +139,10 @@ nlohmann::json RobotToJson(const RobotView& view, const engine::WarehouseMap& ma
             {"plan_id", view.plan_id},
             {"plan_waypoints", view.waypoints},
             {"last_seen", view.last_seen},
-            {"battery", r.battery ? json(*r.battery) : json(nullptr)}};
+            {"battery", r.battery ? json(*r.battery) : json(nullptr)},
+            {"formation", view.formation.empty() ? json(nullptr) : json(view.formation)},
+            {"held", view.held},
+            {"hold_reason", view.hold_reason}};
   j["point"] = r.current_point == engine::kNoPoint ? json(nullptr) : StopToJson(r.current_point, map);
   return j;
 }

@@ -1,5 +1,6 @@
 #include "server/order_service.h"
 
+#include <optional>
 #include <set>
 
 #include "server/grpc_status.h"
@@ -9,9 +10,21 @@
 namespace dispatch::server {
 namespace {
 
+// Status messages travel in a trailer and clients refuse large metadata ("received initial
+// metadata size exceeds limit", which would hide the error); messages echo client input (a
+// point name, an id), so they are cut to a size every client accepts.
+grpc::Status Fitted(grpc::Status status) {
+  constexpr std::size_t kMaxMessage = 1024;
+  const std::string& m = status.error_message();
+  if (m.size() <= kMaxMessage) return status;
+  std::size_t cut = kMaxMessage;
+  while (cut > 0 && (static_cast<unsigned char>(m[cut]) & 0xC0) == 0x80) --cut;  // keep UTF-8 whole
+  return {status.error_code(), m.substr(0, cut) + "... (" + std::to_string(m.size()) + " bytes)"};
+}
+
 grpc::ServerUnaryReactor* Done(grpc::CallbackServerContext* context, grpc::Status status) {
   auto* reactor = context->DefaultReactor();
-  reactor->Finish(std::move(status));
+  reactor->Finish(Fitted(std::move(status)));
   return reactor;
 }
 
@@ -119,20 +132,45 @@ class WatchReactor final : public QueuedWriter<grpc::ServerWriteReactor<pb::Orde
 
 constexpr int kDefaultPageSize = 100;
 
+// The index in a page token "p<digits>" (as ListOrders issues them), or nothing.
+std::optional<std::size_t> PageTokenIndex(const std::string& token) {
+  if (token.size() < 2 || token.size() > 20 || token[0] != 'p') return std::nullopt;
+  if (token[1] == '0' && token.size() > 2) return std::nullopt;  // issued without leading zeros
+  std::size_t index = 0;
+  for (std::size_t i = 1; i < token.size(); ++i) {
+    if (token[i] < '0' || token[i] > '9') return std::nullopt;
+    index = index * 10 + static_cast<std::size_t>(token[i] - '0');
+  }
+  return index;
+}
+
 }  // namespace
 
 grpc::ServerUnaryReactor* OrderServiceImpl::SubmitOrder(grpc::CallbackServerContext* context,
-                                                        const pb::SubmitOrderRequest* request,
-                                                        pb::SubmitOrderResponse* response) {
-  auto converted = OrderRequestFromProto(*request);
+                                                        const grpc::ByteBuffer* request,
+                                                        grpc::ByteBuffer* response) {
+  pb::SubmitOrderRequest parsed;
+  grpc::ByteBuffer bytes(*request);  // Deserialize consumes its buffer
+  if (!grpc::SerializationTraits<pb::SubmitOrderRequest>::Deserialize(&bytes, &parsed).ok()) {
+    return Done(context, {grpc::StatusCode::INVALID_ARGUMENT,
+                          "the request does not parse as a warehouse.dispatch.v1.SubmitOrderRequest "
+                          "(malformed protobuf, or a string field that is not UTF-8)"});
+  }
+  auto converted = OrderRequestFromProto(parsed);
   if (!converted.ok()) return Done(context, ToGrpcStatus(FromEngineError(converted.error())));
   auto* reactor = context->DefaultReactor();
   dispatcher_.SubmitOrder(std::move(converted).value(), [this, reactor, response](SubmitReply reply) {
     if (reply.status.ok()) {
-      OrderToProto(*reply.order, dispatcher_.map(), response->mutable_order());
-      response->set_created(reply.created);
+      pb::SubmitOrderResponse out;
+      OrderToProto(*reply.order, dispatcher_.map(), out.mutable_order());
+      out.set_created(reply.created);
+      bool own_buffer = false;
+      if (!grpc::SerializationTraits<pb::SubmitOrderResponse>::Serialize(out, response, &own_buffer).ok()) {
+        reactor->Finish({grpc::StatusCode::INTERNAL, "the stored order could not be serialized"});
+        return;
+      }
     }
-    reactor->Finish(ToGrpcStatus(reply.status));
+    reactor->Finish(Fitted(ToGrpcStatus(reply.status)));
   });
   return reactor;
 }
@@ -170,7 +208,7 @@ grpc::ServerUnaryReactor* OrderServiceImpl::CancelOrder(grpc::CallbackServerCont
   dispatcher_.CancelOrder(request->order_id(), request->reason(),
                           [this, reactor, response](OrderReply reply) {
                             if (reply.status.ok()) OrderToProto(*reply.order, dispatcher_.map(), response);
-                            reactor->Finish(ToGrpcStatus(reply.status));
+                            reactor->Finish(Fitted(ToGrpcStatus(reply.status)));
                           });
   return reactor;
 }
@@ -180,25 +218,32 @@ grpc::ServerUnaryReactor* OrderServiceImpl::ListOrders(grpc::CallbackServerConte
                                                        pb::ListOrdersResponse* response) {
   std::set<engine::OrderState> states;
   for (int s : request->states()) {
+    if (s == pb::ORDER_STATE_UNSPECIFIED) continue;  // "no filter" (common.proto)
     auto state = OrderStateFromProto(static_cast<pb::OrderState>(s));
-    if (state) states.insert(*state);
+    if (!state) {
+      return Done(context, {grpc::StatusCode::INVALID_ARGUMENT,
+                            "states: " + std::to_string(s) + " is not an OrderState"});
+    }
+    states.insert(*state);
   }
   if (request->page_size() < 0) {
     return Done(context, {grpc::StatusCode::INVALID_ARGUMENT, "page_size must be >= 0"});
   }
   const int page = request->page_size() == 0 ? kDefaultPageSize
                                              : std::min(request->page_size(), storage::kMaxPageSize);
-  std::int64_t after = 0;
-  if (!request->page_token().empty()) {
-    const std::string& t = request->page_token();
-    char* end = nullptr;
-    after = t.size() > 1 && t[0] == 'p' ? std::strtoll(t.c_str() + 1, &end, 10) : -1;
-    if (after < 0 || end == nullptr || *end != '\0') {
-      return Done(context, {grpc::StatusCode::INVALID_ARGUMENT, "page_token '" + t + "' is not one this server issued"});
-    }
-  }
   auto snap = dispatcher_.snapshot();
-  for (std::size_t i = static_cast<std::size_t>(after); i < snap->orders.size(); ++i) {
+  std::size_t after = 0;
+  if (!request->page_token().empty()) {
+    // Tokens are "p<index>" with the index of the next order, at most the current count
+    // (orders are never removed); anything else is not one this server issued.
+    auto index = PageTokenIndex(request->page_token());
+    if (!index || *index > snap->orders.size()) {
+      return Done(context, {grpc::StatusCode::INVALID_ARGUMENT,
+                            "page_token '" + request->page_token() + "' is not one this server issued"});
+    }
+    after = *index;
+  }
+  for (std::size_t i = after; i < snap->orders.size(); ++i) {
     const auto& view = *snap->orders[i];
     if (!states.empty() && !states.count(view.record.order.state)) continue;
     if (response->orders_size() == page) {

@@ -9,13 +9,16 @@
 
 namespace dispatch::server {
 
-class OrderServiceImpl final : public ::warehouse::dispatch::v1::OrderService::CallbackService {
+// SubmitOrder takes its request as bytes and parses it itself: gRPC's callback API answers a
+// request that does not parse with UNIMPLEMENTED and no message (grpcpp's
+// server_callback_handlers.h); a malformed order gets INVALID_ARGUMENT saying what it is.
+class OrderServiceImpl final : public ::warehouse::dispatch::v1::OrderService::WithRawCallbackMethod_SubmitOrder<
+                                   ::warehouse::dispatch::v1::OrderService::CallbackService> {
  public:
   explicit OrderServiceImpl(Dispatcher& dispatcher) : dispatcher_(dispatcher) {}
 
-  grpc::ServerUnaryReactor* SubmitOrder(grpc::CallbackServerContext* context,
-                                        const ::warehouse::dispatch::v1::SubmitOrderRequest* request,
-                                        ::warehouse::dispatch::v1::SubmitOrderResponse* response) override;
+  grpc::ServerUnaryReactor* SubmitOrder(grpc::CallbackServerContext* context, const grpc::ByteBuffer* request,
+                                        grpc::ByteBuffer* response) override;
   grpc::ServerUnaryReactor* GetOrder(grpc::CallbackServerContext* context,
                                      const ::warehouse::dispatch::v1::GetOrderRequest* request,
                                      ::warehouse::dispatch::v1::Order* response) override;

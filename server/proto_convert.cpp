@@ -169,6 +169,11 @@ engine::Result<RobotInbound> RobotInboundFromProto(const pb::RobotMessage& m) {
       if (!std::isfinite(in.diameter) || in.diameter < 0 || !std::isfinite(in.max_speed) || in.max_speed < 0) {
         return engine::InvalidArgument("hello: diameter and max_speed must be finite and >= 0");
       }
+      // Sequences are stored as SQLite integers (< 2^63); no server sends 2^62 messages.
+      if (in.last_acked_sequence > (std::uint64_t{1} << 62)) {
+        return engine::InvalidArgument("hello: last_acked_sequence " + std::to_string(in.last_acked_sequence) +
+                                       " is beyond 2^62; no server has sent that many messages");
+      }
       return in;
     }
     case pb::RobotMessage::kStateReport: {

@@ -3,20 +3,63 @@
 
 #include <httplib.h>
 
+#include "server/web_assets.h"
+
 namespace dispatch::server {
 namespace {
 
+// Request bodies beyond this get 413: the largest order (100 picks) is ~5 kB of JSON.
+constexpr std::size_t kMaxBodyBytes = std::size_t{1} << 20;
+// httplib serves a connection on one pool thread until it closes: a client that stalls
+// mid-request holds its thread for the read timeout, an idle keep-alive connection (a browser
+// polling the web map) for the keep-alive timeout. The default pool of 8 threads made 8 such
+// clients stall everyone; 64 threads and short timeouts keep /healthz answering.
+constexpr std::size_t kHttpThreads = 64;
+constexpr time_t kReadTimeoutSeconds = 2;
+constexpr time_t kKeepAliveSeconds = 2;
+
+// JSON text; bytes that are not UTF-8 (a path or query echoed in an error) become U+FFFD
+// instead of a type_error 316, which thrown in the error handler ends the process.
+std::string Dump(const nlohmann::json& j) { return j.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace); }
+
 void Reply(httplib::Response& res, const RestReply& reply) {
   res.status = reply.status;
-  res.set_content(reply.body.dump(), "application/json");
+  if (!reply.content_type.empty()) {
+    res.set_content(reply.text, reply.content_type);
+  } else {
+    res.set_content(Dump(reply.body), "application/json");
+  }
+}
+
+// The web map: from `web_root` when given, else the copy built into the binary.
+void ServeWebMap(httplib::Server& s, const std::string& web_root) {
+  if (!web_root.empty()) {
+    s.set_mount_point("/", web_root);  // "/" serves index.html
+    return;
+  }
+  for (const WebAsset& asset : BuiltInWebAssets()) {
+    auto serve = [&asset](const httplib::Request&, httplib::Response& res) {
+      res.set_content(asset.body.data(), asset.body.size(), std::string(asset.content_type).c_str());
+      res.set_header("Cache-Control", "no-cache");
+    };
+    s.Get(std::string(asset.path), serve);
+    if (asset.path == "/index.html") s.Get("/", serve);
+  }
 }
 
 }  // namespace
 
-RestServer::RestServer(RestHandlers handlers)
+RestServer::RestServer(RestHandlers handlers, const std::string& web_root)
     : handlers_(handlers), http_(std::make_unique<httplib::Server>()) {
   auto& h = handlers_;
   auto& s = *http_;
+  ServeWebMap(s, web_root);
+  s.Get("/metrics", [&h](const httplib::Request&, httplib::Response& res) { Reply(res, h.Metrics()); });
+  s.Get("/api/v1/map", [&h](const httplib::Request&, httplib::Response& res) { Reply(res, h.Map()); });
+  s.Get("/api/v1/zones", [&h](const httplib::Request&, httplib::Response& res) { Reply(res, h.Zones()); });
+  s.Get("/api/v1/intersections", [&h](const httplib::Request&, httplib::Response& res) {
+    Reply(res, h.Intersections());
+  });
   s.Get("/healthz", [&h](const httplib::Request&, httplib::Response& res) { Reply(res, h.Health()); });
   s.Get("/readyz", [&h](const httplib::Request&, httplib::Response& res) { Reply(res, h.Ready()); });
   s.Get("/api/v1/status", [&h](const httplib::Request&, httplib::Response& res) { Reply(res, h.Status()); });
@@ -39,11 +82,21 @@ RestServer::RestServer(RestHandlers handlers)
   s.Delete(R"(/api/v1/orders/([^/]+))", [&h](const httplib::Request& req, httplib::Response& res) {
     Reply(res, h.CancelOrder(req.matches[1], req.has_param("reason") ? req.get_param_value("reason") : ""));
   });
+  s.set_payload_max_length(kMaxBodyBytes);
+  s.new_task_queue = [] { return new httplib::ThreadPool(kHttpThreads); };
+  s.set_read_timeout(kReadTimeoutSeconds);
+  s.set_keep_alive_timeout(kKeepAliveSeconds);
   s.set_error_handler([](const httplib::Request& req, httplib::Response& res) {
     if (!res.body.empty()) return;
-    const std::string message = res.status == 404 ? "no such endpoint: " + req.method + " " + req.path
-                                                  : "request failed with HTTP " + std::to_string(res.status);
-    res.set_content(nlohmann::json{{"error", message}}.dump(), "application/json");
+    std::string message;
+    switch (res.status) {
+      case 400: message = "malformed HTTP request"; break;
+      case 404: message = "no such endpoint: " + req.method + " " + req.path; break;
+      case 413: message = "request body too large: the limit is " + std::to_string(kMaxBodyBytes) + " bytes"; break;
+      case 414: message = "request URI too long"; break;
+      default: message = "request failed with HTTP " + std::to_string(res.status);
+    }
+    res.set_content(Dump(nlohmann::json{{"error", message}}), "application/json");
   });
   s.set_exception_handler([](const httplib::Request&, httplib::Response& res, std::exception_ptr ep) {
     std::string what = "internal error";
@@ -54,7 +107,7 @@ RestServer::RestServer(RestHandlers handlers)
     } catch (...) {
     }
     res.status = 500;
-    res.set_content(nlohmann::json{{"error", what}}.dump(), "application/json");
+    res.set_content(Dump(nlohmann::json{{"error", what}}), "application/json");
   });
 }
 
@@ -68,12 +121,21 @@ int RestServer::Start(const std::string& bind, int port) {
     bound = -1;
   }
   if (bound <= 0) return -1;
-  thread_ = std::thread([this] { http_->listen_after_bind(); });
+  listening_ = true;
+  thread_ = std::thread([this] {
+    http_->listen_after_bind();
+    listening_ = false;
+  });
   return bound;
 }
 
 void RestServer::Stop() {
-  if (http_) http_->stop();
+  // httplib's stop() does nothing until the listener thread runs (is_running()), so a Stop
+  // right after Start repeats it until the listener has returned.
+  while (listening_) {
+    http_->stop();
+    if (listening_) std::this_thread::yield();
+  }
   if (thread_.joinable()) thread_.join();
 }
 

@@ -1,9 +1,13 @@
 #include "server/rest_handlers.h"
 
 #include <cmath>
+#include <cstdint>
+#include <limits>
 
+#include "engine/io/map_json.h"
 #include "server/dispatcher.h"
 #include "server/json_convert.h"
+#include "server/metrics.h"
 
 namespace dispatch::server {
 namespace {
@@ -23,7 +27,13 @@ int HttpStatus(StatusCode code) {
   return 500;
 }
 
-RestReply Error(int status, const std::string& message) { return {status, {{"error", message}}}; }
+// Messages echo client input (a path segment, a query value) that may be any bytes, and
+// JSON text must be UTF-8 (dump() throws otherwise): invalid bytes become U+FFFD.
+std::string Utf8(const std::string& text) {
+  return json::parse(json(text).dump(-1, ' ', false, json::error_handler_t::replace)).get<std::string>();
+}
+
+RestReply Error(int status, const std::string& message) { return {status, {{"error", Utf8(message)}}}; }
 RestReply Error(const ServiceStatus& s) { return Error(HttpStatus(s.code), s.message); }
 
 engine::Result<engine::StopSpec> StopOf(const json& j, const std::string& what) {
@@ -32,6 +42,11 @@ engine::Result<engine::StopSpec> StopOf(const json& j, const std::string& what) 
     return engine::StopSpec(Eigen::Vector2d(j["x"].get<double>(), j["y"].get<double>()));
   }
   return engine::InvalidArgument(what + " must be a point name or {\"x\": .., \"y\": ..}");
+}
+
+// A present field of the wrong type, named (nlohmann's own message does not name it).
+engine::Error WrongType(const std::string& field, const std::string& want, const json& got) {
+  return engine::InvalidArgument(field + " must be " + want + ", got " + (got.is_number() ? got.dump() : got.type_name()));
 }
 
 engine::Result<engine::OrderRequest> RequestOf(const std::string& body) {
@@ -43,38 +58,104 @@ engine::Result<engine::OrderRequest> RequestOf(const std::string& body) {
   }
   if (!j.is_object()) return engine::InvalidArgument("body must be a JSON object");
   engine::OrderRequest r;
-  try {
-    const char* id_key = j.contains("client_order_id") ? "client_order_id" : "client_id";
-    if (!j.contains(id_key) || !j[id_key].is_string()) {
-      return engine::InvalidArgument("client_order_id (string) is required");
+  const char* id_key = j.contains("client_order_id") ? "client_order_id" : "client_id";
+  if (!j.contains(id_key) || !j[id_key].is_string()) {
+    return engine::InvalidArgument("client_order_id (string) is required");
+  }
+  r.client_id = j[id_key].get<std::string>();
+  if (j.contains("priority")) {
+    const json& p = j["priority"];
+    // int32 as in SubmitOrderRequest; get<int>() would wrap 2^32 + 1 to 1 and cut 1.5 to 1.
+    const bool fits = p.is_number_unsigned() ? p.get<std::uint64_t>() <= std::numeric_limits<std::int32_t>::max()
+                      : p.is_number_integer() ? p.get<std::int64_t>() >= std::numeric_limits<std::int32_t>::min() &&
+                                                    p.get<std::int64_t>() <= std::numeric_limits<std::int32_t>::max()
+                                              : false;
+    if (!fits) return WrongType("priority", "an integer in [-2^31, 2^31 - 1]", p);
+    r.priority = p.get<int>();
+  }
+  if (!j.contains("picks") || !j["picks"].is_array()) {
+    return engine::InvalidArgument("picks (array of stops) is required");
+  }
+  int k = 0;
+  for (const auto& p : j["picks"]) {
+    auto stop = StopOf(p, "pick " + std::to_string(++k));
+    if (!stop.ok()) return stop.error();
+    r.picks.push_back(*stop);
+  }
+  if (!j.contains("drop")) return engine::InvalidArgument("drop is required");
+  auto drop = StopOf(j["drop"], "drop");
+  if (!drop.ok()) return drop.error();
+  r.drop = *drop;
+  if (j.contains("formation")) {
+    if (!j["formation"].is_boolean()) return WrongType("formation", "true or false", j["formation"]);
+    r.formation = j["formation"].get<bool>();
+  }
+  if (j.contains("work_time")) {
+    if (!j["work_time"].is_number()) return WrongType("work_time", "a number of seconds", j["work_time"]);
+    r.work_time = j["work_time"].get<double>();
+  }
+  if (j.contains("release_time") && !j["release_time"].is_null()) {
+    const json& t = j["release_time"];
+    if (!t.is_number() || !std::isfinite(t.get<double>())) {
+      return WrongType("release_time", "a finite number of seconds or null", t);
     }
-    r.client_id = j[id_key].get<std::string>();
-    if (j.contains("priority")) r.priority = j["priority"].get<int>();
-    if (!j.contains("picks") || !j["picks"].is_array()) {
-      return engine::InvalidArgument("picks (array of stops) is required");
-    }
-    int k = 0;
-    for (const auto& p : j["picks"]) {
-      auto stop = StopOf(p, "pick " + std::to_string(++k));
-      if (!stop.ok()) return stop.error();
-      r.picks.push_back(*stop);
-    }
-    if (!j.contains("drop")) return engine::InvalidArgument("drop is required");
-    auto drop = StopOf(j["drop"], "drop");
-    if (!drop.ok()) return drop.error();
-    r.drop = *drop;
-    if (j.contains("formation")) r.formation = j["formation"].get<bool>();
-    if (j.contains("work_time")) r.work_time = j["work_time"].get<double>();
-    if (j.contains("release_time") && !j["release_time"].is_null()) {
-      r.release_time = j["release_time"].get<double>();
-    }
-  } catch (const json::exception& e) {
-    return engine::InvalidArgument(std::string("a field has the wrong type: ") + e.what());
+    r.release_time = t.get<double>();
   }
   return r;
 }
 
 }  // namespace
+
+RestHandlers::RestHandlers(Dispatcher& dispatcher, ServiceMetrics* metrics)
+    : dispatcher_(dispatcher),
+      metrics_(metrics),
+      map_json_(std::make_shared<const std::string>(engine::WriteMapJson(dispatcher.map()))) {}
+
+RestReply RestHandlers::Map() const { return RestReply::Text("application/json", *map_json_); }
+
+RestReply RestHandlers::Zones() const {
+  auto snap = dispatcher_.snapshot();
+  const auto& zones = dispatcher_.map().zones();
+  json out = json::array();
+  for (std::size_t z = 0; z < zones.size(); ++z) {
+    json polygon = json::array();
+    for (const auto& v : zones[z].polygon) polygon.push_back({v.x(), v.y()});
+    const ZoneView* live = z < snap->zones.size() ? &snap->zones[z] : nullptr;
+    out.push_back({{"id", zones[z].name},
+                   {"polygon", polygon},
+                   {"area", zones[z].area},
+                   {"robots", live ? live->robots.size() : 0},
+                   {"density", live ? live->density : 0.0},
+                   {"robot_ids", live ? json(live->robots) : json::array()}});
+  }
+  return {200, {{"time", snap->time}, {"zones", out}}};
+}
+
+RestReply RestHandlers::Intersections() const {
+  auto snap = dispatcher_.snapshot();
+  const engine::WarehouseMap& map = dispatcher_.map();
+  auto names = [&map](const std::vector<engine::PointId>& points) {
+    json out = json::array();
+    for (engine::PointId p : points) out.push_back(map.point(p).name);
+    return out;
+  };
+  json out = json::array();
+  for (std::size_t i = 0; i < map.intersections().size(); ++i) {
+    const auto& x = map.intersections()[i];
+    const IntersectionView* live = i < snap->intersections.size() ? &snap->intersections[i] : nullptr;
+    out.push_back({{"id", x.name},
+                   {"inner", names(x.inner)},
+                   {"approach", names(x.approach)},
+                   {"holders", live ? json(live->holders) : json::array()},
+                   {"waiting", live ? json(live->waiting) : json::array()}});
+  }
+  return {200, {{"time", snap->time}, {"control", snap->traffic.enabled}, {"intersections", out}}};
+}
+
+RestReply RestHandlers::Metrics() const {
+  if (!metrics_) return Error(404, "metrics are not enabled");
+  return RestReply::Text("text/plain; version=0.0.4; charset=utf-8", metrics_->Render(*dispatcher_.snapshot()));
+}
 
 RestReply RestHandlers::Health() const { return {200, {{"status", "ok"}}}; }
 
@@ -161,12 +242,27 @@ RestReply RestHandlers::Orders(const std::optional<std::string>& state) const {
   return {200, {{"orders", orders}}};
 }
 
-RestReply RestHandlers::Order(const std::string& id) const {
+RestReply RestHandlers::Order(const std::string& id) {
   auto snap = dispatcher_.snapshot();
   auto order = snap->FindOrder(id);
   if (!order) order = snap->FindClientOrder(id);
   if (!order) return Error(404, "no order with id or client id '" + id + "'");
-  return {200, OrderToJson(*order, dispatcher_.map(), true)};
+  json j = OrderToJson(*order, dispatcher_.map(), true);
+  const std::string order_id = order->record.order.id;
+  OrderRoutes routes = dispatcher_.Call<OrderRoutes>([this, order_id](std::function<void(OrderRoutes)> done) {
+    done(dispatcher_.RoutesOf(order_id));
+  });
+  json by_robot = json::object();
+  for (const auto& [robot, waypoints] : routes) {
+    json list = json::array();
+    for (const auto& w : waypoints) {
+      list.push_back({{"seq", w.seq}, {"x", w.xy.x()}, {"y", w.xy.y()},
+                      {"action", engine::WaypointActionName(w.action)}, {"released", w.released}});
+    }
+    by_robot[robot] = list;
+  }
+  j["routes"] = by_robot;
+  return {200, j};
 }
 
 RestReply RestHandlers::SubmitOrder(const std::string& body) {

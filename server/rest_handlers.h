@@ -7,21 +7,35 @@
 
 #include <nlohmann/json.hpp>
 
+#include <memory>
 #include <optional>
 #include <string>
+#include <utility>
 
 namespace dispatch::server {
 
 class Dispatcher;
+class ServiceMetrics;
 
+// A JSON body, or (content_type set) `text` as it is.
 struct RestReply {
+  RestReply(int status, nlohmann::json body) : status(status), body(std::move(body)) {}
+  static RestReply Text(std::string content_type, std::string text) {
+    RestReply r(200, nullptr);
+    r.content_type = std::move(content_type);
+    r.text = std::move(text);
+    return r;
+  }
   int status = 200;
   nlohmann::json body;
+  std::string content_type;
+  std::string text;
 };
 
 class RestHandlers {
  public:
-  explicit RestHandlers(Dispatcher& dispatcher) : dispatcher_(dispatcher) {}
+  // `metrics` may be null (GET /metrics then answers 404).
+  RestHandlers(Dispatcher& dispatcher, ServiceMetrics* metrics);
 
   RestReply Health() const;
   RestReply Ready() const;
@@ -32,7 +46,16 @@ class RestHandlers {
   RestReply Orders(const std::optional<std::string>& state) const;
   // GET /api/v1/traffic: every robot's traffic state (where, route, what it waits on).
   RestReply Traffic();
-  RestReply Order(const std::string& id) const;
+  // With the allocation explanation and "routes": each robot's waypoints of it not reached.
+  RestReply Order(const std::string& id);
+  // GET /api/v1/map: the map in the JSON map format (engine/io/map_format.md).
+  RestReply Map() const;
+  // GET /api/v1/zones: each zone's polygon, area and live density.
+  RestReply Zones() const;
+  // GET /api/v1/intersections: each intersection's regions, grant holders and waiters.
+  RestReply Intersections() const;
+  // GET /metrics: Prometheus text format.
+  RestReply Metrics() const;
   // body: {"client_order_id": "...", "picks": ["P1-1-1" | {"x":..,"y":..}, ...],
   //        "drop": "D1" | {"x":..,"y":..}, "priority": 0, "formation": false,
   //        "work_time": 5.0, "release_time": 0.0}
@@ -41,6 +64,8 @@ class RestHandlers {
 
  private:
   Dispatcher& dispatcher_;
+  ServiceMetrics* metrics_;
+  std::shared_ptr<const std::string> map_json_;  // built once
 };
 
 }  // namespace dispatch::server

@@ -15,6 +15,8 @@
 #include "engine/routing/route_table.h"
 #include "server/dispatcher.h"
 #include "server/fleet_service.h"
+#include "server/metered_store.h"
+#include "server/metrics.h"
 #include "server/order_service.h"
 #include "server/rest_api.h"
 #include "storage/sqlite_store.h"
@@ -97,6 +99,9 @@ engine::Result<std::unique_ptr<DispatchServer>> DispatchServer::Start(const Serv
     s->owned_store_ = std::move(opened).value();
     s->store_ = s->owned_store_.get();
   }
+  s->metrics_ = std::make_unique<ServiceMetrics>();
+  s->metered_store_ = std::make_unique<MeteredStore>(*s->store_, *s->metrics_);
+  s->store_ = s->metered_store_.get();
   storage::MapVersion version;
   version.name = map->name();
   version.content_hash = MapContentHash(engine::WriteMapJson(*map));
@@ -119,6 +124,7 @@ engine::Result<std::unique_ptr<DispatchServer>> DispatchServer::Start(const Serv
   options.traffic.t_w2 = config.t_w2;
   options.traffic.blocked_after = config.blocked_after;
   options.map_version = recorded->content_hash;
+  options.metrics = s->metrics_.get();
   auto dispatcher = Dispatcher::Create(map, shared_routes, *s->store_, options);
   if (!dispatcher.ok()) return dispatcher.error();
   s->dispatcher_ = std::move(dispatcher).value();
@@ -140,7 +146,7 @@ engine::Result<std::unique_ptr<DispatchServer>> DispatchServer::Start(const Serv
   }
   s->ports_.grpc = grpc_port;
 
-  s->rest_ = std::make_unique<RestServer>(RestHandlers(*s->dispatcher_));
+  s->rest_ = std::make_unique<RestServer>(RestHandlers(*s->dispatcher_, s->metrics_.get()), config.web_root);
   const int http_port = s->rest_->Start(config.bind, config.http_port);
   if (http_port <= 0) {
     return engine::IoError("cannot listen for HTTP on " + config.bind + ":" + std::to_string(config.http_port));

@@ -29,6 +29,8 @@ class RestServer;
 class OrderServiceImpl;
 class FleetServiceImpl;
 class MapServiceImpl;
+class ServiceMetrics;
+class MeteredStore;
 
 struct ServerPorts {
   int grpc = 0;
@@ -52,6 +54,8 @@ class DispatchServer {
   DispatchServer() = default;
 
   std::unique_ptr<storage::Store> owned_store_;
+  std::unique_ptr<ServiceMetrics> metrics_;
+  std::unique_ptr<MeteredStore> metered_store_;  // wraps the store; store_ points here
   storage::Store* store_ = nullptr;
   std::unique_ptr<Dispatcher> dispatcher_;
   std::unique_ptr<OrderServiceImpl> order_service_;

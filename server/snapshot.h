@@ -43,6 +43,21 @@ struct RobotView {
   double last_seen = 0.0;  // dispatcher seconds
   std::uint64_t plan_id = 0;
   std::size_t waypoints = 0;  // in its current plan
+  bool held = false;          // a traffic Hold is in force
+  std::string hold_reason;
+  std::string formation;      // the formation order whose team it is in ("": none)
+};
+
+// A zone's live density (Chu2024 eq. (7) with the robots there now): robots / area.
+struct ZoneView {
+  std::vector<std::string> robots;  // connected robots whose position is in the zone
+  double density = 0.0;             // robots per m^2
+};
+
+// A map intersection's grant: who holds it, who waits (robot ids).
+struct IntersectionView {
+  std::vector<std::string> holders;
+  std::vector<std::string> waiting;
 };
 
 // The traffic layer's counters and the closest two robots seen (server/traffic_gate.h).
@@ -71,6 +86,8 @@ struct Snapshot {
   std::unordered_map<std::string, std::size_t> by_client_id;  // client id -> index
   std::map<std::string, RobotView> robots;                    // by id
   TrafficView traffic;
+  std::vector<ZoneView> zones;                  // index = map zone id
+  std::vector<IntersectionView> intersections;  // index = map intersection (empty: no control)
 
   std::shared_ptr<const OrderView> FindOrder(const std::string& id) const {
     auto it = by_id.find(id);

@@ -108,6 +108,7 @@ void GateImpl::SendRelease(GateBot& b, int intersection, std::vector<GateEffect>
 void GateImpl::Hold(GateBot& b, const std::string& why, std::vector<GateEffect>& out) {
   if (b.held) return;
   b.held = true;
+  b.hold_reason = why;
   GateEffect e;
   e.kind = GateEffect::Kind::kHold;
   e.robot = b.id;
@@ -666,6 +667,43 @@ std::string TrafficGate::Describe(const std::string& robot) const {
   out += "; waypoint " + std::to_string(b.idx) + "/" + std::to_string(b.plan.waypoints.size()) +
          ", released " + std::to_string(b.released) + (b.connected ? "" : ", offline");
   return out;
+}
+
+std::vector<GateIntersection> TrafficGate::Intersections() const {
+  const Impl& s = *impl_;
+  std::unordered_map<std::string, const GateTeam*> team_of_agent;
+  for (const auto& [order, team] : s.teams) {
+    if (team.ctl >= 0) team_of_agent[s.ctl.robot_id(static_cast<std::size_t>(team.ctl))] = &team;
+  }
+  auto robots_of = [&](const std::vector<std::string>& agents) {
+    std::vector<std::string> out;
+    for (const auto& agent : agents) {
+      auto t = team_of_agent.find(agent);
+      if (t == team_of_agent.end()) {
+        out.push_back(agent);
+      } else {
+        out.insert(out.end(), t->second->members.begin(), t->second->members.end());
+      }
+    }
+    return out;
+  };
+  const engine::IntersectionGrants& grants = s.ctl.grants();
+  std::vector<GateIntersection> out(grants.guard_count());
+  for (std::size_t g = 0; g < out.size(); ++g) {
+    out[g].holders = robots_of(grants.Holders(g));
+    out[g].waiting = robots_of(grants.Queue(g));
+  }
+  return out;
+}
+
+GateRobotState TrafficGate::RobotState(const std::string& robot) const {
+  GateRobotState state;
+  auto it = impl_->bots.find(robot);
+  if (it == impl_->bots.end()) return state;
+  state.held = it->second.held;
+  if (state.held) state.reason = it->second.hold_reason;
+  state.formation = it->second.team;
+  return state;
 }
 
 const MinDistance& TrafficGate::min_distance() const { return impl_->min_distance; }

@@ -86,6 +86,19 @@ struct MinDistance {
   double time = 0.0;
 };
 
+// A map intersection's grant as robots see it (a formation's grant lists its members).
+struct GateIntersection {
+  std::vector<std::string> holders;  // robots holding the grant
+  std::vector<std::string> waiting;  // robots queued for it, FIFO
+};
+
+// What the operator sees of one robot's traffic state.
+struct GateRobotState {
+  bool held = false;       // a Hold is in force
+  std::string reason;      // why, while held
+  std::string formation;   // the formation order whose team it is in ("": none)
+};
+
 class TrafficGate {
  public:
   static engine::Result<std::unique_ptr<TrafficGate>> Create(
@@ -116,6 +129,9 @@ class TrafficGate {
   engine::PointId StartPoint(const std::string& robot) const;
   // Highest waypoint sequence released to the robot.
   std::uint64_t ReleasedUpTo(const std::string& robot) const;
+  // One entry per map intersection (index = intersection index).
+  std::vector<GateIntersection> Intersections() const;
+  GateRobotState RobotState(const std::string& robot) const;
   const MinDistance& min_distance() const;
   const engine::TrafficStats& stats() const;
   // One line on the robot's traffic state (for logs): where, route, what it waits on.

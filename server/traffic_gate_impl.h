@@ -30,6 +30,7 @@ struct GateBot {
   bool has_xy = false;
   bool left = false;      // LeftPoint done for the current drive
   bool held = false;      // a Hold was sent for the current wait
+  std::string hold_reason;  // the reason of that Hold
   bool resume_pending = false;  // reconnected: resend Resume if it was held
   bool blocked = false;   // kBlocked reported for the current wait
   bool stepped_aside = false;
