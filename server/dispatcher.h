@@ -3,9 +3,11 @@
 // One loop thread owns the order book, the robots (pose, link, current plan) and the
 // allocator. API threads never touch them: they post commands (Post) and get the answer
 // through a callback run on the loop thread (gRPC reactors finish from it; REST waits on a
-// future, see Call). After every batch of commands the loop publishes an immutable Snapshot
-// (atomic shared_ptr swap) that reads use without locks of the loop; replies, robot messages
-// and journal events of the batch go out only after that publish (read-your-writes).
+// future, see Call). The loop publishes an immutable Snapshot (atomic shared_ptr swap) that
+// reads use without locks of the loop: after every batch whose replies, journal events,
+// Welcomes or stream ends announce a change (they go out only after that publish: read-your-writes), and
+// otherwise at most every 20 ms while robots report (positions, grants and holds are at most
+// that stale in REST).
 //
 // Durability: an order is committed to the Store (InsertOrder) before SubmitOrder answers
 // OK; a failed write is an error to the caller and leaves the in-memory state unchanged.
@@ -185,9 +187,11 @@ class Dispatcher {
   void Put(std::shared_ptr<OrderView> view);  // replaces (or adds) an order in the book
   // Publishes a committed journal event to the watchers (deferred, see Defer).
   void Journal(const storage::OrderEvent& event);
-  // Runs `effect` after this batch's snapshot is published: replies, robot messages and
-  // journal events leave the loop only once the state they announce is readable.
-  void Defer(std::function<void()> effect);
+  // Runs `effect` at the end of this batch; with `after_publish` only once the snapshot
+  // holding the batch's changes is published: replies, journal events, Welcomes and stream
+  // ends leave the loop only once the state they announce is readable. Robot plans, grants and
+  // holds need no snapshot and do not force one (see Flush).
+  void Defer(std::function<void()> effect, bool after_publish = true);
   void CloseLink(const std::shared_ptr<RobotLink>& link, ServiceStatus status);
   std::string NextOrderId();
 
@@ -266,12 +270,16 @@ class Dispatcher {
   std::vector<std::shared_ptr<const OrderView>> orders_;
   std::unordered_map<std::string, std::size_t> by_id_;
   std::unordered_map<std::string, std::size_t> by_client_id_;
+  std::shared_ptr<const Snapshot::OrderIndex> published_index_;  // copy of the two maps above
   std::map<std::string, RobotRuntime> robots_;
   std::unordered_map<const RobotLink*, std::string> link_robot_;
   std::int64_t last_order_number_ = 0;
   std::uint64_t snapshot_version_ = 0;
   bool dirty_ = true;
   std::vector<std::function<void()>> deferred_;  // effects of the current batch
+  bool deferred_need_publish_ = false;            // one of them waits for the snapshot
+  static constexpr std::chrono::milliseconds kPublishEvery{20};
+  Clock::time_point last_publish_{};
   bool retry_allocation_ = false;
   bool allocation_due_ = false;  // an allocation round runs at the end of this batch
   MinDistance min_distance_;

@@ -135,7 +135,10 @@ void Dispatcher::SendTo(RobotRuntime& robot, RobotOutbound message) {
   message.sequence = robot.record.next_sequence++;
   message.server_time = Now();
   if (robot.link) {
-    Defer([link = robot.link, message = std::move(message)]() mutable { link->Send(std::move(message)); });
+    // A Welcome waits for the snapshot that holds the robot; plans, grants and holds do not.
+    const bool after_publish = message.kind == RobotOutbound::Kind::kWelcome;
+    Defer([link = robot.link, message = std::move(message)]() mutable { link->Send(std::move(message)); },
+          after_publish);
   }
 }
 
@@ -217,7 +220,29 @@ void Dispatcher::ReplayQueue(engine::FleetState& fleet, std::size_t index, const
       }
       if (picks.empty()) picks.push_back(order.drop);  // picked: only the drop is left
     }
-    auto assigned = fleet.AssignSingle(index, order.id, fleet.TaskOf(picks, order.drop, order.work_time));
+    // The stored waypoints of this order (the first: those not reached yet), re-timed from
+    // the queue's end: no routing (on a large floor every random pick is a new destination
+    // of the lazy route table, and re-routing every queue each round thrashed its cache).
+    const std::size_t begin = k == 0 ? 1 : SegmentStart(plan, k), end = SegmentStart(plan, k + 1);
+    std::vector<engine::Waypoint> segment;
+    const engine::PointId from = fleet.summary(index).end_point;
+    segment.push_back({0, from, map_->point(from).position, 0.0, engine::WaypointAction::kMove, 0.0});
+    for (std::size_t w = begin; w < end && w < plan.plan.waypoints.size(); ++w) {
+      engine::Waypoint wp = plan.plan.waypoints[w];
+      if (k == 0 && static_cast<std::uint64_t>(wp.seq) <= r.last_reached) continue;
+      if (segment.size() == 1) {
+        // Reach the first one from the queue's end at cruise speed, then keep the plan's pace.
+        const double lead = (wp.xy - segment.front().xy).norm() / options_.allocation.speed;
+        segment.front().eta = wp.eta - lead;
+      }
+      segment.push_back(wp);
+    }
+    const engine::PlanTask task = fleet.TaskOf(picks, order.drop, order.work_time);
+    engine::Status assigned = engine::InvalidArgument("no stored waypoints");
+    if (segment.size() >= 2 && segment.back().point == order.drop) {
+      assigned = fleet.AssignPlanned(index, order.id, task, std::move(segment));
+    }
+    if (!assigned.ok()) assigned = fleet.AssignSingle(index, order.id, task);
     if (!assigned.ok()) {
       spdlog::warn("allocation: queue of {} replayed up to {} only: {}", r.record.robot.id, order.id,
                    assigned.error().message);

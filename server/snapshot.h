@@ -82,20 +82,23 @@ struct Snapshot {
   std::string strategy;
   double time_scale = 1.0;
   std::vector<std::shared_ptr<const OrderView>> orders;  // submission order
-  std::unordered_map<std::string, std::size_t> by_id;         // order id -> index
-  std::unordered_map<std::string, std::size_t> by_client_id;  // client id -> index
+  // Order id / client id -> index in `orders`; shared by snapshots until an order is added.
+  struct OrderIndex {
+    std::unordered_map<std::string, std::size_t> by_id, by_client_id;
+  };
+  std::shared_ptr<const OrderIndex> index = std::make_shared<const OrderIndex>();
   std::map<std::string, RobotView> robots;                    // by id
   TrafficView traffic;
   std::vector<ZoneView> zones;                  // index = map zone id
   std::vector<IntersectionView> intersections;  // index = map intersection (empty: no control)
 
   std::shared_ptr<const OrderView> FindOrder(const std::string& id) const {
-    auto it = by_id.find(id);
-    return it == by_id.end() ? nullptr : orders[it->second];
+    auto it = index->by_id.find(id);
+    return it == index->by_id.end() ? nullptr : orders[it->second];
   }
   std::shared_ptr<const OrderView> FindClientOrder(const std::string& client_id) const {
-    auto it = by_client_id.find(client_id);
-    return it == by_client_id.end() ? nullptr : orders[it->second];
+    auto it = index->by_client_id.find(client_id);
+    return it == index->by_client_id.end() ? nullptr : orders[it->second];
   }
 };
 

@@ -120,6 +120,37 @@ Status FleetState::AssignSingle(std::size_t robot, const std::string& order_id,
   return Ok{};
 }
 
+Status FleetState::AssignPlanned(std::size_t robot, const std::string& order_id, const PlanTask& task,
+                                 std::vector<Waypoint> segment) {
+  if (robot >= robots_.size()) {
+    return NotFound("order " + order_id + ": unknown robot index " + std::to_string(robot));
+  }
+  if (segment.size() < 2) return InvalidArgument("order " + order_id + ": a planned segment needs 2 waypoints");
+  RobotEntry& e = robots_[robot];
+  const double shift = e.summary.end_time - segment.front().eta;
+  double travel = 0.0;
+  for (std::size_t k = 0; k < segment.size(); ++k) {
+    if (k > 0) {
+      const double drive = segment[k].eta - segment[k - 1].departure();
+      if (!(drive >= -1e-9)) {
+        return InvalidArgument("order " + order_id + ": planned waypoint " + std::to_string(k) + " arrives before " +
+                               "the previous one is left");
+      }
+      travel += std::max(0.0, drive);
+    }
+    segment[k].eta += shift;
+  }
+  QueuedTask q{order_id, task, {e.info.id}, e.summary.end_time, segment.back().departure()};
+  AppendSegment(e.plan, segment);
+  e.summary.end_point = segment.back().point;
+  e.summary.end_time = e.plan.end_time();
+  e.summary.travel_time += travel;
+  e.summary.work_time += TaskWorkTime(task);
+  e.queue.push_back(std::move(q));
+  Publish(e);
+  return Ok{};
+}
+
 Status FleetState::AssignFormation(const std::array<std::size_t, 3>& team,
                                    const std::string& order_id, const PlanTask& task) {
   for (std::size_t i = 0; i < team.size(); ++i) {

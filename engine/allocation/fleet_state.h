@@ -95,6 +95,13 @@ class FleetState {
 
   // Appends `task` to robot's queue and plan. Errors: unknown robot index, unreachable legs.
   Status AssignSingle(std::size_t robot, const std::string& order_id, const PlanTask& task);
+  // The same with the task's waypoints already planned (a queue replayed from stored plans:
+  // no routing). segment[0] stands for the queue's end point; the segment is shifted to start
+  // at the queue's end time, and its driving time (arrivals minus the previous departures)
+  // counts as the task's T_d. Errors: unknown robot index, fewer than 2 waypoints, times
+  // that go backwards.
+  Status AssignPlanned(std::size_t robot, const std::string& order_id, const PlanTask& task,
+                       std::vector<Waypoint> segment);
   // Appends a formation task to the three distinct members' queues (team[0] leads).
   Status AssignFormation(const std::array<std::size_t, 3>& team, const std::string& order_id,
                          const PlanTask& task);

@@ -146,8 +146,13 @@ TEST_F(OperatorEndpointsTest, IntersectionsShowWhoHoldsTheGrant) {
   auto [id, plan] = SubmitAndAssign(robot, "ops-x");
   auto grant = DriveToFirstIntersection(robot, plan);
   ASSERT_TRUE(grant) << "the route to K3-2-3N crosses no intersection";
-  // The Grant leaves the loop only after the snapshot that holds it is published.
-  const json held = GetJson("/api/v1/intersections");
+  // Snapshots of robot traffic are published within 20 ms: poll until R7 shows as holder.
+  json held;
+  const auto deadline = std::chrono::steady_clock::now() + kTimeout;
+  for (bool seen = false; !seen && std::chrono::steady_clock::now() < deadline;) {
+    held = GetJson("/api/v1/intersections");
+    for (const auto& x : held["intersections"]) seen = seen || (x["id"] == grant->intersection_name() && !x["holders"].empty());
+  }
   int holders = 0;
   for (const auto& x : held["intersections"]) {
     if (x["id"] == grant->intersection_name()) {
