@@ -47,6 +47,7 @@ std::vector<Key> Keys() {
       MakeKey("t_w1", &ServerConfig::t_w1),
       MakeKey("t_w2", &ServerConfig::t_w2),
       MakeKey("blocked_after", &ServerConfig::blocked_after),
+      MakeKey("route_cache_mb", &ServerConfig::route_cache_mb),
       MakeKey("web_root", &ServerConfig::web_root),
       MakeKey("ports_file", &ServerConfig::ports_file),
       MakeKey("ready_fd", &ServerConfig::ready_fd),
@@ -117,6 +118,7 @@ engine::Status ValidateServerConfig(const ServerConfig& c) {
   for (auto [name, v] : {std::pair{"t_w1", c.t_w1}, {"t_w2", c.t_w2}, {"blocked_after", c.blocked_after}}) {
     if (!positive(v)) return InvalidArgument(std::string(name) + " must be > 0 seconds");
   }
+  if (c.route_cache_mb < 1) return InvalidArgument("route_cache_mb must be >= 1");
   if (!c.web_root.empty() && !std::filesystem::is_directory(c.web_root)) {
     return InvalidArgument("web_root '" + c.web_root + "' is not a folder");
   }
@@ -155,6 +157,8 @@ engine::Result<ParsedCommandLine> ParseCommandLine(int argc, char** argv) {
   app.add_option("--blocked-after", flags.blocked_after,
                  "Waiting with no alternative this long marks a robot blocked, dispatcher s")
       ->capture_default_str();
+  app.add_option("--route-cache-mb", flags.route_cache_mb,
+                 "Lazy route table cache bound, MiB (large grid floors)")->capture_default_str();
   app.add_option("--web-root", flags.web_root,
                  "Serve the web map from this folder instead of the built-in copy");
   app.add_option("--ports-file", flags.ports_file, "Write the chosen ports as JSON here");

@@ -30,6 +30,10 @@ struct ServerConfig {
   double t_w1 = 10.0;           // s: head-on (single-lane) wait before re-planning (Wang2019)
   double t_w2 = 20.0;           // s: wait on a held point or grant before re-planning
   double blocked_after = 120.0; // s of waiting with no alternative -> robot blocked (fault)
+  // Bound of the lazy route table's per-destination cache (large grid floors, where a dense
+  // all-pairs table does not fit), MiB. It should hold the destinations in use at once (every
+  // robot's next stop): on a 38k-cell floor one destination takes 0.46 MB.
+  int route_cache_mb = 1024;
   // Serve the web map's files from this folder instead of the copy built into the binary
   // ("" = built-in; for working on the page without rebuilding).
   std::string web_root;

@@ -115,6 +115,9 @@ void Dispatcher::ApplyGateEffect(GateEffect& e) {
     }
     case GateEffect::Kind::kRewrite: {
       storage::AssignmentRecord a = r->assignment;
+      if (a.robot_id.empty()) {  // an idle robot without a stored plan sent aside
+        a.robot_id = a.plan.robot_id = e.robot;
+      }
       a.plan.waypoints = std::move(e.waypoints);
       if (!a.plan.waypoints.empty()) {
         a.released_up_to = std::max<std::int64_t>(a.released_up_to, a.plan.waypoints.back().seq);

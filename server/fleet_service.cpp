@@ -7,18 +7,6 @@
 namespace dispatch::server {
 namespace {
 
-// Status messages travel in a trailer and clients refuse large metadata ("received initial
-// metadata size exceeds limit", which would hide the error); messages echo client input (a
-// point name, an id), so they are cut to a size every client accepts.
-grpc::Status Fitted(grpc::Status status) {
-  constexpr std::size_t kMaxMessage = 1024;
-  const std::string& m = status.error_message();
-  if (m.size() <= kMaxMessage) return status;
-  std::size_t cut = kMaxMessage;
-  while (cut > 0 && (static_cast<unsigned char>(m[cut]) & 0xC0) == 0x80) --cut;  // keep UTF-8 whole
-  return {status.error_code(), m.substr(0, cut) + "... (" + std::to_string(m.size()) + " bytes)"};
-}
-
 class RobotSession;
 
 // The dispatcher's handle on a session; outlives it (the session detaches in OnDone).

@@ -1,7 +1,10 @@
-// ServiceStatus -> grpc::Status: the one mapping of service errors onto gRPC codes.
+// ServiceStatus -> grpc::Status: the one mapping of service errors onto gRPC codes, and
+// Fitted, which keeps status messages short enough for every client.
 #pragma once
 
 #include <grpcpp/grpcpp.h>
+
+#include <string>
 
 #include "server/service_status.h"
 
@@ -18,6 +21,18 @@ inline grpc::Status ToGrpcStatus(const ServiceStatus& s) {
     case StatusCode::kInternal: return {grpc::StatusCode::INTERNAL, s.message};
   }
   return {grpc::StatusCode::INTERNAL, s.message};
+}
+
+// Status messages travel in a trailer and clients refuse large metadata ("received initial
+// metadata size exceeds limit", which would hide the error); messages echo client input (a
+// point name, an id), so they are cut to a size every client accepts.
+inline grpc::Status Fitted(grpc::Status status) {
+  constexpr std::size_t kMaxMessage = 1024;
+  const std::string& m = status.error_message();
+  if (m.size() <= kMaxMessage) return status;
+  std::size_t cut = kMaxMessage;
+  while (cut > 0 && (static_cast<unsigned char>(m[cut]) & 0xC0) == 0x80) --cut;  // keep UTF-8 whole
+  return {status.error_code(), m.substr(0, cut) + "... (" + std::to_string(m.size()) + " bytes)"};
 }
 
 }  // namespace dispatch::server

@@ -87,6 +87,7 @@ engine::Result<std::unique_ptr<DispatchServer>> DispatchServer::Start(const Serv
   allocation.zeta = config.zeta;
   engine::RouteTableOptions route_options;
   route_options.speed = allocation.speed;
+  route_options.lazy_cache_bytes = static_cast<std::size_t>(config.route_cache_mb) << 20;
   auto routes = engine::MakeRouteTable(map, route_options);
   if (!routes.ok()) return routes.error();
   std::shared_ptr<const engine::RouteTable> shared_routes = std::move(routes).value();

@@ -129,17 +129,15 @@ Status FleetState::AssignPlanned(std::size_t robot, const std::string& order_id,
   RobotEntry& e = robots_[robot];
   const double shift = e.summary.end_time - segment.front().eta;
   double travel = 0.0;
-  for (std::size_t k = 0; k < segment.size(); ++k) {
-    if (k > 0) {
-      const double drive = segment[k].eta - segment[k - 1].departure();
-      if (!(drive >= -1e-9)) {
-        return InvalidArgument("order " + order_id + ": planned waypoint " + std::to_string(k) + " arrives before " +
-                               "the previous one is left");
-      }
-      travel += std::max(0.0, drive);
+  for (std::size_t k = 1; k < segment.size(); ++k) {
+    const double drive = segment[k].eta - segment[k - 1].departure();
+    if (!(drive >= -1e-9)) {
+      return InvalidArgument("order " + order_id + ": planned waypoint " + std::to_string(k) + " arrives before " +
+                             "the previous one is left");
     }
-    segment[k].eta += shift;
+    travel += std::max(0.0, drive);
   }
+  for (Waypoint& w : segment) w.eta += shift;
   QueuedTask q{order_id, task, {e.info.id}, e.summary.end_time, segment.back().departure()};
   AppendSegment(e.plan, segment);
   e.summary.end_point = segment.back().point;

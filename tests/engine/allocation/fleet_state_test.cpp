@@ -47,6 +47,39 @@ TEST_F(FleetStateTest, CreateRejectsBadRobotsAndConfig) {
   EXPECT_FALSE(FleetState::Create(nullptr, routes_, {}).ok());
 }
 
+TEST_F(FleetStateTest, APlannedTaskMatchesTheRoutedOneWithoutRouting) {
+  // The plan AssignSingle builds, replayed into a fresh fleet whose robot is ready later:
+  // the same waypoints shifted in time, the same T_d, T_w and end point.
+  FleetState routed = MakeFleet(map_, routes_, {{"A", Pt(*map_, "0,0"), 1.0}});
+  ASSERT_TRUE(routed.AssignSingle(0, "o1", Task("2,0", "0,3")).ok());
+  std::vector<Waypoint> segment = routed.plan(0).waypoints;
+  FleetState replayed = MakeFleet(map_, routes_, {{"A", Pt(*map_, "0,0"), 11.0}});
+  auto planned = replayed.AssignPlanned(0, "o1", Task("2,0", "0,3"), segment);
+  ASSERT_TRUE(planned.ok()) << planned.error().message;
+  EXPECT_DOUBLE_EQ(replayed.summary(0).end_time, routed.summary(0).end_time + 10.0);
+  EXPECT_DOUBLE_EQ(replayed.summary(0).travel_time, routed.summary(0).travel_time);
+  EXPECT_DOUBLE_EQ(replayed.summary(0).work_time, routed.summary(0).work_time);
+  EXPECT_EQ(replayed.summary(0).end_point, Pt(*map_, "0,3"));
+  ASSERT_EQ(replayed.plan(0).waypoints.size(), segment.size());
+  for (std::size_t k = 0; k < segment.size(); ++k) {
+    EXPECT_DOUBLE_EQ(replayed.plan(0).waypoints[k].eta, segment[k].eta + 10.0) << k;
+    EXPECT_EQ(replayed.plan(0).waypoints[k].point, segment[k].point) << k;
+  }
+  ExpectMonotone(replayed.plan(0));
+  ASSERT_EQ(replayed.queue(0).size(), 1u);
+  EXPECT_EQ(replayed.queue(0)[0].order_id, "o1");
+  // The next task is routed on from the replayed end, as after AssignSingle.
+  ASSERT_TRUE(replayed.AssignSingle(0, "o2", Task("5,0", "5,3", 1.0)).ok());
+  ASSERT_TRUE(routed.AssignSingle(0, "o2", Task("5,0", "5,3", 1.0)).ok());
+  EXPECT_DOUBLE_EQ(replayed.summary(0).end_time, routed.summary(0).end_time + 10.0);
+  // Bad segments are errors.
+  EXPECT_FALSE(replayed.AssignPlanned(0, "o3", Task("2,0", "0,3"), {segment.front()}).ok());
+  std::vector<Waypoint> backwards = segment;
+  backwards[2].eta = backwards[1].eta - 5.0;
+  EXPECT_FALSE(replayed.AssignPlanned(0, "o3", Task("2,0", "0,3"), backwards).ok());
+  EXPECT_FALSE(replayed.AssignPlanned(9, "o3", Task("2,0", "0,3"), segment).ok());
+}
+
 TEST_F(FleetStateTest, SecondTaskStartsWhenTheFirstEnds) {
   FleetState s = MakeFleet(map_, routes_, {{"A", Pt(*map_, "0,0"), 1.0}});
   EXPECT_EQ(s.summary(0).end_time, 1.0);
