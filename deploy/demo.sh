@@ -2,11 +2,13 @@
 # The main job: the dispatch service on the built-in Chu2024 floor. Builds everything, shows
 # the engine's seed reproductions briefly, then starts dispatchd (SQLite file on disk),
 # fleet-sim with 18 robots in the parking stations, submits seed 000 Table 1 and then Table 2
-# through wmsctl, prints the results, and keeps the service up until Ctrl-C.
+# through wmsctl, prints the results, and keeps the service and its live web map up until
+# Ctrl-C (the map's URL is printed as soon as dispatchd listens: open it to watch the run).
 #
 # Environment: TIME_SCALE (dispatcher seconds per wall second, default 5), GRPC_PORT and
-# HTTP_PORT (default 0: any free port), DEMO_EXIT=1 (stop after the results instead of
-# serving until Ctrl-C).
+# HTTP_PORT (default 0: any free port), BIND (default 127.0.0.1; 0.0.0.0 to open the map from
+# another machine or from outside a container), DEMO_EXIT=1 (stop after the results instead
+# of serving until Ctrl-C).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash deploy/setup.sh build build-release -DCMAKE_BUILD_TYPE=Release -DDISPATCH_BUILD_TESTS=OFF \
@@ -48,7 +50,7 @@ stop() {
 trap stop EXIT
 trap 'echo; echo "demo: stopping"; exit 0' INT TERM
 mkfifo "$run/ready" "$run/fleet-ready"
-"$bin/server/dispatchd" --bind 127.0.0.1 --grpc-port "${GRPC_PORT:-0}" --http-port "${HTTP_PORT:-0}" \
+"$bin/server/dispatchd" --bind "${BIND:-127.0.0.1}" --grpc-port "${GRPC_PORT:-0}" --http-port "${HTTP_PORT:-0}" \
   --db "$run/dispatch.db" --map chu2024 --time-scale "${TIME_SCALE:-5}" \
   --ready-fd 3 3>"$run/ready" >"$run/dispatchd.log" 2>&1 &
 server_pid=$!
@@ -59,10 +61,13 @@ if [ -z "$ports" ]; then
   cat "$run/dispatchd.log" >&2
   exit 1
 fi
-grpc=127.0.0.1:$(sed -E 's/.*"grpc_port": *([0-9]+).*/\1/' <<<"$ports")
-http=127.0.0.1:$(sed -E 's/.*"http_port": *([0-9]+).*/\1/' <<<"$ports")
+host=127.0.0.1
+grpc=$host:$(sed -E 's/.*"grpc_port": *([0-9]+).*/\1/' <<<"$ports")
+http=$host:$(sed -E 's/.*"http_port": *([0-9]+).*/\1/' <<<"$ports")
 echo "dispatchd: gRPC $grpc, REST http://$http/api/v1/status, database $run/dispatch.db"
 echo "           (log $run/dispatchd.log, time scale ${TIME_SCALE:-5}x)"
+echo "Live web map: http://$http/"
+
 "$bin/clients/fleet-sim" --server "$grpc" --robots 18 --ready-fd 4 4>"$run/fleet-ready" \
   >"$run/fleet-sim.log" 2>&1 &
 fleet_pid=$!
@@ -94,9 +99,10 @@ print(f"Traffic control: {t['grants']} grants, {t['holds']} holds, {t['replans']
       f"{t['deadlocks_resolved']} deadlocks resolved")
 PY
 echo
+echo "Live web map: http://$http/  (metrics: http://$http/metrics)"
 echo "Orders, robots, traffic and the service status: curl http://$http/api/v1/orders, http://$http/api/v1/robots,"
-echo "  http://$http/api/v1/traffic, http://$http/api/v1/status"
+echo "  http://$http/api/v1/traffic, http://$http/api/v1/zones, http://$http/api/v1/intersections, http://$http/api/v1/status"
 echo "An allocation's reasons: $bin/clients/wmsctl --server $grpc explain <order id>"
 if [ "${DEMO_EXIT:-0}" = 1 ]; then exit 0; fi
-echo "Serving until Ctrl-C."
+echo "Serving the web map until Ctrl-C."
 wait "$server_pid"
