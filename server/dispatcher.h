@@ -222,6 +222,8 @@ class Dispatcher {
   // Stamps the robot's next message sequence and the time, and sends if connected.
   void SendTo(RobotRuntime& robot, RobotOutbound message);
   static std::string OrderOfWaypoint(const storage::AssignmentRecord& plan, std::size_t index);
+  // OrderOfWaypoint of every waypoint, in one pass.
+  static std::vector<std::string> OrdersOfWaypoints(const storage::AssignmentRecord& plan);
   RobotRuntime* RobotOf(const std::string& id);
 
   // Robots (dispatcher_robots.cpp).

@@ -52,6 +52,18 @@ std::size_t Dispatcher::SegmentStart(const storage::AssignmentRecord& plan, std:
   return plan.plan.waypoints.size();
 }
 
+std::vector<std::string> Dispatcher::OrdersOfWaypoints(const storage::AssignmentRecord& plan) {
+  // Waypoint 0 anchors; then segment k (up to and including its drop) serves order_ids[k].
+  const auto& w = plan.plan.waypoints;
+  std::vector<std::string> out(w.size());
+  std::size_t drops = 0;
+  for (std::size_t i = 1; i < w.size() && drops < plan.order_ids.size(); ++i) {
+    out[i] = plan.order_ids[drops];
+    if (w[i].action == engine::WaypointAction::kDrop) ++drops;
+  }
+  return out;
+}
+
 std::string Dispatcher::OrderOfWaypoint(const storage::AssignmentRecord& plan, std::size_t index) {
   if (index == 0) return {};
   std::size_t drops = 0;
@@ -72,14 +84,11 @@ OrderRoutes Dispatcher::RoutesOf(const std::string& order_id) const {
     const auto& a = r.assignment;
     const std::uint64_t released = ReleasedUpTo(r);
     auto& route = out[robot_id];
-    std::size_t drops = 0;  // segment k of the plan serves order_ids[k] (see OrderOfWaypoint)
-    for (std::size_t i = 1; i < a.plan.waypoints.size() && drops < a.order_ids.size(); ++i) {
+    const std::vector<std::string> order_of = OrdersOfWaypoints(a);
+    for (std::size_t i = 0; i < a.plan.waypoints.size(); ++i) {
       const auto& w = a.plan.waypoints[i];
       const auto seq = static_cast<std::uint64_t>(w.seq);
-      if (a.order_ids[drops] == order_id && seq > r.last_reached) {
-        route.push_back({seq, w.xy, w.action, seq <= released});
-      }
-      if (w.action == engine::WaypointAction::kDrop) ++drops;
+      if (order_of[i] == order_id && seq > r.last_reached) route.push_back({seq, w.xy, w.action, seq <= released});
     }
   }
   return out;
@@ -115,10 +124,11 @@ RobotOutbound Dispatcher::PlanMessage(const RobotRuntime& robot, bool full,
   m.order_ids = a.order_ids;
   // Released: what the traffic gate has released so far (everything without traffic control).
   const std::uint64_t released = ReleasedUpTo(robot);
+  const std::vector<std::string> order_of = OrdersOfWaypoints(a);
   for (std::size_t i = 0; i < a.plan.waypoints.size(); ++i) {
     const auto& w = a.plan.waypoints[i];
     if (!full && static_cast<std::uint64_t>(w.seq) < from_sequence) continue;
-    m.waypoints.push_back({w, OrderOfWaypoint(a, i), static_cast<std::uint64_t>(w.seq) <= released});
+    m.waypoints.push_back({w, order_of[i], static_cast<std::uint64_t>(w.seq) <= released});
   }
   m.released_up_to = released;
   for (const auto& id : a.order_ids) {
@@ -239,9 +249,7 @@ void Dispatcher::ReplayQueue(engine::FleetState& fleet, std::size_t index, const
     }
     const engine::PlanTask task = fleet.TaskOf(picks, order.drop, order.work_time);
     engine::Status assigned = engine::InvalidArgument("no stored waypoints");
-    if (segment.size() >= 2 && segment.back().point == order.drop) {
-      assigned = fleet.AssignPlanned(index, order.id, task, std::move(segment));
-    }
+    if (segment.size() >= 2) assigned = fleet.AssignPlanned(index, order.id, task, std::move(segment));
     if (!assigned.ok()) assigned = fleet.AssignSingle(index, order.id, task);
     if (!assigned.ok()) {
       spdlog::warn("allocation: queue of {} replayed up to {} only: {}", r.record.robot.id, order.id,

@@ -13,14 +13,7 @@ GatePlan Dispatcher::GatePlanOf(const RobotRuntime& r) const {
   GatePlan g;
   const auto& w = r.assignment.plan.waypoints;
   g.waypoints = w;
-  // As OrderOfWaypoint, in one pass: waypoint 0 anchors, then segment k serves order_ids[k].
-  g.order_of.reserve(w.size());
-  std::size_t drops = 0;
-  for (std::size_t i = 0; i < w.size(); ++i) {
-    const auto& ids = r.assignment.order_ids;
-    g.order_of.push_back(i == 0 || drops >= ids.size() ? std::string() : ids[drops]);
-    if (i > 0 && w[i].action == engine::WaypointAction::kDrop) ++drops;
-  }
+  g.order_of = OrdersOfWaypoints(r.assignment);
   for (const auto& id : r.assignment.order_ids) {
     auto view = Find(id);
     if (view && view->record.order.formation) g.teams[id] = view->record.robots;

@@ -109,15 +109,20 @@ Status FleetState::AssignSingle(std::size_t robot, const std::string& order_id,
                  "order " + order_id + " for robot " + e.info.id + ": " + segment.error().message};
   }
   const double travel = routes_->Cost(s.end_point, task.picks.front()) + TaskTravelTime(task);
-  QueuedTask q{order_id, task, {e.info.id}, s.end_time, segment->end_time()};
-  AppendSegment(e.plan, segment->waypoints);
+  AppendTask(e, order_id, task, segment->waypoints, travel);
+  return Ok{};
+}
+
+void FleetState::AppendTask(RobotEntry& e, const std::string& order_id, const PlanTask& task,
+                            const std::vector<Waypoint>& segment, double travel) {
+  QueuedTask q{order_id, task, {e.info.id}, e.summary.end_time, segment.back().departure()};
+  AppendSegment(e.plan, segment);
   e.summary.end_point = task.drop;
   e.summary.end_time = e.plan.end_time();
   e.summary.travel_time += travel;
   e.summary.work_time += TaskWorkTime(task);
   e.queue.push_back(std::move(q));
   Publish(e);
-  return Ok{};
 }
 
 Status FleetState::AssignPlanned(std::size_t robot, const std::string& order_id, const PlanTask& task,
@@ -137,15 +142,11 @@ Status FleetState::AssignPlanned(std::size_t robot, const std::string& order_id,
     }
     travel += std::max(0.0, drive);
   }
+  if (segment.back().point != task.drop) {
+    return InvalidArgument("order " + order_id + ": a planned segment must end at the task's drop");
+  }
   for (Waypoint& w : segment) w.eta += shift;
-  QueuedTask q{order_id, task, {e.info.id}, e.summary.end_time, segment.back().departure()};
-  AppendSegment(e.plan, segment);
-  e.summary.end_point = segment.back().point;
-  e.summary.end_time = e.plan.end_time();
-  e.summary.travel_time += travel;
-  e.summary.work_time += TaskWorkTime(task);
-  e.queue.push_back(std::move(q));
-  Publish(e);
+  AppendTask(e, order_id, task, segment, travel);
   return Ok{};
 }
 

@@ -99,7 +99,7 @@ class FleetState {
   // no routing). segment[0] stands for the queue's end point; the segment is shifted to start
   // at the queue's end time, and its driving time (arrivals minus the previous departures)
   // counts as the task's T_d. Errors: unknown robot index, fewer than 2 waypoints, times
-  // that go backwards.
+  // that go backwards, a last waypoint that is not the task's drop.
   Status AssignPlanned(std::size_t robot, const std::string& order_id, const PlanTask& task,
                        std::vector<Waypoint> segment);
   // Appends a formation task to the three distinct members' queues (team[0] leads).
@@ -116,6 +116,10 @@ class FleetState {
   FleetState() = default;
   // Appends `segment` (its waypoint 0 repeats the plan's end and is dropped) to the plan.
   static void AppendSegment(Plan& plan, const std::vector<Waypoint>& segment);
+  // Appends a planned single task (segment starts at the queue's end) and updates the queue,
+  // its summary and the prediction.
+  void AppendTask(RobotEntry& e, const std::string& order_id, const PlanTask& task,
+                  const std::vector<Waypoint>& segment, double travel);
   // Gives the predictor robot e's plan plus a final wait of config_.hold_seconds.
   void Publish(const RobotEntry& e);
 
