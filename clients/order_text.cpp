@@ -32,8 +32,9 @@ void AppendBid(std::string& out, const v1::Bid& b) {
     return;
   }
   if (!b.priced()) {
-    out += Format("  %-6s B>=%8.2f  T_t=%7.2f T_d=%7.2f T_w=%6.2f  F not evaluated (could not win)\n",
-                  b.robot_id().c_str(), b.total(), b.total_time(), b.travel_time(), b.work_time());
+    out += Format("  %-6s B>=%8.2f  T_t=%7.2f T_d=%7.2f T_w=%6.2f  F>=%.4f (part of the route: could not win)\n",
+                  b.robot_id().c_str(), b.total(), b.total_time(), b.travel_time(), b.work_time(),
+                  b.traffic_flow());
     return;
   }
   out += Format("  %-6s B=%9.2f  T_t=%7.2f T_d=%7.2f T_w=%6.2f  F=%.4f x=%7.2f%s\n",

@@ -4,6 +4,8 @@
 #include <array>
 #include <cmath>
 #include <cstdio>
+#include <functional>
+#include <utility>
 #include <limits>
 
 #include "engine/allocation/route_sampler.h"
@@ -84,34 +86,84 @@ std::size_t Keep(const FleetState& state, std::size_t k) {
 
 }  // namespace
 
-template <typename Price>
-void AuctionAllocator::PriceLowest(std::vector<Bid>& bids, std::size_t keep, Price&& price) {
+template <typename Bound, typename Price>
+void AuctionAllocator::PriceLowest(const AllocationConfig& c, std::vector<Bid>& bids,
+                                   std::size_t keep, Bound&& bound, Price&& price) {
   if (keep == 0) {
     for (std::size_t i = 0; i < bids.size(); ++i) {
       if (bids[i].reachable) price(i);
     }
     return;
   }
+  // A min-heap of (lower bound, robot): robots come out in increasing bound, ties in robot
+  // order, and only as many as get priced pay for more than the O(n) heap build.
   order_.clear();
+  flow_bounds_.assign(bids.size(), 0.0);
   for (std::size_t i = 0; i < bids.size(); ++i) {
-    if (bids[i].reachable) order_.push_back(i);
+    if (!bids[i].reachable) continue;
+    flow_bounds_[i] = bound(i);
+    bids[i].bid = BidValue(c.alpha, c.beta, bids[i].t_t, bids[i].t_d, c.zeta * flow_bounds_[i]);
+    order_.emplace_back(bids[i].bid, i);
   }
-  std::sort(order_.begin(), order_.end(), [&](std::size_t a, std::size_t b) {
-    return bids[a].bid < bids[b].bid || (bids[a].bid == bids[b].bid && a < b);
-  });
+  const auto later = std::greater<std::pair<double, std::size_t>>();
+  std::make_heap(order_.begin(), order_.end(), later);
   kept_.clear();
-  std::size_t k = 0;
-  for (; k < order_.size(); ++k) {
-    Bid& b = bids[order_[k]];
+  while (!order_.empty()) {
+    const std::size_t i = order_.front().second;
+    Bid& b = bids[i];
     // Full bids are >= their bound: once the bound passes the keep-th lowest full bid, this
     // robot and every later one are out of the lowest `keep` (ties still priced).
     if (kept_.size() == keep && b.bid > kept_.back()) break;
-    price(order_[k]);
+    std::pop_heap(order_.begin(), order_.end(), later);
+    order_.pop_back();
+    price(i);
     if (!b.reachable) continue;
     kept_.insert(std::upper_bound(kept_.begin(), kept_.end(), b.bid), b.bid);
     if (kept_.size() > keep) kept_.pop_back();
   }
-  for (; k < order_.size(); ++k) bids[order_[k]].priced = false;
+  for (const auto& [bound_bid, i] : order_) {
+    Bid& b = bids[i];
+    b.priced = false;
+    b.flow = flow_bounds_[i];
+    b.x = c.zeta * b.flow;  // b.bid is already BidValue(..., b.x)
+  }
+}
+
+double AuctionAllocator::FlowBound(const FleetState& state, std::size_t robot, PointId first,
+                                   RouteSampler& sampler,
+                                   TrafficPredictor::DensityAccumulator& density,
+                                   const ZoneRun* runs, std::size_t run_count) {
+  const QueueSummary& s = state.summary(robot);
+  const TrafficPredictor& predictor = state.predictor();
+  const double to_go = sampler.TimeToTarget(s.end_point, first);
+  if (!std::isfinite(to_go)) return 0.0;  // priced in time order, found unreachable there
+  density.Reset(state.prediction(robot));
+  // The leg's first sample exactly: its start point when it leaves (AddLegSamples' first).
+  if (s.end_point != first) {
+    density.Add(predictor.ZoneAt(state.map().point(s.end_point).position), s.end_time);
+  }
+  // Every kBoundStride-th sample of the order's route from the arrival. The arrival is the
+  // leg's own up to rounding (far below the slack), so each sample's bucket is in the window.
+  constexpr std::size_t kBoundStride = 4;
+  const double arrival = s.end_time + to_go;
+  const double slack = 1e-6 * std::max(1.0, std::abs(arrival) + shared_span_);
+  for (std::size_t r = 0; r < run_count; ++r) {
+    const ZoneRun& run = runs[r];
+    for (std::size_t k = 0; k < run.size; k += kBoundStride) {
+      density.AddAtMost(run.zone, shared_times_[run.begin + k] + arrival, slack);
+    }
+  }
+  return density.Flow();
+}
+
+RouteSampler& AuctionAllocator::Sampler(const FleetState& state) {
+  const AllocationConfig& c = state.config();
+  if (!sampler_) {
+    sampler_.emplace(state.map(), state.routes(), c.speed, c.sample_step);
+  } else {
+    sampler_->Bind(state.map(), state.routes(), c.speed, c.sample_step);
+  }
+  return *sampler_;
 }
 
 ZoneId AuctionAllocator::MixedArcZone(const TrafficPredictor& predictor, ArcId arc,
@@ -158,7 +210,7 @@ std::vector<Bid> AuctionAllocator::ComputeBids(const FleetState& state, const Pl
                                                std::size_t keep) {
   const AllocationConfig& c = state.config();
   const RouteTable& routes = state.routes();
-  RouteSampler sampler(state.map(), routes, c.speed, c.sample_step);
+  RouteSampler& sampler = Sampler(state);
   ResetMixedArcs(state.map());
   shared_.clear();
   sampler.AppendTask(task, 0.0, shared_);
@@ -195,11 +247,17 @@ std::vector<Bid> AuctionAllocator::ComputeBids(const FleetState& state, const Pl
     SetTimes(c, s.travel_time + leg + task_travel, s.work_time + task_work, b);
     bids.push_back(std::move(b));
   }
-  PriceLowest(bids, keep, [&](std::size_t i) {
+  shared_span_ = shared_times_.empty() ? 0.0 : std::abs(shared_times_.back());
+  TrafficPredictor::DensityAccumulator density(predictor, TrafficPredictor::PlanHandle{});
+  // The lower bound of F: the leg's first sample and some of the order's own route.
+  auto bound = [&](std::size_t i) {
+    return FlowBound(state, i, first, sampler, density, shared_runs_.data(), shared_runs_.size());
+  };
+  PriceLowest(c, bids, keep, bound, [&](std::size_t i) {
     const QueueSummary& s = state.summary(i);
     // The leg's samples go straight into the density (a sample's order does not change
     // eqs. (6)-(8)); if the robot cannot reach the pick, they are discarded with it.
-    TrafficPredictor::DensityAccumulator density(predictor, state.robot_id(i));
+    density.Reset(state.prediction(i));
     const double arrival = AddLegSamples(sampler, predictor, s.end_point, first, s.end_time,
                                          density);
     if (!std::isfinite(arrival)) {
@@ -218,7 +276,7 @@ std::vector<Bid> AuctionAllocator::ComputeReachBids(const FleetState& state, Poi
                                                     std::size_t keep) {
   const AllocationConfig& c = state.config();
   const RouteTable& routes = state.routes();
-  RouteSampler sampler(state.map(), routes, c.speed, c.sample_step);
+  RouteSampler& sampler = Sampler(state);
   ResetMixedArcs(state.map());
   const TrafficPredictor& predictor = state.predictor();
   const ZoneId pick_zone = predictor.ZoneAt(state.map().point(first_pick).position);
@@ -237,9 +295,17 @@ std::vector<Bid> AuctionAllocator::ComputeReachBids(const FleetState& state, Poi
     SetTimes(c, s.travel_time + leg, s.work_time, b);
     bids.push_back(std::move(b));
   }
-  PriceLowest(bids, keep, [&](std::size_t i) {
+  TrafficPredictor::DensityAccumulator density(predictor, TrafficPredictor::PlanHandle{});
+  // The lower bound of F': the leg's first sample and the first pick on arrival.
+  shared_times_.assign(1, 0.0);
+  shared_span_ = 0.0;
+  const ZoneRun pick_run{pick_zone, 0, 1};
+  auto bound = [&](std::size_t i) {
+    return FlowBound(state, i, first_pick, sampler, density, &pick_run, 1);
+  };
+  PriceLowest(c, bids, keep, bound, [&](std::size_t i) {
     const QueueSummary& s = state.summary(i);
-    TrafficPredictor::DensityAccumulator density(predictor, state.robot_id(i));
+    density.Reset(state.prediction(i));
     const double arrival = AddLegSamples(sampler, predictor, s.end_point, first_pick,
                                          s.end_time, density);
     if (!std::isfinite(arrival)) {

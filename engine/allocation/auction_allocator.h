@@ -28,7 +28,9 @@
 
 #include <array>
 #include <limits>
+#include <optional>
 #include <string_view>
+#include <utility>
 #include <vector>
 
 #include "engine/allocation/allocator.h"
@@ -63,14 +65,34 @@ class AuctionAllocator final : public Allocator {
                       const Eigen::Vector2d& xb, double f);
   // Forgets the remembered zones (they hold for one map and one predictor: one call).
   void ResetMixedArcs(const WarehouseMap& map);
+  // The sampler for one call on `state` (kept between calls for its memo's storage).
+  RouteSampler& Sampler(const FleetState& state);
 
   // Calls price(i) for the robots that can be among the `keep` lowest bids (all when keep is
-  // 0), in increasing order of their lower bound bids[i].bid, and marks the others unpriced.
-  // bids holds every robot's time terms and bound on entry; price(i) completes bids[i].
-  template <typename Price>
-  void PriceLowest(std::vector<Bid>& bids, std::size_t keep, Price&& price);
+  // 0), in increasing order of their lower bounds, and marks the others unpriced. bids holds
+  // every robot's time terms on entry; bound(i) returns a lower bound of robot i's F (keep >
+  // 0 only), so alpha T_t + beta T_d + zeta bound(i) bounds its bid; price(i) completes
+  // bids[i]. An unpriced bid keeps its bound: flow = bound(i), x and bid to match.
+  template <typename Bound, typename Price>
+  void PriceLowest(const AllocationConfig& c, std::vector<Bid>& bids, std::size_t keep,
+                   Bound&& bound, Price&& price);
 
-  std::vector<std::size_t> order_;  // PriceLowest's robot order
+  std::optional<RouteSampler> sampler_;
+  // Consecutive samples of a route in one zone, their times at [begin, begin + size) of
+  // shared_times_.
+  struct ZoneRun {
+    ZoneId zone = -1;
+    std::size_t begin = 0;
+    std::size_t size = 0;
+  };
+  // A lower bound of robot `robot`'s F over the samples of its leg to `first` and the runs
+  // of the order's route shifted to its arrival (see FlowBound in the .cpp).
+  double FlowBound(const FleetState& state, std::size_t robot, PointId first,
+                   RouteSampler& sampler, TrafficPredictor::DensityAccumulator& density,
+                   const ZoneRun* runs, std::size_t run_count);
+
+  std::vector<std::pair<double, std::size_t>> order_;  // PriceLowest's heap of (bound, robot)
+  std::vector<double> flow_bounds_;  // PriceLowest's bound(i) per robot
   std::vector<double> kept_;        // PriceLowest's k lowest full bids, ascending
 
   struct MixedSample {
@@ -81,13 +103,9 @@ class AuctionAllocator final : public Allocator {
   std::vector<ArcId> mixed_touched_;               // arcs with a remembered zone
   std::vector<RouteSample> shared_;   // the order's samples from its first pick, from t = 0
   // shared_ as runs of consecutive samples in one zone (ZoneAt), over shared_times_.
-  struct ZoneRun {
-    ZoneId zone = -1;
-    std::size_t begin = 0;
-    std::size_t size = 0;
-  };
   std::vector<ZoneRun> shared_runs_;
   std::vector<double> shared_times_;  // shared_[k].t
+  double shared_span_ = 0.0;          // |last shared time|, for FlowBound's slack
 };
 
 }  // namespace dispatch::engine

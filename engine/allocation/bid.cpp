@@ -9,8 +9,9 @@ std::string DescribeBid(const Bid& bid) {
   char buf[200];
   if (!bid.priced) {
     std::snprintf(buf, sizeof(buf),
-                  " B>=%.2f (T_t=%.2f, T_d=%.2f, T_w=%.2f, F not evaluated: could not win)",
-                  bid.bid, bid.t_t, bid.t_d, bid.t_w);
+                  " B>=%.2f (T_t=%.2f, T_d=%.2f, T_w=%.2f, F>=%.4f from part of the route: "
+                  "could not win)",
+                  bid.bid, bid.t_t, bid.t_d, bid.t_w, bid.flow);
     return bid.robot + buf;
   }
   std::snprintf(buf, sizeof(buf), " B=%.2f (T_t=%.2f, T_d=%.2f, T_w=%.2f, F=%.4f, x=%.2f)",

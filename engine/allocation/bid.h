@@ -5,9 +5,10 @@
 // Invariant of a reachable Bid from an allocator: bid == BidValue(alpha, beta, t_t, t_d, x),
 // t_t == t_d + t_w, x == zeta * flow. An unreachable robot (no route to the order) has
 // reachable = false and every time term +infinity. A bid that was not priced (priced = false:
-// large fleets, see AllocationConfig::price_every_bid_up_to) has its time terms, flow = x = 0,
-// and bid = alpha * T_t + beta * T_d: a lower bound of its full bid that already exceeds the
-// bids that decided the award. Plain values; thread-safe to share.
+// large fleets, see AllocationConfig::price_every_bid_up_to) has its time terms, flow = a
+// lower bound of F_i from part of its route's samples, x and bid to match (so bid is a lower
+// bound of its full bid, and it already exceeds the bids that decided the award), and no
+// peaks. Plain values; thread-safe to share.
 #pragma once
 
 #include <string>
@@ -21,7 +22,7 @@ namespace dispatch::engine {
 struct Bid {
   std::string robot;
   bool reachable = true;
-  bool priced = true;  // F_i evaluated; false: bid is the lower bound alpha T_t + beta T_d
+  bool priced = true;  // F_i evaluated; false: flow, x and bid are lower bounds
   double t_d = 0.0;   // T_d,i: travel time of the whole queue + this order, s (eq. (3))
   double t_w = 0.0;   // T_w,i: work time n_c * t_w of the whole queue + this order, s (eq. (3))
   double t_t = 0.0;   // T_t,i = T_d,i + T_w,i (eq. (2))

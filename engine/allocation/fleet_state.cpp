@@ -45,7 +45,7 @@ Result<FleetState> FleetState::Create(std::shared_ptr<const WarehouseMap> map,
     state.index_.emplace(r.id, state.robots_.size());
     state.robots_.push_back(std::move(e));
   }
-  for (const RobotEntry& e : state.robots_) state.Publish(e);
+  for (RobotEntry& e : state.robots_) state.Publish(e);
   return state;
 }
 
@@ -81,9 +81,9 @@ void FleetState::AppendSegment(Plan& plan, const std::vector<Waypoint>& segment)
   }
 }
 
-void FleetState::Publish(const RobotEntry& e) {
+void FleetState::Publish(RobotEntry& e) {
   if (config_.hold_seconds <= 0.0) {
-    predictor_->SetPlan(e.info.id, e.plan);
+    e.prediction = predictor_->SetPlan(e.info.id, e.plan);
     return;
   }
   Plan held = e.plan;
@@ -93,7 +93,7 @@ void FleetState::Publish(const RobotEntry& e) {
   w.action = WaypointAction::kWait;
   w.dwell = config_.hold_seconds;
   held.waypoints.push_back(w);
-  predictor_->SetPlan(e.info.id, held);
+  e.prediction = predictor_->SetPlan(e.info.id, held);
 }
 
 Status FleetState::AssignSingle(std::size_t robot, const std::string& order_id,

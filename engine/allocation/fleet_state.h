@@ -86,6 +86,10 @@ class FleetState {
   const RouteTable& routes() const { return *routes_; }
   const AllocationConfig& config() const { return config_; }
   const TrafficPredictor& predictor() const { return *predictor_; }
+  // Robot `robot`'s plan in the predictor (predictor().Find(robot_id(robot)) without the lookup).
+  TrafficPredictor::PlanHandle prediction(std::size_t robot) const {
+    return robots_.at(robot).prediction;
+  }
 
   // The PlanTask of an order under this config (t_w = override or the order's own).
   PlanTask TaskOf(const std::vector<PointId>& picks, PointId drop, double order_work_time) const;
@@ -112,6 +116,7 @@ class FleetState {
     std::vector<QueuedTask> queue;
     Plan plan;
     QueueSummary summary;
+    TrafficPredictor::PlanHandle prediction;  // set by Publish
   };
   FleetState() = default;
   // Appends `segment` (its waypoint 0 repeats the plan's end and is dropped) to the plan.
@@ -121,7 +126,7 @@ class FleetState {
   void AppendTask(RobotEntry& e, const std::string& order_id, const PlanTask& task,
                   const std::vector<Waypoint>& segment, double travel);
   // Gives the predictor robot e's plan plus a final wait of config_.hold_seconds.
-  void Publish(const RobotEntry& e);
+  void Publish(RobotEntry& e);
 
   std::shared_ptr<const WarehouseMap> map_;
   std::shared_ptr<const RouteTable> routes_;

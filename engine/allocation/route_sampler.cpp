@@ -9,8 +9,21 @@ constexpr double kInf = std::numeric_limits<double>::infinity();
 }  // namespace
 
 RouteSampler::RouteSampler(const WarehouseMap& map, const RouteTable& routes, double speed,
-                           double step)
-    : map_(map), routes_(routes), speed_(speed), step_(step), memo_(map.point_count()) {}
+                           double step) {
+  Bind(map, routes, speed, step);
+}
+
+void RouteSampler::Bind(const WarehouseMap& map, const RouteTable& routes, double speed,
+                        double step) {
+  for (PointId p : touched_) memo_[static_cast<std::size_t>(p)] = Hop{};
+  touched_.clear();
+  memo_target_ = kNoPoint;
+  if (memo_.size() != map.point_count()) memo_.assign(map.point_count(), Hop{});
+  map_ = &map;
+  routes_ = &routes;
+  speed_ = speed;
+  step_ = step;
+}
 
 double RouteSampler::ArcTime(const Arc& arc) const {
   return arc.length / (arc.max_speed > 0.0 ? std::min(speed_, arc.max_speed) : speed_);
@@ -20,19 +33,19 @@ const RouteSampler::Hop& RouteSampler::FindHop(PointId p) {
   Hop& hop = memo_[static_cast<std::size_t>(p)];
   touched_.push_back(p);
   hop.arc = -1;
-  const PointId q = routes_.NextHop(p, memo_target_);
+  const PointId q = routes_->NextHop(p, memo_target_);
   if (q == kNoPoint) return hop;
   // The fastest arc p -> q (maps may hold parallel arcs).
   double best = kInf;
-  for (ArcId a : map_.out_arcs(p)) {
-    const Arc& arc = map_.arc(a);
+  for (ArcId a : map_->out_arcs(p)) {
+    const Arc& arc = map_->arc(a);
     if (arc.to == q && ArcTime(arc) < best) {
       best = ArcTime(arc);
       hop.arc = a;
     }
   }
   if (hop.arc >= 0) {
-    const Arc& arc = map_.arc(hop.arc);
+    const Arc& arc = map_->arc(hop.arc);
     hop.to = arc.to;
     hop.length = arc.length;
     hop.dt = ArcTime(arc);
@@ -54,13 +67,40 @@ double RouteSampler::AppendLeg(PointId from, PointId to, double depart,
                                  double f, double t) { out.push_back({xa + f * (xb - xa), t}); });
 }
 
+double RouteSampler::TimeToTarget(PointId from, PointId to) {
+  SetTarget(to);
+  // Forward to the target or to a point whose time to go is known, then back along the walk.
+  walk_.clear();
+  const std::size_t n_points = map_->point_count();
+  double to_go = 0.0;
+  for (PointId p = from; p != to;) {
+    const Hop& hop = NextHop(p);
+    if (hop.to_go >= 0.0) {
+      to_go = hop.to_go;
+      break;
+    }
+    if (hop.arc < 0 || walk_.size() >= n_points) {  // unreachable, or a loop of next hops
+      to_go = kInf;
+      break;
+    }
+    walk_.push_back(p);
+    p = hop.to;
+  }
+  for (auto it = walk_.rbegin(); it != walk_.rend(); ++it) {
+    Hop& hop = memo_[static_cast<std::size_t>(*it)];
+    to_go += hop.dt;
+    hop.to_go = to_go;
+  }
+  return to_go;
+}
+
 double RouteSampler::AppendTask(const PlanTask& task, double arrival,
                                 std::vector<RouteSample>& out) {
   if (task.picks.empty()) return kInf;
   double t = arrival;
   PointId at = task.picks.front();
   auto stop = [&](PointId p) {
-    out.push_back({map_.point(p).position, t});
+    out.push_back({map_->point(p).position, t});
     t += task.work_time;
     at = p;
   };

@@ -12,7 +12,8 @@
 //
 // Routes follow RouteTable::NextHop; next hops towards one target are memoised (the auction
 // asks for many robots' legs to the same first pick), so a sampler must not outlive its
-// RouteTable. Not thread-safe (the memo is mutable state); cheap to construct per order.
+// RouteTable. Not thread-safe (the memo is mutable state). Construction allocates a memo
+// entry per map point; Bind reuses it for another call (the auction keeps one sampler).
 #pragma once
 
 #include <limits>
@@ -29,6 +30,10 @@ class RouteSampler {
  public:
   RouteSampler(const WarehouseMap& map, const RouteTable& routes, double speed, double step);
 
+  // Starts over on `map` and `routes` (which may be new objects or changed tables): forgets
+  // every memoised hop, keeping the memo's storage. O(hops memoised since the last Bind).
+  void Bind(const WarehouseMap& map, const RouteTable& routes, double speed, double step);
+
   // Appends the samples of the drive from `from` (leaving at `depart`) to `to`, arrival point
   // excluded, and returns the arrival time; +infinity if `to` is unreachable (the samples
   // appended so far are then meaningless).
@@ -40,6 +45,12 @@ class RouteSampler {
   // rounding above 1), at time t. Returns what AppendLeg returns.
   template <typename Visit>
   double ForEachLegSample(PointId from, PointId to, double depart, Visit&& visit);
+
+  // The arrival time of AppendLeg(from, to, 0, ...) up to rounding (the same hops' times,
+  // summed from the far end), without the samples: memoised per point towards `to`, so the
+  // legs of many robots to one pick cost about the points of their union. +infinity if `to`
+  // is unreachable.
+  double TimeToTarget(PointId from, PointId to);
 
   // Appends the samples of serving `task` for a robot arriving at its first pick at
   // `arrival`: every stop at its arrival, the legs between them, t_w at each stop. Returns the
@@ -54,6 +65,7 @@ class RouteSampler {
     PointId to = kNoPoint;
     double length = 0.0;
     double dt = 0.0;
+    double to_go = -1.0;  // TimeToTarget from this point; < 0: not yet known
   };
   // The hop the robot takes out of `p` towards memo_target_ (memoised).
   const Hop& NextHop(PointId p) {
@@ -63,13 +75,14 @@ class RouteSampler {
   const Hop& FindHop(PointId p);
   double ArcTime(const Arc& arc) const;
 
-  const WarehouseMap& map_;
-  const RouteTable& routes_;
-  double speed_;
-  double step_;
+  const WarehouseMap* map_ = nullptr;
+  const RouteTable* routes_ = nullptr;
+  double speed_ = 1.0;
+  double step_ = 1.0;
   PointId memo_target_ = kNoPoint;
   std::vector<Hop> memo_;  // per point
   std::vector<PointId> touched_;
+  std::vector<PointId> walk_;  // TimeToTarget's scratch
 
   void SetTarget(PointId to);
 };
@@ -82,8 +95,8 @@ double RouteSampler::ForEachLegSample(PointId from, PointId to, double depart, V
   double next_s = 0.0;  // distance of the next sample
   PointId p = from;
   std::size_t hops = 0;
-  const std::size_t n_points = map_.point_count();
-  const Point* points = map_.points().data();
+  const std::size_t n_points = map_->point_count();
+  const Point* points = map_->points().data();
   while (p != to) {
     const Hop& hop = NextHop(p);
     if (hop.arc < 0 || ++hops > n_points) return std::numeric_limits<double>::infinity();

@@ -228,11 +228,12 @@ void TrafficPredictor::Apply(const Contribution& c, int sign) {
   }
 }
 
-void TrafficPredictor::SetPlan(const std::string& robot, const Plan& plan) {
+TrafficPredictor::PlanHandle TrafficPredictor::SetPlan(const std::string& robot,
+                                                       const Plan& plan) {
   if (robot.empty()) throw std::invalid_argument("TrafficPredictor::SetPlan: empty robot id");
   if (plan.waypoints.empty()) {
     RemovePlan(robot);
-    return;
+    return PlanHandle{};
   }
   const double start = plan.start_time(), end = plan.end_time();
   if (!std::isfinite(start) || !std::isfinite(end)) {
@@ -309,6 +310,23 @@ void TrafficPredictor::SetPlan(const std::string& robot, const Plan& plan) {
   if (!inserted) Apply(it->second, -1);
   Apply(next, +1);
   it->second = std::move(next);
+  return HandleOf(it->second);  // unordered_map nodes (and their zones) stay put until erased
+}
+
+TrafficPredictor::PlanHandle TrafficPredictor::HandleOf(const Contribution& c) {
+  PlanHandle h;
+  if (c.zones.empty()) return h;
+  h.zones_ = c.zones.data();
+  h.first_ = c.first_bucket;
+  h.tail_ = c.first_bucket + c.tail;
+  h.end_ = c.first_bucket + c.zones.size();
+  h.tail_zone_ = c.zones.back();
+  return h;
+}
+
+TrafficPredictor::PlanHandle TrafficPredictor::Find(const std::string& robot) const {
+  auto it = robots_.find(robot);
+  return it == robots_.end() ? PlanHandle{} : HandleOf(it->second);
 }
 
 void TrafficPredictor::RemovePlan(const std::string& robot) {
@@ -340,18 +358,23 @@ DensityTerm TrafficPredictor::Density(const std::vector<RouteSample>& samples,
 
 TrafficPredictor::DensityAccumulator::DensityAccumulator(const TrafficPredictor& predictor,
                                                          const std::string& robot)
+    : DensityAccumulator(predictor, robot.empty() ? PlanHandle{} : predictor.Find(robot)) {}
+
+TrafficPredictor::DensityAccumulator::DensityAccumulator(const TrafficPredictor& predictor,
+                                                         PlanHandle own)
     : predictor_(&predictor) {
-  if (!robot.empty()) {
-    auto it = predictor.robots_.find(robot);
-    if (it != predictor.robots_.end()) own_ = &it->second;
-  }
-  if (own_ != nullptr && !own_->zones.empty()) {
-    own_first_ = own_->first_bucket;
-    own_tail_ = own_first_ + own_->tail;
-    own_end_ = own_first_ + own_->zones.size();
-    own_zones_ = own_->zones.data();
-    tail_zone_ = own_->zones.back();
-  }
+  Reset(own);
+}
+
+void TrafficPredictor::DensityAccumulator::Reset(PlanHandle own) {
+  own_zones_ = own.zones_;
+  own_first_ = own.first_;
+  own_tail_ = own.tail_;
+  own_end_ = own.end_;
+  tail_zone_ = own.tail_zone_;
+  peaks_.clear();
+  last_ = 0;
+  cursor_ = 0;
 }
 
 void TrafficPredictor::DensityAccumulator::NewZone(ZoneId zone, int n) {
@@ -377,6 +400,39 @@ void TrafficPredictor::DensityAccumulator::AddRun(ZoneId zone, const double* tim
   }
   if (last_ >= peaks_.size() || peaks_[last_].first != zone) NewZone(zone, peak);
   peaks_[last_].second = std::max(peaks_[last_].second, peak);
+}
+
+void TrafficPredictor::DensityAccumulator::AddAtMost(ZoneId zone, double t, double slack) {
+  if (zone < 0) return;
+  const TrafficPredictor& p = *predictor_;
+  const std::int32_t* row = p.counts_.data() + static_cast<std::size_t>(zone) * p.bucket_stride_;
+  const double* starts = p.bucket_starts_.data();  // bucket_count_ + 1 entries
+  int n = 0;  // an unstored bucket in the window (or a NaN time): no robot there
+  std::size_t lo = 0;
+  if (Locate(t - slack, &lo)) {
+    // hi = bucket(t + slack): from lo up (s_b is non-decreasing in b).
+    const double t_hi = t + slack;
+    std::size_t hi = lo;
+    while (hi < p.bucket_count_ && starts[hi + 1] <= t_hi) ++hi;
+    if (hi < p.bucket_count_) {
+      n = std::numeric_limits<int>::max();
+      for (std::size_t b = lo; b <= hi; ++b) {
+        n = std::min(n, row[b] - (OwnZone(b) == zone ? 1 : 0));
+      }
+    }
+  }
+  if (last_ >= peaks_.size() || peaks_[last_].first != zone) NewZone(zone, n);
+  peaks_[last_].second = std::max(peaks_[last_].second, n);
+}
+
+double TrafficPredictor::DensityAccumulator::Flow() {
+  sorted_ = peaks_;
+  std::sort(sorted_.begin(), sorted_.end());
+  double flow = 0.0;
+  for (const auto& [z, n_max] : sorted_) {
+    flow += n_max / predictor_->zones_[static_cast<std::size_t>(z)].area;  // eqs. (7)-(8)
+  }
+  return flow;
 }
 
 DensityTerm TrafficPredictor::DensityAccumulator::Finish() const {

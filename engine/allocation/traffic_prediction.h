@@ -67,17 +67,45 @@ struct DensityTerm {
 };
 
 class TrafficPredictor {
+ private:
+  struct Contribution;
+
  public:
+  // Density's computation fed one sample at a time, for callers that already know a sample's
+  // zone (the auction reuses the zones of an order's route for every bidder). Holds pointers
+  // into the predictor: use it only while the predictor is not modified.
+  class DensityAccumulator;
+  // A robot's stored prediction, to build a DensityAccumulator without looking the robot up
+  // by id. Valid until that robot's next SetPlan or RemovePlan (use the handle SetPlan
+  // returns); a default PlanHandle stands for no plan.
+  class PlanHandle {
+   public:
+    PlanHandle() = default;
+
+   private:
+    friend class TrafficPredictor;
+    friend class DensityAccumulator;
+    // The contribution's shape, copied so that DensityAccumulator::Reset reads no more than
+    // the handle (the contribution itself is read only for buckets before its tail).
+    const ZoneId* zones_ = nullptr;  // zone at bucket first_ + k; nullptr: no plan
+    std::size_t first_ = 0, tail_ = 0, end_ = 0;  // bucket ranges as in Contribution
+    ZoneId tail_zone_ = -1;
+  };
+
   // Builds the zone grid: O(cells of each zone's bounding box x its edges) once.
   // Throws std::invalid_argument on a non-positive or non-finite setting (broken contract).
   TrafficPredictor(const WarehouseMap& map, TrafficPredictionConfig config);
 
   // Replaces robot `robot`'s contribution with `plan` (adds it if new); an empty plan removes
   // it. O(buckets of the old and new plan x log waypoints). Storage grows to the plan's last
-  // bucket. Throws std::invalid_argument on an empty robot id or non-finite plan times.
-  void SetPlan(const std::string& robot, const Plan& plan);
+  // bucket. Returns the robot's handle (a default one when `plan` is empty). Throws
+  // std::invalid_argument on an empty robot id or non-finite plan times.
+  PlanHandle SetPlan(const std::string& robot, const Plan& plan);
   // Removes robot `robot`'s contribution; unknown robots are ignored.
   void RemovePlan(const std::string& robot);
+  // The handle of robot `robot`'s current plan (a default one if it has none): one hash
+  // lookup.
+  PlanHandle Find(const std::string& robot) const;
 
   // The zone holding xy (lowest id on shared borders): O(1); -1 outside every zone.
   ZoneId ZoneAt(const Eigen::Vector2d& xy) const;
@@ -103,10 +131,6 @@ class TrafficPredictor {
   // route never visits are not in `peaks`. O(samples x zones visited).
   DensityTerm Density(const std::vector<RouteSample>& samples, const std::string& robot) const;
 
-  // The same computation fed one sample at a time, for callers that already know a sample's
-  // zone (the auction reuses the zones of an order's route for every bidder). Holds pointers
-  // into the predictor: use it only while the predictor is not modified.
-  class DensityAccumulator;
 
   // Buckets with storage: one past the last bucket any plan has reached (never shrinks).
   std::size_t bucket_count() const { return bucket_count_; }
@@ -150,6 +174,7 @@ class TrafficPredictor {
     return true;
   }
   void Apply(const Contribution& c, int sign);
+  static PlanHandle HandleOf(const Contribution& c);
   static ZoneId ZoneOf(const Contribution* c, std::size_t bucket) {
     if (c == nullptr || bucket < c->first_bucket || bucket - c->first_bucket >= c->zones.size()) {
       return -1;
@@ -189,6 +214,10 @@ class TrafficPredictor::DensityAccumulator {
  public:
   // Counts exclude robot `robot`'s own plan (none when empty or unknown).
   DensityAccumulator(const TrafficPredictor& predictor, const std::string& robot);
+  // Counts exclude the plan behind `own` (none for a default handle).
+  DensityAccumulator(const TrafficPredictor& predictor, PlanHandle own);
+  // Starts over for another robot, keeping the buffers (no allocation once warm).
+  void Reset(PlanHandle own);
   // A sample in `zone` (skipped when < 0) at time t. Inline: every route sample comes here.
   void Add(ZoneId zone, double t) {
     if (zone < 0) return;
@@ -207,23 +236,32 @@ class TrafficPredictor::DensityAccumulator {
   // n samples in `zone` (none when < 0) at times times[k] + shift: the same as
   // Add(zone, times[k] + shift) for each k, in one tight loop.
   void AddRun(ZoneId zone, const double* times, std::size_t n, double shift);
+  // A sample in `zone` (skipped when < 0) at a time known only to lie within `slack` of t:
+  // counts the fewest other robots of the buckets [bucket(t - slack), bucket(t + slack)] (0 for
+  // unstored ones), so the peaks stay at or below those of the exact time. For lower bounds
+  // of F; O(buckets in the window).
+  void AddAtMost(ZoneId zone, double t, double slack);
   // Eqs. (6)-(8) over the samples added so far; peaks sorted by zone id.
   DensityTerm Finish() const;
+  // Finish().flow without building the term (summed in the same zone order, so a route's F
+  // is at least the Flow of any subset of its samples, rounding included). No allocation once
+  // warm.
+  double Flow();
 
  private:
   const TrafficPredictor* predictor_;
-  const Contribution* own_ = nullptr;
-  // own_ as bucket ranges: its zone at b in [own_first_, own_end_) is own_zones_[b -
+  // The own plan as bucket ranges: its zone at b in [own_first_, own_end_) is own_zones_[b -
   // own_first_], which is tail_zone_ from own_tail_ on (no memory access on the hot path).
   std::size_t own_first_ = 0, own_tail_ = 0, own_end_ = 0;
   const ZoneId* own_zones_ = nullptr;
   ZoneId tail_zone_ = -1;
   std::vector<std::pair<ZoneId, int>> peaks_;  // N_p,max so far, in order of first visit
   std::size_t last_ = 0;                       // index of the last zone added
+  std::vector<std::pair<ZoneId, int>> sorted_;  // Flow's scratch
 
   std::size_t cursor_ = 0;  // the bucket of the last sample located (or 0)
 
-  // ZoneOf(own_, b).
+  // The own plan's zone at bucket b (-1 if none).
   ZoneId OwnZone(std::size_t b) const {
     if (b >= own_end_) return -1;
     if (b >= own_tail_) return tail_zone_;
@@ -232,17 +270,18 @@ class TrafficPredictor::DensityAccumulator {
 
   // Points last_ at zone's entry, appending (zone, n) if the zone is new.
   void NewZone(ZoneId zone, int n);
-  // StoredBucketOf(t), walking from the last sample's bucket when t is at most two buckets
-  // past it (a route's samples come in time order, about one bucket apart). bucket(t) is
+  // StoredBucketOf(t), walking from the last sample's bucket when t is at most kWalk buckets
+  // past it (a route's samples come in time order, one to a few buckets apart). bucket(t) is
   // the largest b with s_b <= t and s_b is non-decreasing in b, so s_c <= t < s_(c+1) pins
   // bucket(t) = c whichever way c was found.
+  static constexpr int kWalk = 8;
   bool Locate(double t, std::size_t* bucket) {
     const TrafficPredictor& p = *predictor_;
     const std::size_t count = p.bucket_count_;
     const double* starts = p.bucket_starts_.data();  // count + 1 entries
     std::size_t b = cursor_;
     if (t >= starts[b]) {  // false for NaN
-      if (b < count && starts[b + 1] <= t) ++b;
+      for (int k = 0; k < kWalk && b < count && starts[b + 1] <= t; ++k) ++b;
       if (!(b < count && starts[b + 1] <= t)) {
         cursor_ = b;
         if (b >= count) return false;  // bucket(t) >= count: not stored

@@ -57,8 +57,8 @@ void PrintTable(const Run& run, const std::string& strategy) {
 
 void PrintBid(const char* role, const Bid& b) {
   if (!b.priced) {
-    std::printf("    %-9s %-4s B>=%7.2f  T_t=%7.2f T_d=%7.2f T_w=%6.2f F not evaluated (could not win)\n",
-                role, b.robot.c_str(), b.bid, b.t_t, b.t_d, b.t_w);
+    std::printf("    %-9s %-4s B>=%7.2f  T_t=%7.2f T_d=%7.2f T_w=%6.2f F>=%.4f (part of the route: could not win)\n",
+                role, b.robot.c_str(), b.bid, b.t_t, b.t_d, b.t_w, b.flow);
     return;
   }
   std::printf("    %-9s %-4s B=%8.2f  T_t=%7.2f T_d=%7.2f T_w=%6.2f F=%.4f x=%7.2f\n", role,

@@ -277,10 +277,14 @@ TEST_F(AuctionGridTest, PricingOnlyBidsThatCanWinGivesTheSameAward) {
           } else {
             ++unpriced;
             EXPECT_TRUE(f->bids[i].priced);
-            EXPECT_EQ(b.bid, full_config.alpha * b.t_t + full_config.beta * b.t_d);
-            EXPECT_LE(b.bid, f->bids[i].bid);  // a lower bound
+            // A lower bound with its own terms: F over part of the route.
+            EXPECT_EQ(b.x, full_config.zeta * b.flow);
+            EXPECT_EQ(b.bid, BidValue(full_config.alpha, full_config.beta, b.t_t, b.t_d, b.x));
+            EXPECT_LE(b.flow, f->bids[i].flow);
+            EXPECT_LE(b.bid, f->bids[i].bid);
             EXPECT_GT(b.bid, winning);
-            EXPECT_NE(DescribeBid(b).find("not evaluated"), std::string::npos);
+            EXPECT_TRUE(b.peaks.empty());
+            EXPECT_NE(DescribeBid(b).find("could not win"), std::string::npos);
           }
         }
       }

@@ -82,5 +82,46 @@ TEST(RouteSamplerTest, SamplesLieOnTheTimedPlan) {
   }
 }
 
+// TimeToTarget is AppendLeg's arrival without the samples, whichever order the legs to one
+// target are asked in (the memo fills from any start), and +infinity where AppendLeg's is.
+TEST(RouteSamplerTest, TimeToTargetIsTheLegsArrival) {
+  auto map = Grid(7, 6, 1.5, 3, {{1, 1}, {5, 4}, {6, 0}, {2, 5}}, {{0, 5}, {6, 5}});
+  auto routes = Routes(map, 1.2);
+  std::mt19937 rng(11);
+  RouteSampler timed(*map, *routes, 1.2, 0.5);
+  RouteSampler sampled(*map, *routes, 1.2, 0.5);
+  std::vector<RouteSample> out;
+  for (int trial = 0; trial < 400; ++trial) {
+    const PointId from = static_cast<PointId>(rng() % map->point_count());
+    const PointId to = static_cast<PointId>(rng() % 3 == 0 ? 5 : rng() % map->point_count());
+    out.clear();
+    const double want = sampled.AppendLeg(from, to, 0.0, out);
+    EXPECT_NEAR(timed.TimeToTarget(from, to), want, 1e-9 * (1.0 + want)) << from << " " << to;
+  }
+  // A rebound sampler forgets its memo (another table, the same answers as a fresh one).
+  auto slow = Routes(map, 0.6);
+  timed.Bind(*map, *slow, 0.6, 0.5);
+  RouteSampler fresh(*map, *slow, 0.6, 0.5);
+  out.clear();
+  EXPECT_NEAR(timed.TimeToTarget(0, 5), fresh.AppendLeg(0, 5, 0.0, out), 1e-9);
+
+  MapBuilder b("oneway");
+  b.AddRectZone("z", {-1, -1}, {5, 1});
+  b.AddPoint("a", {0, 0}, PointKind::kPick);
+  b.AddPoint("m", {2, 0}, PointKind::kLane);
+  b.AddPoint("b", {4, 0}, PointKind::kDrop);
+  b.AddPath("a", "m");
+  b.AddPath("m", "b");
+  MapBuildOptions o;
+  o.check_service_connectivity = false;
+  auto oneway = testing_util::Share(b.Build(o));
+  auto oneway_routes = Routes(oneway);
+  RouteSampler s(*oneway, *oneway_routes, 1.0, 0.5);
+  EXPECT_DOUBLE_EQ(s.TimeToTarget(Pt(*oneway, "a"), Pt(*oneway, "b")), 4.0);
+  EXPECT_DOUBLE_EQ(s.TimeToTarget(Pt(*oneway, "m"), Pt(*oneway, "b")), 2.0);  // memoised
+  EXPECT_EQ(s.TimeToTarget(Pt(*oneway, "b"), Pt(*oneway, "b")), 0.0);
+  EXPECT_TRUE(std::isinf(s.TimeToTarget(Pt(*oneway, "b"), Pt(*oneway, "a"))));
+}
+
 }  // namespace
 }  // namespace dispatch::engine

@@ -550,6 +550,75 @@ TEST(SamplePlanTest, ReusesTheCallersBuffer) {
 // Every sample is where the plan is at the sample's time; consecutive samples are `step`
 // apart along the path (so at most `step` in a straight line); the count is
 // floor(length / step) + 1 plus the last waypoint unless a sample already landed on it.
+// The accumulator's variants against Density: one reused through Reset, built from the handle
+// SetPlan returns, or from Find, gives Density's peaks and flow; Flow() is Finish().flow; a
+// sample added with AddAtMost at a time off by at most its slack never raises a peak above
+// the exact sample's (the auction's lower bound of F rests on this), and equals it when the
+// window holds one bucket.
+TEST_F(TrafficPredictionModelTest, AccumulatorVariantsAndLowerBounds) {
+  TrafficPredictionConfig config;
+  config.bucket_seconds = 0.7;
+  config.origin_time = 3.1;
+  TrafficPredictor pred(*map_, config);
+  std::mt19937 rng(4242);
+  std::uniform_real_distribution<double> u01(0.0, 1.0);
+  std::map<std::string, TrafficPredictor::PlanHandle> handles;
+  for (int r = 0; r < 12; ++r) {
+    const std::string robot = "R" + std::to_string(r);
+    handles[robot] = pred.SetPlan(robot, RandomPlan(rng));
+  }
+  handles["R3"] = pred.SetPlan("R3", RandomPlan(rng));  // a replaced plan's new handle
+  TrafficPredictor::DensityAccumulator reused(pred, TrafficPredictor::PlanHandle{});
+  TrafficPredictor::DensityAccumulator bound(pred, TrafficPredictor::PlanHandle{});
+  for (int trial = 0; trial < 300; ++trial) {
+    const std::string robot = "R" + std::to_string(rng() % 13);  // R12: no plan
+    std::vector<RouteSample> samples(1 + rng() % 40);
+    double t = -5.0 + 150.0 * u01(rng);
+    for (RouteSample& x : samples) {
+      x.xy = {-4.0 + 43.0 * u01(rng), -3.0 + 30.0 * u01(rng)};
+      x.t = t;
+      t += 2.0 * u01(rng);
+    }
+    const DensityTerm want = pred.Density(samples, robot);
+    const auto h = handles.count(robot) != 0 ? handles[robot] : TrafficPredictor::PlanHandle{};
+    reused.Reset(h);
+    TrafficPredictor::DensityAccumulator found(pred, pred.Find(robot));
+    bound.Reset(h);
+    const double slack = trial % 3 == 0 ? 1e-9 : 0.4 * u01(rng);
+    for (const RouteSample& x : samples) {
+      const ZoneId z = pred.ZoneAt(x.xy);
+      reused.Add(z, x.t);
+      found.Add(z, x.t);
+      bound.AddAtMost(z, x.t + slack * (2.0 * u01(rng) - 1.0), slack);
+    }
+    const DensityTerm got = reused.Finish();
+    EXPECT_EQ(got.peaks, want.peaks) << trial;
+    EXPECT_EQ(got.flow, want.flow) << trial;
+    EXPECT_EQ(found.Finish().peaks, want.peaks) << trial;
+    EXPECT_EQ(reused.Flow(), want.flow) << trial;
+    const DensityTerm low = bound.Finish();
+    EXPECT_LE(bound.Flow(), want.flow) << trial;
+    ASSERT_EQ(low.peaks.size(), want.peaks.size()) << trial;  // the same zones
+    for (std::size_t k = 0; k < low.peaks.size(); ++k) {
+      EXPECT_EQ(low.peaks[k].first, want.peaks[k].first);
+      EXPECT_LE(low.peaks[k].second, want.peaks[k].second) << trial;
+    }
+    if (HasFailure()) return;
+  }
+  // One bucket in every window (slack far below the bucket, times mid-bucket): exact.
+  for (int trial = 0; trial < 100; ++trial) {
+    const std::string robot = "R" + std::to_string(rng() % 12);
+    std::vector<RouteSample> samples(1 + rng() % 20);
+    for (RouteSample& x : samples) {
+      x.xy = {-4.0 + 43.0 * u01(rng), -3.0 + 30.0 * u01(rng)};
+      x.t = config.origin_time + (static_cast<double>(rng() % 300) + 0.5) * config.bucket_seconds;
+    }
+    bound.Reset(handles[robot]);
+    for (const RouteSample& x : samples) bound.AddAtMost(pred.ZoneAt(x.xy), x.t, 1e-6);
+    EXPECT_EQ(bound.Finish().peaks, pred.Density(samples, robot).peaks) << trial;
+  }
+}
+
 TEST_F(TrafficPredictionModelTest, SamplesLieOnThePlanAtTheirTimes) {
   std::mt19937 rng(99);
   for (int trial = 0; trial < 300; ++trial) {
