@@ -250,6 +250,9 @@ class Dispatcher {
 
   const std::shared_ptr<const engine::WarehouseMap> map_;
   const std::shared_ptr<const engine::RouteTable> routes_;
+  // The traffic predictor's zone lookup, built by the first allocation round and shared by
+  // the later ones (loop thread only).
+  std::shared_ptr<const engine::ZoneIndex> zone_index_;
   storage::Store& store_;
   const DispatcherOptions options_;
   WatchHub hub_;

@@ -190,12 +190,14 @@ void Dispatcher::AllocatePending() {
     f.ready_time = now;
     fleet_robots.push_back(f);
   }
-  auto fleet = engine::FleetState::Create(map_, routes_, fleet_robots, options_.allocation);
+  auto fleet = engine::FleetState::Create(map_, routes_, fleet_robots, options_.allocation,
+                                          zone_index_);
   if (!fleet.ok()) {
     spdlog::error("allocation: {}", fleet.error().message);
     return;
   }
   engine::FleetState state = std::move(fleet).value();
+  zone_index_ = state.zone_index();  // one floor, one index: the next round skips the grid
   for (std::size_t i = 0; i < ids.size(); ++i) ReplayQueue(state, i, robots_.at(ids[i]));
   for (const auto& view : pending) {
     const engine::Order& order = view->record.order;

@@ -11,15 +11,21 @@ namespace dispatch::engine {
 Result<FleetState> FleetState::Create(std::shared_ptr<const WarehouseMap> map,
                                       std::shared_ptr<const RouteTable> routes,
                                       const std::vector<FleetRobot>& robots,
-                                      const AllocationConfig& config) {
+                                      const AllocationConfig& config,
+                                      std::shared_ptr<const ZoneIndex> zones) {
   if (!map) return InvalidArgument("fleet state: null map");
   if (!routes) return InvalidArgument("fleet state: null route table");
   if (Status s = ValidateAllocationConfig(config); !s.ok()) return s.error();
+  if (zones && (zones->zones().size() != map->zones().size() ||
+                zones->requested_cell_size() != config.traffic.zone_cell_size)) {
+    return InvalidArgument("fleet state: the zone index was built for another map or cell size");
+  }
   FleetState state;
   state.map_ = std::move(map);
   state.routes_ = std::move(routes);
   state.config_ = config;
-  state.predictor_ = std::make_unique<TrafficPredictor>(*state.map_, config.traffic);
+  state.predictor_ = zones ? std::make_unique<TrafficPredictor>(std::move(zones), config.traffic)
+                           : std::make_unique<TrafficPredictor>(*state.map_, config.traffic);
   for (const FleetRobot& r : robots) {
     if (r.id.empty()) return InvalidArgument("fleet state: a robot has an empty id");
     if (state.index_.count(r.id) != 0) {

@@ -63,11 +63,15 @@ struct QueueSummary {
 class FleetState {
  public:
   // Errors (kInvalidArgument / kNotFound) name the robot or field: bad config, null map or
-  // routes, empty or duplicate robot ids, unknown start points, non-finite ready times.
+  // routes, empty or duplicate robot ids, unknown start points, non-finite ready times, a
+  // zone index with another zone count or cell size. `zones`: the predictor's ZoneIndex,
+  // built for this map (a previous state's zone_index(), so a state rebuilt every round
+  // does not re-grid the floor); null builds one.
   static Result<FleetState> Create(std::shared_ptr<const WarehouseMap> map,
                                    std::shared_ptr<const RouteTable> routes,
                                    const std::vector<FleetRobot>& robots,
-                                   const AllocationConfig& config = {});
+                                   const AllocationConfig& config = {},
+                                   std::shared_ptr<const ZoneIndex> zones = nullptr);
 
   FleetState(FleetState&&) = default;
   FleetState& operator=(FleetState&&) = default;
@@ -86,6 +90,7 @@ class FleetState {
   const RouteTable& routes() const { return *routes_; }
   const AllocationConfig& config() const { return config_; }
   const TrafficPredictor& predictor() const { return *predictor_; }
+  const std::shared_ptr<const ZoneIndex>& zone_index() const { return predictor_->zone_index(); }
   // Robot `robot`'s plan in the predictor (predictor().Find(robot_id(robot)) without the lookup).
   TrafficPredictor::PlanHandle prediction(std::size_t robot) const {
     return robots_.at(robot).prediction;

@@ -12,19 +12,12 @@
 // kept per (bucket, zone) and per robot, so "other robots in zone p at time t" is O(1):
 // count(bucket(t), p) - [robot's own zone at bucket(t) == p].
 //
-// Zones: ZoneAt(xy) = the lowest zone id whose Zone::Contains(xy) holds (-1 if none), answered
-// through a uniform grid over the floor (see TrafficPredictionConfig::zone_cell_size). A cell
-// that lies (with a 1 mm margin) inside the lowest zone touching it answers directly; other
-// cells keep the ids of the few zones touching them and test Contains on those in id order.
-//
-// Arcs: for every arc of the map the predictor also keeps ArcZone(arc), the one zone ZoneAt
-// answers for every point of the arc's segment (within a margin far above the rounding of a
-// point computed on it), or kMixedZone when that is not known to hold; route samples strictly
-// on such an arc skip the grid lookup.
+// Zones: ZoneAt and ArcZone come from a ZoneIndex (zone_index.h), built by the first
+// constructor or shared through the second.
 //
 // Invariant: after SetPlan/RemovePlan the counts equal a recount from scratch over the current
-// plans (a model test checks this). The predictor copies the zones it needs; it keeps no
-// reference to the map. Not thread-safe: one writer (the allocator) at a time; const methods
+// plans (a model test checks this). The predictor keeps no reference to the map. Not
+// thread-safe: one writer (the allocator) at a time; const methods
 // may run concurrently with each other.
 #pragma once
 
@@ -33,11 +26,13 @@
 #include <algorithm>
 #include <cstddef>
 #include <cstdint>
+#include <memory>
 #include <string>
 #include <unordered_map>
 #include <utility>
 #include <vector>
 
+#include "engine/allocation/zone_index.h"
 #include "engine/fleet/plan.h"
 #include "engine/map/warehouse_map.h"
 
@@ -50,7 +45,7 @@ struct TrafficPredictionConfig {
   // kMaxZoneCells cells (4 bytes each): 0.25 m keeps a 500 x 140 m LoRR floor at 1.1 M cells
   // (4.5 MB); the Chu2024 floor (39.5 x 27.5 m) needs 17 k.
   double zone_cell_size = 0.25;
-  static constexpr std::size_t kMaxZoneCells = std::size_t{1} << 21;
+  static constexpr std::size_t kMaxZoneCells = ZoneIndex::kMaxZoneCells;
 };
 
 // A point of a candidate route: where robot i would be (xy) and when (t).
@@ -92,9 +87,12 @@ class TrafficPredictor {
     ZoneId tail_zone_ = -1;
   };
 
-  // Builds the zone grid: O(cells of each zone's bounding box x its edges) once.
-  // Throws std::invalid_argument on a non-positive or non-finite setting (broken contract).
+  // Builds its ZoneIndex (see there for the cost). Throws std::invalid_argument on a
+  // non-positive or non-finite setting (broken contract).
   TrafficPredictor(const WarehouseMap& map, TrafficPredictionConfig config);
+  // Shares `index` (built for config.zone_cell_size: std::invalid_argument otherwise, or for
+  // a null index): O(1), for predictors rebuilt every round on one map.
+  TrafficPredictor(std::shared_ptr<const ZoneIndex> index, TrafficPredictionConfig config);
 
   // Replaces robot `robot`'s contribution with `plan` (adds it if new); an empty plan removes
   // it. O(buckets of the old and new plan x log waypoints). Storage grows to the plan's last
@@ -107,19 +105,12 @@ class TrafficPredictor {
   // lookup.
   PlanHandle Find(const std::string& robot) const;
 
-  // The zone holding xy (lowest id on shared borders): O(1); -1 outside every zone.
-  ZoneId ZoneAt(const Eigen::Vector2d& xy) const;
-  // ArcZone's answer when ZoneAt may differ along the arc.
-  static constexpr ZoneId kMixedZone = -2;
-  // For an arc of the map given to the constructor: z (>= -1) if ZoneAt(p) == z for every
-  // point p within 1e-6 m (more for far-off coordinates) of the box spanned by the arc's end
-  // points, so also for every point a + f (b - a), 0 <= f <= 1, computed in floating point;
-  // kMixedZone otherwise, and for an unknown arc id. O(1).
-  ZoneId ArcZone(ArcId arc) const {
-    return arc >= 0 && static_cast<std::size_t>(arc) < arc_zones_.size()
-               ? arc_zones_[static_cast<std::size_t>(arc)]
-               : kMixedZone;
-  }
+  // The zone holding xy: ZoneIndex::ZoneAt.
+  ZoneId ZoneAt(const Eigen::Vector2d& xy) const { return index_->ZoneAt(xy); }
+  static constexpr ZoneId kMixedZone = ZoneIndex::kMixedZone;
+  // ZoneIndex::ArcZone.
+  ZoneId ArcZone(ArcId arc) const { return index_->ArcZone(arc); }
+  const std::shared_ptr<const ZoneIndex>& zone_index() const { return index_; }
   // Robots predicted in `zone` at time t (see the bucket rule above), not counting
   // `exclude_robot` (may be empty). 0 for an unknown zone, a NaN time or a time past the
   // last stored bucket. O(1) (one hash lookup when `exclude_robot` is given).
@@ -137,7 +128,7 @@ class TrafficPredictor {
   std::size_t robot_count() const { return robots_.size(); }
   const TrafficPredictionConfig& config() const { return config_; }
   // The grid actually used (after the kMaxZoneCells cap).
-  double zone_cell_size() const { return cell_size_; }
+  double zone_cell_size() const { return index_->cell_size(); }
 
  private:
   // What one robot's plan added: zones_[k] is its zone (or -1) at bucket first_bucket + k.
@@ -147,10 +138,6 @@ class TrafficPredictor {
     std::size_t tail = 0;  // zones[k] == zones.back() for every k >= tail (a plan's final wait)
   };
 
-  void BuildZoneGrid(const Eigen::Vector2d& floor_min, const Eigen::Vector2d& floor_max);
-  void BuildArcZones(const WarehouseMap& map);
-  // The direct answer shared by every grid cell meeting the box [lo, hi], or kMixedZone.
-  ZoneId UniformZoneIn(const Eigen::Vector2d& lo, const Eigen::Vector2d& hi) const;
   double BucketStart(std::size_t b) const {
     return config_.origin_time + static_cast<double>(b) * config_.bucket_seconds;
   }
@@ -184,21 +171,7 @@ class TrafficPredictor {
 
   TrafficPredictionConfig config_;
   double inv_bucket_seconds_ = 2.0;  // 1 / bucket_seconds
-  double inv_cell_size_ = 4.0;       // 1 / cell_size_
-  std::vector<Zone> zones_;  // copies of the map's zones: polygons (Contains) and areas S_p
-
-  // Zone grid: cell (cx, cy) covers origin + [cx, cx+1] x [cy, cy+1] * cell_size_. cells_ holds
-  // a zone id (answers directly), -1 (no zone) or -2 - k: test Contains on
-  // candidates_[candidate_begin_[k] .. candidate_begin_[k+1]) in that (id) order.
-  Eigen::Vector2d grid_origin_ = Eigen::Vector2d::Zero();
-  double cell_size_ = 0.25;
-  std::int64_t grid_cols_ = 0;
-  std::int64_t grid_rows_ = 0;
-  std::vector<std::int32_t> cells_;
-  std::vector<std::uint32_t> candidate_begin_;
-  std::vector<ZoneId> candidates_;
-
-  std::vector<ZoneId> arc_zones_;  // ArcZone per arc id
+  std::shared_ptr<const ZoneIndex> index_;
 
   // counts_[p * bucket_stride_ + b]: robots in zone p at s_b, over all robots' plans (zone
   // major, so the consecutive buckets a route spends in one zone are adjacent); buckets in

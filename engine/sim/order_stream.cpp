@@ -58,6 +58,7 @@ class StreamSim {
 
   std::shared_ptr<const WarehouseMap> map_;
   std::shared_ptr<const RouteTable> routes_;
+  std::shared_ptr<const ZoneIndex> zone_index_;  // kept between allocation rounds
   const StreamConfig& config_;
   TrafficController ctl_;
   std::vector<Bot> bots_;
@@ -163,7 +164,7 @@ void StreamSim::Release(double t) {
     }
     return;
   }
-  auto created = FleetState::Create(map_, routes_, fleet, config_.allocation);
+  auto created = FleetState::Create(map_, routes_, fleet, config_.allocation, zone_index_);
   if (!created.ok()) {
     for (std::size_t k = next_release_ - batch.size(); k < next_release_; ++k) {
       fail(orders_[k], "allocation: " + created.error().message);
@@ -171,6 +172,7 @@ void StreamSim::Release(double t) {
     return;
   }
   FleetState state = std::move(created).value();
+  zone_index_ = state.zone_index();
   // Re-queue every robot's unfinished tasks (remaining picks + drop).
   for (std::size_t i = 0; i < bot_of.size(); ++i) {
     const Bot& b = bots_[bot_of[i]];

@@ -127,6 +127,36 @@ TEST_F(FleetStateTest, PredictionFollowsEveryAward) {
   EXPECT_EQ(p.CountAt(z00, 0.0), 1);
 }
 
+// A state built on a previous state's zone index shares it and predicts the same counts;
+// an index of another map or cell size is refused.
+TEST_F(FleetStateTest, SharedZoneIndexGivesTheSamePrediction) {
+  const std::vector<FleetRobot> robots = {{"A", Pt(*map_, "0,0"), 0.0}, {"B", Pt(*map_, "5,3"), 0.0}};
+  FleetState first = MakeFleet(map_, routes_, robots);
+  Result<FleetState> created =
+      FleetState::Create(map_, routes_, robots, AllocationConfig{}, first.zone_index());
+  ASSERT_TRUE(created.ok()) << created.error().message;
+  FleetState again = std::move(created).value();
+  EXPECT_EQ(again.zone_index(), first.zone_index());
+  ASSERT_TRUE(first.AssignSingle(0, "o1", Task("4,3", "5,3", 1.0)).ok());
+  ASSERT_TRUE(again.AssignSingle(0, "o1", Task("4,3", "5,3", 1.0)).ok());
+  for (ZoneId z = 0; z < static_cast<ZoneId>(map_->zones().size()); ++z) {
+    for (double t = 0.0; t < 30.0; t += 0.5) {
+      EXPECT_EQ(again.predictor().CountAt(z, t), first.predictor().CountAt(z, t)) << z << " " << t;
+    }
+  }
+  AllocationConfig coarse;
+  coarse.traffic.zone_cell_size = 1.0;
+  Result<FleetState> other_cell =
+      FleetState::Create(map_, routes_, robots, coarse, first.zone_index());
+  ASSERT_FALSE(other_cell.ok());
+  EXPECT_NE(other_cell.error().message.find("zone index"), std::string::npos);
+  auto other_map = Grid(3, 3, 1.0, 1, {{1, 1}}, {{0, 2}});
+  auto other_routes = Routes(other_map);
+  EXPECT_FALSE(FleetState::Create(other_map, other_routes, {{"A", 0, 0.0}}, AllocationConfig{},
+                                  first.zone_index())
+                   .ok());
+}
+
 TEST_F(FleetStateTest, FormationMembersStartAfterTheirOwnQueues) {
   FleetState s = MakeFleet(map_, routes_,
                            {{"A", Pt(*map_, "0,0"), 0.0}, {"B", Pt(*map_, "5,3"), 0.0},
