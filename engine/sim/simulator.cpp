@@ -605,10 +605,17 @@ Result<SimResult> Simulate(const WarehouseMap& map, const std::vector<SimRobot>&
   }
   Status valid = config.traffic.Validate();
   if (!valid.ok()) return valid.error();
-  Sim sim(map, robots, config);
+  SimConfig run = config;
+  run.record_frames = config.record_frames || config.check_safety;
+  Sim sim(map, robots, run);
   Status prepared = sim.Prepare();
   if (!prepared.ok()) return prepared.error();
-  return sim.Run();
+  SimResult out = sim.Run();
+  if (config.check_safety) {
+    out.safety = CheckSafety(out.frames, map, config.traffic);
+    if (!config.record_frames) std::vector<SafetyFrame>().swap(out.frames);
+  }
+  return out;
 }
 
 Result<SimResult> Simulate(const FleetState& state, const SimConfig& config) {

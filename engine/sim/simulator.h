@@ -42,6 +42,7 @@
 
 #include <cstddef>
 #include <limits>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -60,6 +61,12 @@ struct SimRobot {
   std::vector<QueuedTask> queue;  // one per drop waypoint of the plan, in order
 };
 
+#ifdef NDEBUG
+inline constexpr bool kCheckSafetyByDefault = false;
+#else
+inline constexpr bool kCheckSafetyByDefault = true;
+#endif
+
 struct SimConfig {
   double time_step = 0.1;    // s (> 0)
   double max_wait = 120.0;   // s of continuous traffic waiting before "blocked"
@@ -67,6 +74,11 @@ struct SimConfig {
   TrafficConfig traffic;
   bool finished_robots_leave_floor = true;  // else they stay as obstacles where they ended
   bool record_frames = true;                // SimResult::frames for CheckSafety
+  // The run checks itself: CheckSafety over its frames (recorded for it whatever
+  // record_frames says) under `traffic`'s clearances, into SimResult::safety. On by default
+  // in debug builds, the simulator's self-check of the traffic rules; release builds leave it
+  // to the caller (it costs a pass over every frame).
+  bool check_safety = kCheckSafetyByDefault;
 };
 
 struct OrderOutcome {
@@ -93,6 +105,7 @@ struct SimResult {
   double overall_min_distance = std::numeric_limits<double>::infinity();
   std::vector<std::string> blocked;  // "R3 waited 120 s at t=..: ..." (deadlocks)
   std::vector<SafetyFrame> frames;   // when SimConfig::record_frames
+  std::optional<SafetyReport> safety;  // when SimConfig::check_safety
   bool all_completed() const;
 };
 

@@ -101,16 +101,25 @@ TEST_F(CrossTest, TwoRobotsCrossingWithRulesOnAreSafeAndOneWaits) {
   EXPECT_LT((s.plan(0).PositionAt(5.0) - s.plan(1).PositionAt(5.0)).norm(), 1e-9);
   SimConfig off;
   off.traffic.rules_enabled = false;
+  off.check_safety = true;  // the run's own check (default in debug builds only)
+  off.record_frames = false;
   auto without = Simulate(s, off);
   ASSERT_TRUE(without.ok());
   EXPECT_LT(without->overall_min_distance, traffic.epsilon_single_single);
-  EXPECT_FALSE(CheckSafety(without->frames, *map_, traffic).ok());
+  ASSERT_TRUE(without->safety.has_value());
+  EXPECT_FALSE(without->safety->ok());
+  EXPECT_TRUE(without->frames.empty());  // checked, then not kept
 
-  auto with = Simulate(s);
+  SimConfig on;
+  on.check_safety = true;
+  auto with = Simulate(s, on);
   ASSERT_TRUE(with.ok()) << with.error().message;
   ASSERT_TRUE(with->all_completed());
   const SafetyReport safety = CheckSafety(with->frames, *map_, traffic);
   EXPECT_TRUE(safety.ok()) << safety.violations.front().Describe();
+  ASSERT_TRUE(with->safety.has_value());
+  EXPECT_EQ(with->safety->violations.size(), safety.violations.size());
+  EXPECT_EQ(with->safety->min_robot_distance, safety.min_robot_distance);
   EXPECT_GE(with->overall_min_distance, traffic.epsilon_single_single - 1e-9);
   EXPECT_GT(with->total_waiting_time, 0.0);
   EXPECT_GE(with->stops, 1);
