@@ -5,8 +5,8 @@
 #include <cmath>
 #include <cstdio>
 #include <functional>
-#include <utility>
 #include <limits>
+#include <utility>
 
 #include "engine/allocation/route_sampler.h"
 
@@ -132,7 +132,8 @@ void AuctionAllocator::PriceLowest(const AllocationConfig& c, std::vector<Bid>& 
 double AuctionAllocator::FlowBound(const FleetState& state, std::size_t robot, PointId first,
                                    RouteSampler& sampler,
                                    TrafficPredictor::DensityAccumulator& density,
-                                   const ZoneRun* runs, std::size_t run_count) {
+                                   const ZoneRun* runs, std::size_t run_count,
+                                   const double* times) {
   const QueueSummary& s = state.summary(robot);
   const TrafficPredictor& predictor = state.predictor();
   const double to_go = sampler.TimeToTarget(s.end_point, first);
@@ -148,11 +149,11 @@ double AuctionAllocator::FlowBound(const FleetState& state, std::size_t robot, P
   // below the slack), so each sample's bucket is in the window.
   constexpr std::size_t kBoundStride = 16;
   const double arrival = s.end_time + to_go;
-  const double slack = 1e-6 * std::max(1.0, std::abs(arrival) + shared_span_);
   for (std::size_t r = 0; r < run_count; ++r) {
     const ZoneRun& run = runs[r];
     for (std::size_t k = 0; k < run.size; k += kBoundStride) {
-      density.AddAtMost(run.zone, shared_times_[run.begin + k] + arrival, slack);
+      const double t = times[run.begin + k] + arrival;
+      density.AddAtMost(run.zone, t, 1e-6 * std::max(1.0, std::abs(t)));
     }
   }
   return density.Flow();
@@ -249,11 +250,11 @@ std::vector<Bid> AuctionAllocator::ComputeBids(const FleetState& state, const Pl
     SetTimes(c, s.travel_time + leg + task_travel, s.work_time + task_work, b);
     bids.push_back(std::move(b));
   }
-  shared_span_ = shared_times_.empty() ? 0.0 : std::abs(shared_times_.back());
   TrafficPredictor::DensityAccumulator density(predictor, TrafficPredictor::PlanHandle{});
   // The lower bound of F: the leg's first sample and some of the order's own route.
   auto bound = [&](std::size_t i) {
-    return FlowBound(state, i, first, sampler, density, shared_runs_.data(), shared_runs_.size());
+    return FlowBound(state, i, first, sampler, density, shared_runs_.data(), shared_runs_.size(),
+                     shared_times_.data());
   };
   PriceLowest(c, bids, keep, bound, [&](std::size_t i) {
     const QueueSummary& s = state.summary(i);
@@ -299,11 +300,10 @@ std::vector<Bid> AuctionAllocator::ComputeReachBids(const FleetState& state, Poi
   }
   TrafficPredictor::DensityAccumulator density(predictor, TrafficPredictor::PlanHandle{});
   // The lower bound of F': the leg's first sample and the first pick on arrival.
-  shared_times_.assign(1, 0.0);
-  shared_span_ = 0.0;
   const ZoneRun pick_run{pick_zone, 0, 1};
+  const double on_arrival = 0.0;
   auto bound = [&](std::size_t i) {
-    return FlowBound(state, i, first_pick, sampler, density, &pick_run, 1);
+    return FlowBound(state, i, first_pick, sampler, density, &pick_run, 1, &on_arrival);
   };
   PriceLowest(c, bids, keep, bound, [&](std::size_t i) {
     const QueueSummary& s = state.summary(i);

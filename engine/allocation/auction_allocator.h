@@ -85,11 +85,12 @@ class AuctionAllocator final : public Allocator {
     std::size_t begin = 0;
     std::size_t size = 0;
   };
-  // A lower bound of robot `robot`'s F over the samples of its leg to `first` and the runs
-  // of the order's route shifted to its arrival (see FlowBound in the .cpp).
+  // A lower bound of robot `robot`'s F over samples of its leg to `first` and of the runs
+  // (their times in `times`, from t = 0 at the first pick) shifted to its arrival (see
+  // FlowBound in the .cpp).
   double FlowBound(const FleetState& state, std::size_t robot, PointId first,
                    RouteSampler& sampler, TrafficPredictor::DensityAccumulator& density,
-                   const ZoneRun* runs, std::size_t run_count);
+                   const ZoneRun* runs, std::size_t run_count, const double* times);
 
   std::vector<std::pair<double, std::size_t>> order_;  // PriceLowest's heap of (bound, robot)
   std::vector<double> flow_bounds_;  // PriceLowest's bound(i) per robot
@@ -105,7 +106,6 @@ class AuctionAllocator final : public Allocator {
   // shared_ as runs of consecutive samples in one zone (ZoneAt), over shared_times_.
   std::vector<ZoneRun> shared_runs_;
   std::vector<double> shared_times_;  // shared_[k].t
-  double shared_span_ = 0.0;          // |last shared time|, for FlowBound's slack
 };
 
 }  // namespace dispatch::engine

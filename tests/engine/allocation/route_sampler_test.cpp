@@ -31,15 +31,22 @@ TEST(RouteSamplerTest, LegSamplesEveryStepExcludingTheArrival) {
   EXPECT_TRUE(out.empty());
 }
 
-TEST(RouteSamplerTest, UnreachableLegIsInfinite) {
+// One way only: a -> m -> b along the x axis (4 m).
+std::shared_ptr<const WarehouseMap> OneWay() {
   MapBuilder b("oneway");
   b.AddRectZone("z", {-1, -1}, {5, 1});
   b.AddPoint("a", {0, 0}, PointKind::kPick);
+  b.AddPoint("m", {2, 0}, PointKind::kLane);
   b.AddPoint("b", {4, 0}, PointKind::kDrop);
-  b.AddPath("a", "b");
+  b.AddPath("a", "m");
+  b.AddPath("m", "b");
   MapBuildOptions o;
   o.check_service_connectivity = false;
-  auto map = testing_util::Share(b.Build(o));
+  return testing_util::Share(b.Build(o));
+}
+
+TEST(RouteSamplerTest, UnreachableLegIsInfinite) {
+  auto map = OneWay();
   auto routes = Routes(map);
   RouteSampler sampler(*map, *routes, 1.0, 0.5);
   std::vector<RouteSample> out;
@@ -105,16 +112,7 @@ TEST(RouteSamplerTest, TimeToTargetIsTheLegsArrival) {
   out.clear();
   EXPECT_NEAR(timed.TimeToTarget(0, 5), fresh.AppendLeg(0, 5, 0.0, out), 1e-9);
 
-  MapBuilder b("oneway");
-  b.AddRectZone("z", {-1, -1}, {5, 1});
-  b.AddPoint("a", {0, 0}, PointKind::kPick);
-  b.AddPoint("m", {2, 0}, PointKind::kLane);
-  b.AddPoint("b", {4, 0}, PointKind::kDrop);
-  b.AddPath("a", "m");
-  b.AddPath("m", "b");
-  MapBuildOptions o;
-  o.check_service_connectivity = false;
-  auto oneway = testing_util::Share(b.Build(o));
+  auto oneway = OneWay();
   auto oneway_routes = Routes(oneway);
   RouteSampler s(*oneway, *oneway_routes, 1.0, 0.5);
   EXPECT_DOUBLE_EQ(s.TimeToTarget(Pt(*oneway, "a"), Pt(*oneway, "b")), 4.0);
