@@ -71,9 +71,16 @@ Dispatcher::Dispatcher(std::shared_ptr<const engine::WarehouseMap> map,
       store_(store),
       options_(std::move(options)),
       allocator_(std::move(allocator)),
-      wall_start_(Clock::now()) {}
+      wall_start_(Clock::now()),
+      route_worker_(std::make_unique<WorkerThread>()),
+      allocation_worker_(std::make_unique<WorkerThread>()) {}
 
-Dispatcher::~Dispatcher() { Stop(); }
+Dispatcher::~Dispatcher() {
+  // The workers post to the loop: they stop before anything is torn down.
+  route_worker_->Stop();
+  allocation_worker_->Stop();
+  Stop();
+}
 
 engine::Status Dispatcher::Recover() {
   // Orders, in submission order.
@@ -161,6 +168,9 @@ void Dispatcher::CloseStreams() {
 
 void Dispatcher::Stop() {
   if (!started_.load()) return;
+  // Orders and rounds the workers still hold reach the loop's queue, which runs them.
+  route_worker_->Stop();
+  allocation_worker_->Stop();
   {
     std::lock_guard<std::mutex> lock(queue_mu_);
     if (stopping_) return;
@@ -357,11 +367,28 @@ std::string Dispatcher::NextOrderId() {
 // --- Orders --------------------------------------------------------------------------------
 
 void Dispatcher::SubmitOrder(engine::OrderRequest request, std::function<void(SubmitReply)> done) {
-  Post([this, request = std::move(request), done = std::move(done)] {
-    DoSubmit(request, [this, done](SubmitReply reply) {
-      Defer([done, reply = std::move(reply)]() mutable { done(std::move(reply)); });
+  // The route searches towards the order's stops run first, on the route worker: the loop's
+  // reachability check and the auction then find them cached.
+  auto shared = std::make_shared<const engine::OrderRequest>(std::move(request));
+  route_worker_->Run([this, shared, done = std::move(done)](bool cancelled) {
+    if (!cancelled) {
+      for (const engine::PointId p : StopsOf(*shared)) routes_->Prepare(p);
+    }
+    Post([this, shared, done] {
+      DoSubmit(*shared, [this, done](SubmitReply reply) {
+        Defer([done, reply = std::move(reply)]() mutable { done(std::move(reply)); });
+      });
     });
   });
+}
+
+std::vector<engine::PointId> Dispatcher::StopsOf(const engine::OrderRequest& request) const {
+  if (request.picks.size() > kMaxPicksPerOrder) return {};
+  auto resolved = engine::ResolveOrder(*map_, request, options_.snap);
+  if (!resolved.ok()) return {};
+  std::vector<engine::PointId> stops = resolved->picks;
+  stops.push_back(resolved->drop);
+  return stops;
 }
 
 void Dispatcher::CancelOrder(std::string order_id, std::string reason,

@@ -15,13 +15,19 @@
 // plans) are one store transaction. At start the dispatcher recovers orders, explanations,
 // robots and assignments from the store.
 //
-// Allocation: the strategy (auction or greedy) runs over the connected robots once per batch
-// in which an order arrived, a robot connected or finished an order, or an order came back
-// for re-allocation (after the batch's replies are out, so a burst of orders is auctioned
-// together and SubmitOrder answers once the order is committed). Each round builds a fresh engine::FleetState with every connected robot at
-// its reported point now, replays its remaining orders into its queue (ReplayQueue), then
-// auctions the accepted orders; a new order's waypoints are appended to the robot's plan.
-// Orders stay `accepted` while no robot (or fewer than 3 for a formation) is connected.
+// Allocation (dispatcher_allocation.cpp): a round of the strategy (auction or greedy) over
+// the connected robots starts after every batch in which an order arrived, a robot connected
+// or finished an order, or an order came back for re-allocation - and the previous round has
+// been committed (one round at a time). The loop copies the round's inputs (the accepted
+// orders, every available robot's point, plan and queue); a worker thread builds a fresh
+// engine::FleetState from them with every robot at its point now, replays its remaining
+// orders into its queue (ReplayQueue), then auctions the orders in (priority, created) order;
+// back on the loop, the awards whose robots and orders have not changed meanwhile are
+// committed in one store transaction (a new order's waypoints appended to the robots' plans),
+// the others stay `accepted` for the next round. So traffic control (grants, holds) never
+// waits for an auction or its route searches. New orders' route searches run on another
+// worker before the loop sees the order (SubmitOrder). Orders stay `accepted` while no robot
+// (or fewer than 3 for a formation) is connected.
 //
 // Robots: Hello registers (snapping the pose to the nearest map point within
 // Options::robot_snap_tolerance); waypoints are numbered over the robot's whole life
@@ -63,6 +69,7 @@
 #include "server/snapshot.h"
 #include "server/traffic_gate.h"
 #include "server/watch_hub.h"
+#include "server/worker_thread.h"
 #include "storage/store.h"
 
 namespace dispatch::server {
@@ -183,6 +190,9 @@ class Dispatcher {
   void DoCancel(const std::string& order_id, const std::string& reason,
                 const std::function<void(OrderReply)>& done);
   ServiceStatus CheckReachable(const engine::Order& order) const;
+  // The stops (picks, drop) the request resolves to; empty when it does not resolve (DoSubmit
+  // then says why). Any thread.
+  std::vector<engine::PointId> StopsOf(const engine::OrderRequest& request) const;
   std::shared_ptr<const OrderView> Find(const std::string& order_id) const;
   void Put(std::shared_ptr<OrderView> view);  // replaces (or adds) an order in the book
   // Publishes a committed journal event to the watchers (deferred, see Defer).
@@ -195,14 +205,54 @@ class Dispatcher {
   void CloseLink(const std::shared_ptr<RobotLink>& link, ServiceStatus status);
   std::string NextOrderId();
 
-  // Allocation and plans (dispatcher_plans.cpp).
+  // Allocation rounds (dispatcher_allocation.cpp). A round's view of one robot, copied on the
+  // loop thread: the worker reads nothing else of the dispatcher's state.
+  struct RoundRobot {
+    std::string id;
+    engine::PointId start = engine::kNoPoint;
+    storage::AssignmentRecord assignment;  // empty order_ids: no queue
+    std::uint64_t last_reached = 0;
+    std::vector<std::shared_ptr<const OrderView>> queue;  // the views of assignment.order_ids
+  };
+  // What must not have changed for an award computed on the copy to be committed.
+  struct RoundKey {
+    std::uint64_t plan_id = 0;
+    std::string last_order;  // the queue's last order ("": none)
+    engine::PointId start = engine::kNoPoint;
+    bool operator==(const RoundKey& o) const {
+      return plan_id == o.plan_id && last_order == o.last_order && start == o.start;
+    }
+  };
+  struct RoundInput {
+    double now = 0.0;
+    std::vector<RoundRobot> robots;  // natural id order
+    std::vector<std::shared_ptr<const OrderView>> pending;  // (priority, created) order
+  };
+  struct RoundAward {
+    std::string order_id;
+    engine::AwardExplanation award;
+    // Per winner (award.winners order): the fleet plan's new waypoints (from its start for a
+    // robot with no queue), and the departure the first of them follows (queued robots).
+    std::vector<std::vector<engine::Waypoint>> segments;
+    std::vector<double> after_departure;
+    double seconds = 0.0;  // the strategy's time for this order
+  };
+  // Loop: starts a round on the allocation worker (or marks one due after the running one).
   void AllocatePending();
+  // The robots a round may use and where a new plan of each would start (loop).
+  RoundKey KeyOf(const RobotRuntime& robot) const;
+  bool Eligible(const RobotRuntime& robot) const;
+  // Worker: the round's awards.
+  std::vector<RoundAward> RunRound(const RoundInput& input);
   // Appends the robot's remaining orders (each as its member's own task; the first one from
   // the picks it has not reached yet) to its queue in `fleet`, so that bids count the whole
-  // queue (Chu2024 eq. 3) and traffic prediction sees the robot's work.
-  void ReplayQueue(engine::FleetState& fleet, std::size_t index, const RobotRuntime& robot) const;
-  // Runs the strategy for one order and commits the award; false if the store failed.
-  bool AwardOrder(const engine::Order& order, engine::FleetState& fleet);
+  // queue (Chu2024 eq. 3) and traffic prediction sees the robot's work (worker).
+  void ReplayQueue(engine::FleetState& fleet, std::size_t index, const RoundRobot& robot) const;
+  // Loop: commits, in one store transaction, the awards whose orders are still accepted and
+  // whose robots are still eligible with the keys the round saw (`keys`); marks another round
+  // due when some were not. False if the store failed (nothing changed).
+  bool CommitRound(const RoundInput& input, const std::map<std::string, RoundKey>& keys,
+                   std::vector<RoundAward> awards);
   // Removes `order_id` and every later order from the plan; returns the later ones.
   static std::vector<std::string> CutPlan(storage::AssignmentRecord& plan, const std::string& order_id);
   // Drops the finished first order (up to its drop waypoint) from the plan; false if
@@ -251,7 +301,7 @@ class Dispatcher {
   const std::shared_ptr<const engine::WarehouseMap> map_;
   const std::shared_ptr<const engine::RouteTable> routes_;
   // The traffic predictor's zone lookup, built by the first allocation round and shared by
-  // the later ones (loop thread only).
+  // the later ones (allocation worker only).
   std::shared_ptr<const engine::ZoneIndex> zone_index_;
   storage::Store& store_;
   const DispatcherOptions options_;
@@ -267,8 +317,9 @@ class Dispatcher {
 
   std::shared_ptr<const Snapshot> snapshot_;  // atomic_load / atomic_store only
 
-  // Loop-thread state (no lock: only the loop touches it after Start).
+  // Allocation worker state (only rounds on allocation_worker_ touch it).
   std::unique_ptr<engine::Allocator> allocator_;
+  // Loop-thread state (no lock: only the loop touches it after Start).
   std::unique_ptr<TrafficGate> gate_;  // null when traffic control is off
   Clock::time_point wall_start_;
   double time_base_ = 0.0;  // dispatcher seconds at wall_start_
@@ -287,12 +338,18 @@ class Dispatcher {
   Clock::time_point last_publish_{};
   bool retry_allocation_ = false;
   bool allocation_due_ = false;  // an allocation round runs at the end of this batch
+  bool round_running_ = false;   // a round is on the worker or waits to be committed
+  bool round_again_ = false;     // a round became due meanwhile
   MinDistance min_distance_;
   std::unordered_map<std::string, double> order_distance_;  // metres driven, open orders
   Clock::time_point next_distance_sample_{};
   struct {
     std::uint64_t grants = 0, holds = 0, replans = 0;
   } traffic_counts_;
+  // Route searches of new orders (SubmitOrder) and allocation rounds: off the loop thread.
+  // Stopped first (Stop, destructor): what they still hold reaches the loop's queue.
+  std::unique_ptr<WorkerThread> route_worker_;
+  std::unique_ptr<WorkerThread> allocation_worker_;
 };
 
 }  // namespace dispatch::server

@@ -1,11 +1,19 @@
 #include "engine/routing/lazy_route_table.h"
 
+#include <atomic>
 #include <limits>
 #include <string>
 
 #include "engine/routing/dijkstra.h"
 
 namespace dispatch::engine {
+namespace {
+
+std::atomic<std::uint64_t> next_table_id{1};
+
+}  // namespace
+
+LazyRouteTable::LazyRouteTable() : id_(next_table_id.fetch_add(1)) {}
 
 Result<std::unique_ptr<LazyRouteTable>> LazyRouteTable::Build(
     std::shared_ptr<const WarehouseMap> map, const RouteTableOptions& options) {
@@ -20,6 +28,25 @@ Result<std::unique_ptr<LazyRouteTable>> LazyRouteTable::Build(
 }
 
 std::shared_ptr<const LazyRouteTable::Entry> LazyRouteTable::Lookup(PointId to) const {
+  // This thread's last lookup (of any table: the key is the table's id, never reused).
+  thread_local struct {
+    std::uint64_t table = 0;
+    PointId to = kNoPoint;
+    std::shared_ptr<const Entry> entry;
+  } last;
+  if (last.table == id_ && last.to == to) return last.entry;
+  std::shared_ptr<const Entry> entry = Find(to);
+  last.table = id_;
+  last.to = to;
+  last.entry = entry;
+  return entry;
+}
+
+void LazyRouteTable::Prepare(PointId to) const {
+  if (Known(to)) Find(to);
+}
+
+std::shared_ptr<const LazyRouteTable::Entry> LazyRouteTable::Find(PointId to) const {
   {
     std::lock_guard lock(mu_);
     if (auto it = index_.find(to); it != index_.end()) {

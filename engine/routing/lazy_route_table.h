@@ -9,9 +9,12 @@
 // always kept). Thread safety: all const methods may be called concurrently; `mu_` guards the
 // LRU list and index. Searches run outside the lock (two threads may search the same
 // destination; the first insert wins); entries are immutable shared_ptrs, so a query keeps
-// its entry alive even if another thread evicts it.
+// its entry alive even if another thread evicts it. Each thread remembers the last entry it
+// looked up (per table), so a run of queries towards one destination (walking a route, a
+// bid's robots) takes the lock once.
 #pragma once
 
+#include <cstdint>
 #include <list>
 #include <memory>
 #include <mutex>
@@ -31,6 +34,7 @@ class LazyRouteTable final : public RouteTable {
   double Cost(PointId from, PointId to) const override;
   PointId NextHop(PointId from, PointId to) const override;
   Result<Route> Path(PointId from, PointId to) const override;
+  void Prepare(PointId to) const override;
   std::string_view method() const override { return "lazy"; }
   RouteTableBuildInfo build_info() const override;
 
@@ -43,13 +47,15 @@ class LazyRouteTable final : public RouteTable {
     std::vector<double> dist;       // per searched vertex: cost to the destination
     std::vector<std::int32_t> via;  // per searched vertex: first graph arc towards it, or -1
   };
-  LazyRouteTable() = default;
+  LazyRouteTable();
   bool Known(PointId p) const { return p >= 0 && static_cast<std::size_t>(p) < graph_.point_count; }
-  std::shared_ptr<const Entry> Lookup(PointId to) const;
+  std::shared_ptr<const Entry> Lookup(PointId to) const;  // via this thread's last entry
+  std::shared_ptr<const Entry> Find(PointId to) const;    // the cache, or a new search
 
   std::shared_ptr<const WarehouseMap> map_;
   MapCostGraph graph_;
   std::size_t cache_bytes_ = 0;
+  const std::uint64_t id_;  // unique per table ever built (the per-thread last entry's key)
 
   mutable std::mutex mu_;
   using Lru = std::list<std::pair<PointId, std::shared_ptr<const Entry>>>;

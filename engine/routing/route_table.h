@@ -53,6 +53,9 @@ class RouteTable {
   virtual Result<Route> Path(PointId from, PointId to) const = 0;
   virtual std::string_view method() const = 0;
   virtual RouteTableBuildInfo build_info() const { return {std::string(method()), point_count()}; }
+  // Does now what later queries towards `to` need (a lazy table's reverse search), so that a
+  // caller can pay it on another thread than the one that queries. Dense tables: nothing.
+  virtual void Prepare(PointId /*to*/) const {}
 };
 
 enum class RouteTableMethod {

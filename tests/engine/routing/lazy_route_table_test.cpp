@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <thread>
 
 #include "engine/routing/floyd_route_table.h"
@@ -91,6 +92,47 @@ TEST(LazyRouteTableTest, CacheIsBoundedAndEvictsLeastRecentlyUsed) {
   const auto tiny = LazyRouteTable::Build(map, options).value();
   EXPECT_TRUE(CostsAgree(dense->Cost(0, 9), tiny->Cost(0, 9)));
   EXPECT_EQ(tiny->cached_destinations(), 1u);
+}
+
+TEST(LazyRouteTableTest, PrepareRunsTheSearchAheadOfTheQueries) {
+  const auto map = RandomMap(33, 8);
+  const auto lazy = LazyRouteTable::Build(map, {}).value();
+  const auto dense = FloydRouteTable::Build(map, {}).value();
+  lazy->Prepare(3);
+  EXPECT_EQ(lazy->searches(), 1u);
+  EXPECT_EQ(lazy->cached_destinations(), 1u);
+  EXPECT_TRUE(CostsAgree(dense->Cost(0, 3), lazy->Cost(0, 3)));
+  EXPECT_EQ(lazy->NextHop(0, 3) == kNoPoint, dense->NextHop(0, 3) == kNoPoint);
+  EXPECT_EQ(lazy->searches(), 1u);  // the queries found it
+  lazy->Prepare(-1);
+  lazy->Prepare(static_cast<PointId>(map->point_count()));
+  EXPECT_EQ(lazy->searches(), 1u);  // unknown ids: nothing to prepare
+  dense->Prepare(3);                // dense tables have nothing to do
+}
+
+TEST(LazyRouteTableTest, EachTableAnswersFromItsOwnEntries) {
+  // A thread keeps its last entry per table: alternating two tables (different floors, the
+  // same destination id) must never answer one from the other's search.
+  const auto map_a = RandomMap(51, 9);
+  const auto map_b = RandomMap(52, 9);
+  const auto a = LazyRouteTable::Build(map_a, {}).value();
+  const auto b = LazyRouteTable::Build(map_b, {}).value();
+  const auto dense_a = FloydRouteTable::Build(map_a, {}).value();
+  const auto dense_b = FloydRouteTable::Build(map_b, {}).value();
+  const auto n = static_cast<PointId>(std::min(map_a->point_count(), map_b->point_count()));
+  int differ = 0;
+  for (PointId u = 0; u < n; ++u) {
+    ASSERT_TRUE(CostsAgree(dense_a->Cost(u, 0), a->Cost(u, 0)));
+    ASSERT_TRUE(CostsAgree(dense_b->Cost(u, 0), b->Cost(u, 0)));
+    differ += !CostsAgree(dense_a->Cost(u, 0), dense_b->Cost(u, 0));
+  }
+  EXPECT_GT(differ, 0);  // the floors differ, so a mix-up would show
+  // A table built where a destroyed one was answers from its own search too.
+  for (int round = 0; round < 3; ++round) {
+    const auto t = LazyRouteTable::Build(round % 2 ? map_a : map_b, {}).value();
+    const auto& dense = round % 2 ? dense_a : dense_b;
+    for (PointId u = 0; u < n; ++u) ASSERT_TRUE(CostsAgree(dense->Cost(u, 1), t->Cost(u, 1)));
+  }
 }
 
 TEST(LazyRouteTableTest, ConcurrentQueriesAgreeWithSequentialOnes) {
