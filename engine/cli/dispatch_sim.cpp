@@ -4,6 +4,7 @@
 //       timed plans with the Chu2024 rules off and/or on (seed 000 Fig. 8, Tables 3-4).
 //   dispatch-sim stream --map chu2024 --robots 18 (--orders FILE | --random 200 --seed 1)
 //       [--strategy auction|greedy] [--zeta 100] [--csv series.csv] [--orders-csv out.csv]
+//       [--check-safety]
 //       an order stream with release times under the online traffic controller.
 //   dispatch-sim compare [--random 200 --seed 1 --robots 18 --map chu2024]
 //       auction zeta=100, auction zeta=0 and greedy on one random stream (issue 4 §4).
@@ -144,6 +145,7 @@ struct StreamArgs {
   std::size_t robots = 18, random = 0;
   std::uint64_t seed = 1;
   double interval = 2.0, zeta = 100.0, dt = 0.1, max_time = 36000.0;
+  bool check_safety = false;
 };
 
 struct Setup {
@@ -186,6 +188,7 @@ StreamConfig ConfigOf(const StreamArgs& a, const std::string& strategy, double z
   c.max_time = a.max_time;
   c.strategy = strategy == "greedy" ? AllocationStrategy::kGreedy : AllocationStrategy::kAuction;
   c.allocation.zeta = zeta;
+  c.check_safety = a.check_safety;
   return c;
 }
 
@@ -199,6 +202,12 @@ void PrintSummary(const std::string& label, const StreamResult& r) {
               r.total_distance, r.total_waiting_time, r.stops, r.traffic.replans,
               r.traffic.grants, r.traffic.deadlocks_resolved, r.traffic.nudges,
               r.traffic.head_on_conflicts, r.overall_min_distance);
+  if (r.safety) {
+    std::printf("  safety check: %zu violations\n", r.safety->violations.size());
+    for (std::size_t i = 0; i < r.safety->violations.size() && i < 5; ++i) {
+      std::printf("    %s\n", r.safety->violations[i].Describe().c_str());
+    }
+  }
   for (std::size_t i = 0; i < r.blocked.size() && i < 5; ++i) {
     std::printf("  blocked: %s\n", r.blocked[i].c_str());
   }
@@ -216,7 +225,7 @@ int RunStream(const StreamArgs& a) {
   auto r = SimulateOrderStream(setup->map, setup->routes, setup->robots, setup->orders,
                                ConfigOf(a, a.strategy, a.zeta));
   if (!r.ok()) return Fail(r.error().message);
-  char label[128];
+  char label[1024];
   std::snprintf(label, sizeof label, "%s on %s, %zu robots, %s (zeta %g)",
                 a.orders.empty() ? "random stream" : a.orders.c_str(), a.map.c_str(),
                 setup->robots.size(), a.strategy.c_str(), a.zeta);
@@ -241,7 +250,7 @@ int RunStream(const StreamArgs& a) {
       out << '\n';
     }
   }
-  return r->all_completed() ? 0 : 2;
+  return r->all_completed() && (!r->safety || r->safety->ok()) ? 0 : 2;
 }
 
 int RunCompare(StreamArgs a) {
@@ -310,6 +319,8 @@ int Main(int argc, char** argv) {
     c->add_option("--interval", a.interval, "Mean seconds between random releases")->capture_default_str();
     c->add_option("--dt", a.dt, "Time step, s")->capture_default_str()->check(CLI::PositiveNumber);
     c->add_option("--max-time", a.max_time, "Simulated seconds before giving up")->capture_default_str();
+    c->add_flag("--check-safety", a.check_safety,
+                "Run CheckSafety over every step (eps1 spacing, crossings in intersections)");
   };
   auto* s = app.add_subcommand("stream", "Order stream under the online traffic controller");
   add_stream(s, stream);

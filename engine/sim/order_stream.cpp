@@ -77,6 +77,7 @@ class StreamSim {
   std::vector<int> next_in_cell_;
   std::uint32_t stamp_ = 0;
   int cols_ = 1, rows_ = 1;
+  std::vector<SafetyFrame> frames_;  // check_safety
 };
 
 double ReleaseOf(const Order& o) { return o.release_time.value_or(o.created_time); }
@@ -389,6 +390,13 @@ void StreamSim::Sample(double t) {
   }
   if (best > cap) best = std::numeric_limits<double>::infinity();
   out_.overall_min_distance = std::min(out_.overall_min_distance, best);
+  if (config_.check_safety) {
+    SafetyFrame& frame = frames_.emplace_back();
+    frame.t = t;
+    for (std::size_t r = 0; r < bots_.size(); ++r) {
+      if (!bots_[r].removed) frame.robots.push_back({bots_[r].id, bots_[r].id, bots_[r].id, false, Position(r)});
+    }
+  }
   if (config_.record_series) {
     out_.times.push_back(t);
     out_.min_distance.push_back(best);
@@ -426,6 +434,11 @@ StreamResult StreamSim::Run() {
     }
   }
   out_.traffic = ctl_.stats();
+  if (config_.check_safety) {
+    TrafficConfig rules;
+    rules.epsilon_single_single = config_.traffic.point_clearance;
+    out_.safety = CheckSafety(frames_, *map_, rules);
+  }
   return std::move(out_);
 }
 

@@ -28,6 +28,7 @@
 #include <cstddef>
 #include <limits>
 #include <memory>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -38,6 +39,7 @@
 #include "engine/fleet/order.h"
 #include "engine/map/warehouse_map.h"
 #include "engine/routing/route_table.h"
+#include "engine/traffic/safety_check.h"
 #include "engine/traffic/traffic_controller.h"
 
 namespace dispatch::engine {
@@ -62,6 +64,11 @@ struct StreamConfig {
   double allocation_period = 0.0;
   bool record_series = true;            // times / min_distance per step
   double distance_cap = 2.0;            // m: spatial-hash cell; farther pairs not measured
+  // The run checks itself (as the plan simulator does, simulator.h): every step's robot
+  // positions go through CheckSafety with eps1 = traffic.point_clearance (no formations here:
+  // every robot is its own agent), into StreamResult::safety. On by default in debug builds;
+  // it keeps every step's positions, so long release-build runs leave it off.
+  bool check_safety = kCheckSafetyByDefault;
 };
 
 struct StreamOrderOutcome {
@@ -89,6 +96,7 @@ struct StreamResult {
   std::vector<double> min_distance;   // per step, +inf when no pair within distance_cap
   double overall_min_distance = std::numeric_limits<double>::infinity();
   std::size_t steps = 0;
+  std::optional<SafetyReport> safety;  // when StreamConfig::check_safety
   bool all_completed() const { return completed == orders.size(); }
 };
 

@@ -61,12 +61,6 @@ struct SimRobot {
   std::vector<QueuedTask> queue;  // one per drop waypoint of the plan, in order
 };
 
-#ifdef NDEBUG
-inline constexpr bool kCheckSafetyByDefault = false;
-#else
-inline constexpr bool kCheckSafetyByDefault = true;
-#endif
-
 struct SimConfig {
   double time_step = 0.1;    // s (> 0)
   double max_wait = 120.0;   // s of continuous traffic waiting before "blocked"

@@ -27,6 +27,14 @@
 
 namespace dispatch::engine {
 
+// The simulators check themselves with CheckSafety in debug builds (SimConfig::check_safety,
+// StreamConfig::check_safety); release builds leave it to the caller.
+#ifdef NDEBUG
+inline constexpr bool kCheckSafetyByDefault = false;
+#else
+inline constexpr bool kCheckSafetyByDefault = true;
+#endif
+
 struct RobotSample {
   std::string robot;
   std::string agent;  // who moves it: robot id, or the formation's id

@@ -87,6 +87,18 @@ void ExpectSane(const World& w, const std::vector<Order>& orders, const StreamRe
   EXPECT_EQ(r.times.size(), r.min_distance.size());
 }
 
+// The run's own CheckSafety (StreamConfig::check_safety): eps1 between every pair of robots
+// and no crossing movements inside one intersection at a time.
+void ExpectSafe(const StreamResult& r) {
+  ASSERT_TRUE(r.safety.has_value());
+  EXPECT_TRUE(r.safety->ok()) << r.safety->violations.size() << " violations, first: "
+                              << r.safety->violations.front().Describe();
+  // The series measures pairs within distance_cap only (+inf when none was that close).
+  if (std::isfinite(r.overall_min_distance)) {
+    EXPECT_NEAR(r.safety->min_robot_distance, r.overall_min_distance, 1e-9);
+  }
+}
+
 TEST(OrderStreamTest, StrategiesOnTwoHundredRandomOrdersOnChu2024) {
   const World w = Chu();
   auto robots = PlaceRobots(*w.map, 18);
@@ -104,8 +116,10 @@ TEST(OrderStreamTest, StrategiesOnTwoHundredRandomOrdersOnChu2024) {
     c.strategy = strategy;
     c.allocation.zeta = zeta;
     c.max_time = 5000;
+    c.check_safety = true;
     auto r = SimulateOrderStream(w.map, w.routes, *robots, *orders, c);
     ASSERT_TRUE(r.ok()) << r.error().message;
+    ExpectSafe(*r);
     EXPECT_TRUE(r->all_completed()) << AllocationStrategyName(strategy) << " " << zeta;
     EXPECT_TRUE(r->blocked.empty());
     ExpectSane(w, *orders, *r, c);
@@ -120,6 +134,30 @@ TEST(OrderStreamTest, StrategiesOnTwoHundredRandomOrdersOnChu2024) {
   EXPECT_EQ(used.size(), 18u);
 }
 
+TEST(OrderStreamTest, SelfCheckCatchesCrossingsWithoutIntersectionGrants) {
+  // The same kind of stream with the controller's intersection grants off: robots still keep
+  // point clearance but enter an intersection whatever crosses it, and the run's CheckSafety
+  // says so (the check above can fail).
+  const World w = Chu();
+  auto robots = PlaceRobots(*w.map, 18);
+  ASSERT_TRUE(robots.ok());
+  RandomOrderOptions ro;
+  ro.count = 100;
+  ro.seed = 7;
+  auto orders = RandomOrders(*w.map, ro);
+  ASSERT_TRUE(orders.ok());
+  StreamConfig c;
+  c.max_time = 5000;
+  c.check_safety = true;
+  c.traffic.intersection_grants = false;
+  auto r = SimulateOrderStream(w.map, w.routes, *robots, *orders, c);
+  ASSERT_TRUE(r.ok()) << r.error().message;
+  ASSERT_TRUE(r->safety.has_value());
+  std::size_t crossings = 0;
+  for (const SafetyViolation& v : r->safety->violations) crossings += v.kind == ViolationKind::kCrossing;
+  EXPECT_GT(crossings, 0u);
+}
+
 TEST(OrderStreamTest, IsDeterministic) {
   const World w = Chu();
   auto robots = PlaceRobots(*w.map, 18);
@@ -127,8 +165,10 @@ TEST(OrderStreamTest, IsDeterministic) {
   ro.count = 40;
   ro.seed = 3;
   auto orders = RandomOrders(*w.map, ro);
-  auto a = SimulateOrderStream(w.map, w.routes, *robots, *orders, {});
-  auto b = SimulateOrderStream(w.map, w.routes, *robots, *orders, {});
+  StreamConfig c;
+  c.check_safety = false;
+  auto a = SimulateOrderStream(w.map, w.routes, *robots, *orders, c);
+  auto b = SimulateOrderStream(w.map, w.routes, *robots, *orders, c);
   ASSERT_TRUE(a.ok() && b.ok());
   ASSERT_EQ(a->orders.size(), b->orders.size());
   for (std::size_t i = 0; i < a->orders.size(); ++i) {
@@ -136,6 +176,7 @@ TEST(OrderStreamTest, IsDeterministic) {
     EXPECT_EQ(a->orders[i].completion_time, b->orders[i].completion_time);
   }
   EXPECT_EQ(a->min_distance, b->min_distance);
+  EXPECT_FALSE(a->safety.has_value());  // not asked for
 }
 
 TEST(OrderStreamTest, TaskTableReleaseTimesAreRespected) {
@@ -246,9 +287,11 @@ TEST(OrderStreamTest, LivenessOnSmallDenseGrids) {
         StreamConfig c;
         c.max_time = 2000;
         c.record_series = false;
+        c.check_safety = true;
         auto r = SimulateOrderStream(w.map, w.routes, *robots, *orders, c);
         ASSERT_TRUE(r.ok()) << r.error().message;
         SCOPED_TRACE("robots " + std::to_string(n) + " seed " + std::to_string(seed));
+        ExpectSafe(*r);
         ExpectSane(w, *orders, *r, c);
         for (const auto& o : r->orders) {
           if (!o.completed) {
