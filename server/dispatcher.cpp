@@ -18,6 +18,7 @@ namespace {
 // page and Assignment carrying it) far below gRPC's 4 MiB message limit: an order of
 // 100 000 picks fits in one SubmitOrder but makes every default-sized page unreadable.
 constexpr std::size_t kMaxPicksPerOrder = 100;
+constexpr int kWorkerNice = 5;  // the workers' CPU priority below the loop's (WorkerThread)
 
 }  // namespace
 
@@ -72,8 +73,9 @@ Dispatcher::Dispatcher(std::shared_ptr<const engine::WarehouseMap> map,
       options_(std::move(options)),
       allocator_(std::move(allocator)),
       wall_start_(Clock::now()),
-      route_worker_(std::make_unique<WorkerThread>()),
-      allocation_worker_(std::make_unique<WorkerThread>()) {}
+      // Below the loop's priority: traffic control first when the cores are busy.
+      route_worker_(std::make_unique<WorkerThread>(kWorkerNice)),
+      allocation_worker_(std::make_unique<WorkerThread>(kWorkerNice)) {}
 
 Dispatcher::~Dispatcher() {
   // The workers post to the loop: they stop before anything is torn down.

@@ -236,6 +236,15 @@ class Dispatcher {
     std::vector<std::vector<engine::Waypoint>> segments;
     std::vector<double> after_departure;
     double seconds = 0.0;  // the strategy's time for this order
+    std::string detail;    // the explanation as stored (AllocationDetail), made on the worker
+  };
+  // A round's awards on their way into the store, kCommitChunk per loop turn.
+  struct RoundCommit {
+    std::shared_ptr<const RoundInput> input;
+    std::map<std::string, RoundKey> keys;  // as the round saw them; then as committed
+    std::vector<RoundAward> awards;
+    std::size_t next = 0;                  // the first award not looked at yet
+    std::map<std::string, bool> spoiled;   // robots the round may not change any more
   };
   // Loop: starts a round on the allocation worker (or marks one due after the running one).
   void AllocatePending();
@@ -248,11 +257,14 @@ class Dispatcher {
   // the picks it has not reached yet) to its queue in `fleet`, so that bids count the whole
   // queue (Chu2024 eq. 3) and traffic prediction sees the robot's work (worker).
   void ReplayQueue(engine::FleetState& fleet, std::size_t index, const RoundRobot& robot) const;
-  // Loop: commits, in one store transaction, the awards whose orders are still accepted and
-  // whose robots are still eligible with the keys the round saw (`keys`); marks another round
-  // due when some were not. False if the store failed (nothing changed).
-  bool CommitRound(const RoundInput& input, const std::map<std::string, RoundKey>& keys,
-                   std::vector<RoundAward> awards);
+  // Loop: commits the round's next kCommitChunk awards, in one store transaction: those whose
+  // orders are still accepted and whose robots are still eligible with the keys the round saw;
+  // marks another round due when some were not. False if the store failed (nothing of this
+  // chunk changed).
+  bool CommitRound(RoundCommit& commit);
+  // Loop: CommitRound, then the rest of the round in a later loop turn (robots are served in
+  // between), then the end of the round.
+  void CommitNext(std::shared_ptr<RoundCommit> commit);
   // Removes `order_id` and every later order from the plan; returns the later ones.
   static std::vector<std::string> CutPlan(storage::AssignmentRecord& plan, const std::string& order_id);
   // Drops the finished first order (up to its drop waypoint) from the plan; false if

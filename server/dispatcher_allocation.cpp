@@ -37,6 +37,10 @@ bool NaturalLess(const std::string& a, const std::string& b) {
 
 bool HasOrders(const storage::AssignmentRecord& a, bool has) { return has && !a.order_ids.empty(); }
 
+// Awards stored per loop turn: a large round (a hundred orders, each explanation with the bids
+// of every robot) would otherwise hold the loop for a quarter second.
+constexpr std::size_t kCommitChunk = 4;
+
 }  // namespace
 
 bool Dispatcher::Eligible(const RobotRuntime& r) const {
@@ -84,7 +88,7 @@ void Dispatcher::AllocatePending() {
     return a->position < b->position;
   });
   input->now = Now();
-  auto keys = std::make_shared<std::map<std::string, RoundKey>>();
+  auto keys = std::make_shared<std::map<std::string, RoundKey>>();  // moved into the commit
   for (const auto& id : ids) {
     const RobotRuntime& r = robots_.at(id);
     RoundRobot robot;
@@ -101,19 +105,26 @@ void Dispatcher::AllocatePending() {
   }
   round_running_ = true;
   allocation_worker_->Run([this, input, keys](bool cancelled) {
-    auto awards = std::make_shared<std::vector<RoundAward>>();
-    if (!cancelled) *awards = RunRound(*input);
-    Post([this, input, keys, awards] {
-      round_running_ = false;
-      if (!CommitRound(*input, *keys, std::move(*awards))) {
-        retry_allocation_ = true;  // the store failed: try again on the next tick
-      }
-      if (round_again_) {
-        round_again_ = false;
-        allocation_due_ = true;
-      }
-    });
+    auto commit = std::make_shared<RoundCommit>();
+    commit->input = input;
+    commit->keys = std::move(*keys);
+    if (!cancelled) commit->awards = RunRound(*input);
+    Post([this, commit] { CommitNext(commit); });
   });
+}
+
+void Dispatcher::CommitNext(std::shared_ptr<RoundCommit> commit) {
+  if (!CommitRound(*commit)) {
+    retry_allocation_ = true;  // the store failed: the rest stays accepted, tried on the next tick
+  } else if (commit->next < commit->awards.size()) {
+    Post([this, commit] { CommitNext(commit); });
+    return;
+  }
+  round_running_ = false;
+  if (round_again_) {
+    round_again_ = false;
+    allocation_due_ = true;
+  }
 }
 
 std::vector<Dispatcher::RoundAward> Dispatcher::RunRound(const RoundInput& input) {
@@ -161,6 +172,8 @@ std::vector<Dispatcher::RoundAward> Dispatcher::RunRound(const RoundInput& input
       a.after_departure.push_back(from > 0 && from <= fp.size() ? fp[from - 1].departure() : 0.0);
     }
     a.award = std::move(award).value();
+    a.detail = AllocationDetail({a.award, options_.allocation.alpha, options_.allocation.beta,
+                                 options_.allocation.zeta, input.now});
     out.push_back(std::move(a));
   }
   return out;
@@ -212,9 +225,11 @@ void Dispatcher::ReplayQueue(engine::FleetState& fleet, std::size_t index, const
   }
 }
 
-bool Dispatcher::CommitRound(const RoundInput& input, const std::map<std::string, RoundKey>& keys,
-                             std::vector<RoundAward> awards) {
+bool Dispatcher::CommitRound(RoundCommit& commit) {
   const double now = Now();
+  const RoundInput& input = *commit.input;
+  auto& keys = commit.keys;
+  auto& spoiled = commit.spoiled;
   // Each robot's plan after this round's awards (built on a copy, applied once stored).
   struct Work {
     RobotRuntime* robot = nullptr;
@@ -224,9 +239,10 @@ bool Dispatcher::CommitRound(const RoundInput& input, const std::map<std::string
     std::uint64_t first_new = 0;  // its first new waypoint sequence
   };
   std::map<std::string, Work> work;
-  std::map<std::string, bool> spoiled;  // robots this round may not change any more
   std::vector<const RoundAward*> accepted;
-  for (const RoundAward& a : awards) {
+  const std::size_t end = std::min(commit.awards.size(), commit.next + kCommitChunk);
+  for (; commit.next < end; ++commit.next) {
+    const RoundAward& a = commit.awards[commit.next];
     auto view = Find(a.order_id);
     if (!view || view->record.order.state != engine::OrderState::kAccepted) continue;  // cancelled meanwhile
     bool valid = true;
@@ -302,7 +318,7 @@ bool Dispatcher::CommitRound(const RoundInput& input, const std::map<std::string
       auto e1 = s.TransitionOrder(t);
       if (!e1.ok()) return e1.error();
       events.push_back(*e1);
-      auto e2 = s.AppendProgress(a.order_id, now, AllocationDetail(records[i]));
+      auto e2 = s.AppendProgress(a.order_id, now, a.detail);
       if (!e2.ok()) return e2.error();
       events.push_back(*e2);
     }
@@ -338,6 +354,7 @@ bool Dispatcher::CommitRound(const RoundInput& input, const std::map<std::string
   // The gate learns every plan before any is sent (a formation needs all three members').
   for (auto& [id, wk] : work) SyncGate(*wk.robot);
   for (auto& [id, wk] : work) SendTo(*wk.robot, PlanMessage(*wk.robot, wk.fresh, wk.first_new));
+  for (auto& [id, wk] : work) keys[id] = KeyOf(*wk.robot);  // the round's later awards build on these
   dirty_ = true;
   return true;
 }

@@ -1,10 +1,18 @@
 #include "server/worker_thread.h"
 
+#include <sys/resource.h>
+#include <unistd.h>
+
 #include <utility>
 
 namespace dispatch::server {
 
-WorkerThread::WorkerThread() : thread_([this] { Loop(); }) {}
+WorkerThread::WorkerThread(int nice)
+    : thread_([this, nice] {
+        // Best effort: without the permission to change it the thread runs at normal priority.
+        if (nice > 0) (void)::setpriority(PRIO_PROCESS, static_cast<id_t>(::gettid()), nice);
+        Loop();
+      }) {}
 
 WorkerThread::~WorkerThread() { Stop(); }
 

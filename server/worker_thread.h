@@ -8,6 +8,9 @@
 // its hand-over (nothing handed to the worker is dropped). Stop() runs the jobs still queued
 // that way and joins; Run() after Stop() runs the job at once on the caller's thread,
 // cancelled. Thread-safe.
+//
+// `nice` > 0 runs the thread at that much lower CPU priority (Linux: setpriority on the
+// thread), so that on a busy machine the loop and the robot streams get the cores first.
 #pragma once
 
 #include <condition_variable>
@@ -21,7 +24,7 @@ namespace dispatch::server {
 class WorkerThread {
  public:
   using Job = std::function<void(bool cancelled)>;
-  WorkerThread();
+  explicit WorkerThread(int nice = 0);
   ~WorkerThread();  // Stop()
   WorkerThread(const WorkerThread&) = delete;
   WorkerThread& operator=(const WorkerThread&) = delete;

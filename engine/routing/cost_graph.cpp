@@ -29,6 +29,10 @@ Result<CostGraph> CostGraph::Build(std::size_t vertex_count, std::vector<CostArc
   CostGraph g;
   g.vertex_count_ = vertex_count;
   g.arcs_ = std::move(arcs);
+  if (!g.arcs_.empty() && g.arcs_.front().cost > 0.0 &&
+      std::all_of(g.arcs_.begin(), g.arcs_.end(), [&](const CostArc& a) { return a.cost == g.arcs_.front().cost; })) {
+    g.uniform_cost_ = g.arcs_.front().cost;
+  }
   // Counting sort of arc ids by tail (out) and head (in): CSR with ids kept in input order.
   auto csr = [&](auto end_of, std::vector<std::size_t>& begin, std::vector<std::int32_t>& ids) {
     begin.assign(vertex_count + 1, 0);

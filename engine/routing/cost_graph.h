@@ -56,9 +56,13 @@ class CostGraph {
   }
   // The cheapest arc from -> to (lowest cost, then lowest id); -1 if there is none.
   std::int32_t CheapestArc(VertexId from, VertexId to) const;
+  // The cost every arc has, when all arcs cost the same and more than 0 (a grid floor driven
+  // at one speed); 0 otherwise. Searches then go level by level (dijkstra.h).
+  double uniform_cost() const { return uniform_cost_; }
 
  private:
   std::size_t vertex_count_ = 0;
+  double uniform_cost_ = 0.0;
   std::vector<CostArc> arcs_;
   std::vector<std::size_t> out_begin_, in_begin_;  // vertex_count + 1 offsets
   std::vector<std::int32_t> out_ids_, in_ids_;

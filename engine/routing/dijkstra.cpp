@@ -15,8 +15,47 @@ constexpr double kInf = std::numeric_limits<double>::infinity();
 using HeapItem = std::pair<double, VertexId>;
 using MinHeap = std::priority_queue<HeapItem, std::vector<HeapItem>, std::greater<>>;
 
+// Uniform arc cost c: every vertex is first reached at its final distance (level k: k c).
+// Levels in vertex order settle vertices in the heap's (dist, vertex) order, and the first
+// relaxation of a vertex (strict <) comes from the same arc: the same tree.
+ShortestPathTree SearchLevels(const CostGraph& graph, std::span<const VertexId> roots, bool reverse,
+                              double c) {
+  const std::size_t n = graph.vertex_count();
+  ShortestPathTree t;
+  t.dist.assign(n, kInf);
+  t.via.assign(n, -1);
+  std::vector<VertexId> level, next;
+  for (VertexId r : roots) {
+    if (t.dist[static_cast<std::size_t>(r)] == 0.0) continue;
+    t.dist[static_cast<std::size_t>(r)] = 0.0;
+    level.push_back(r);
+  }
+  double d = 0.0;
+  while (!level.empty()) {
+    std::sort(level.begin(), level.end());
+    const double dv = d + c;
+    for (const VertexId u : level) {
+      if (!reverse) t.order.push_back(u);
+      for (std::int32_t id : reverse ? graph.in_arcs(u) : graph.out_arcs(u)) {
+        const CostArc& a = graph.arc(id);
+        const VertexId v = reverse ? a.from : a.to;
+        if (dv < t.dist[static_cast<std::size_t>(v)]) {
+          t.dist[static_cast<std::size_t>(v)] = dv;
+          t.via[static_cast<std::size_t>(v)] = id;
+          next.push_back(v);
+        }
+      }
+    }
+    level.swap(next);
+    next.clear();
+    d = dv;
+  }
+  return t;
+}
+
 // Shared loop: `reverse` searches in-arcs and relaxes the arc's tail.
 ShortestPathTree Search(const CostGraph& graph, std::span<const VertexId> roots, bool reverse) {
+  if (graph.uniform_cost() > 0.0) return SearchLevels(graph, roots, reverse, graph.uniform_cost());
   const std::size_t n = graph.vertex_count();
   ShortestPathTree t;
   t.dist.assign(n, kInf);

@@ -1,8 +1,11 @@
 // Dijkstra on a CostGraph (binary heap, lazy deletion): single source, reverse (towards a set
 // of targets, for the lazy table), and all-pairs into the same AllPairsTable Floyd fills.
 //
-// Distances are double; exact up to floating-point summation. Pure functions of their inputs:
-// safe to call concurrently on a shared graph.
+// Distances are double; exact up to floating-point summation. On a graph whose arcs all cost
+// the same (CostGraph::uniform_cost: grid floors) the searches run breadth-first, level by
+// level with each level in vertex order: the very same trees (dist, via, settle order) as the
+// heap, which pops (dist, vertex) in that order, about three times faster. Pure functions of
+// their inputs: safe to call concurrently on a shared graph.
 #pragma once
 
 #include <span>
