@@ -200,8 +200,9 @@ double Dispatcher::Now() const {
 }
 
 void Dispatcher::Loop() {
-  // Ticks also run the traffic controller for robots that report nothing new (a dwell ends,
-  // a held point frees up): at least 20 times per wall second.
+  // Ticks also run the traffic controller for robots that report nothing new (a held point
+  // frees up): at least 20 times per wall second; and the loop wakes when a robot's planned
+  // departure comes (TrafficGate::NextWake).
   const double tick_s = std::clamp(options_.heartbeat_timeout / 10.0, 0.01, gate_ ? 0.05 : 0.5);
   const auto tick = std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(tick_s));
   auto next_tick = Clock::now() + tick;
@@ -209,8 +210,16 @@ void Dispatcher::Loop() {
     std::deque<std::function<void()>> batch;
     bool stopping = false;
     {
+      auto wake = dirty_ ? std::min(next_tick, last_publish_ + kPublishEvery) : next_tick;
+      // A robot that only waits for its planned departure is released then, not a tick late.
+      if (gate_) {
+        const double at = gate_->NextWake();
+        if (at < Now() + tick_s * options_.time_scale) {
+          const auto wait = std::chrono::duration<double>(std::max(0.0, at - Now()) / options_.time_scale);
+          wake = std::min(wake, Clock::now() + std::chrono::duration_cast<Clock::duration>(wait));
+        }
+      }
       std::unique_lock<std::mutex> lock(queue_mu_);
-      const auto wake = dirty_ ? std::min(next_tick, last_publish_ + kPublishEvery) : next_tick;
       queue_cv_.wait_until(lock, wake, [&] { return !queue_.empty() || stopping_; });
       batch.swap(queue_);
       stopping = stopping_;

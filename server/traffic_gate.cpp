@@ -22,7 +22,7 @@ TrafficGate::~TrafficGate() = default;
 engine::Result<std::unique_ptr<TrafficGate>> TrafficGate::Create(
     std::shared_ptr<const engine::WarehouseMap> map, std::shared_ptr<const engine::RouteTable> routes,
     engine::TrafficControllerConfig config) {
-  auto ctl = engine::TrafficController::Create(map, config);
+  auto ctl = engine::TrafficController::Create(map, config, routes);
   if (!ctl.ok()) return ctl.error();
   auto impl = std::make_unique<Impl>(std::move(map), std::move(routes), config, std::move(ctl).value());
   return std::unique_ptr<TrafficGate>(new TrafficGate(std::move(impl)));
@@ -145,6 +145,7 @@ std::optional<GateImpl::TeamSpan> GateImpl::SpanOf(const GateBot& b, const std::
 // The next formation join boundary after index `from` (the J of the first team order ahead),
 // or -1.
 long GateImpl::NextJoin(const GateBot& b, long from, std::string* order) const {
+  if (b.plan.teams.empty()) return -1;  // no formation order in the plan
   const auto& ow = b.plan.order_of;
   std::string seen;
   for (long i = std::max(0L, from + 1); i < static_cast<long>(ow.size()); ++i) {
@@ -314,6 +315,7 @@ void GateImpl::StepSolo(GateBot& b, double t, std::vector<GateEffect>& out) {
   const long here = std::max(run_end, b.idx);
   if (b.idx < here) return;  // still to reach (or work at) the waypoints here
   if (b.idx >= 0 && t < Departure(b, b.idx)) {
+    WakeAt(Departure(b, b.idx));  // nothing but time keeps it here
     ctl.SetWorking(r, IsStop(w[static_cast<std::size_t>(b.idx)]), Departure(b, b.idx));
     return;
   }
@@ -493,6 +495,7 @@ void GateImpl::OnReached(GateBot& b, std::uint64_t seq, double t) {
 // The formation orders a robot counts as one agent with: the team it is in or approaches,
 // and the team it left at its last drop until it (and its teammates) have driven off.
 std::pair<std::string, std::string> GateImpl::TeamKeys(const GateBot& b) const {
+  if (b.team.empty() && b.former_team.empty() && b.plan.teams.empty()) return {};  // a robot alone
   std::string current = b.team;
   if (current.empty()) {
     const long i = std::min<long>(b.idx + 1, static_cast<long>(b.plan.order_of.size()) - 1);
@@ -603,6 +606,7 @@ void TrafficGate::Report(const std::string& robot, const Eigen::Vector2d& xy, st
 std::vector<GateEffect> TrafficGate::Step(double t) {
   Impl& s = *impl_;
   std::vector<GateEffect> out;
+  s.next_wake = std::numeric_limits<double>::infinity();
   // A reconnected robot may still obey a Hold whose Resume was lost with its old stream: it
   // gets a Resume with its horizon (the horizon, not the Hold, is what keeps it safe), and a
   // Hold again if it must still wait.
@@ -626,6 +630,8 @@ std::vector<GateEffect> TrafficGate::Step(double t) {
 }
 
 void TrafficGate::SampleDistances(double t) { impl_->SampleDistances(t); }
+
+double TrafficGate::NextWake() const { return impl_->next_wake; }
 
 bool TrafficGate::Available(const std::string& robot) const {
   auto it = impl_->bots.find(robot);

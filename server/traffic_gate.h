@@ -120,6 +120,10 @@ class TrafficGate {
               double t);
   // Runs the controller for every agent and returns what to tell the robots.
   std::vector<GateEffect> Step(double t);
+  // When the next Step may release a robot though no report came in: the earliest planned
+  // departure (the end of a dwell, or a robot ahead of its plan) the last Step saw robots
+  // wait for; +inf when none. The owner steps again then (a release is not a tick late).
+  double NextWake() const;
   // Updates the minimum distance from the robots' last reported positions (O(robots)).
   void SampleDistances(double t);
 

@@ -2,7 +2,9 @@
 // (formations). Internal to the server; see traffic_gate.h for the model.
 #pragma once
 
+#include <algorithm>
 #include <functional>
+#include <limits>
 #include <optional>
 #include <map>
 #include <set>
@@ -84,6 +86,10 @@ struct GateImpl {
   std::vector<std::size_t> team_pool;     // removed team agents, reusable
   std::size_t team_agents = 0;            // team agents ever added (their ids)
   MinDistance min_distance;
+  // The earliest planned departure (dispatcher seconds) a standing robot or team waits for,
+  // seen by the last Step: nothing else may change by then (+inf: none).
+  double next_wake = std::numeric_limits<double>::infinity();
+  void WakeAt(double t) { next_wake = std::min(next_wake, t); }
   // Per point: a service point other than parking is this point or within point_clearance
   // of it (an idle robot standing there keeps others from serving).
   std::vector<bool> blocks_service;

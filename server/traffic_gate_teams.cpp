@@ -232,6 +232,7 @@ void GateImpl::StepTeams(double t, std::vector<GateEffect>& out) {
           double departure = 0.0;
           for (const MemberView& v : m) departure = std::max(departure, Departure(*v.bot, v.first_pick + rk));
           const bool done_here = all_reached(rk);
+          if (done_here && t < departure) WakeAt(departure);
           if (done_here && t >= departure) {
             ctl.SetWorking(tr, false);
             if (rk + 1 >= length) {

@@ -5,8 +5,12 @@
 
 #include <gtest/gtest.h>
 
+#include <functional>
 #include <map>
+#include <set>
 
+#include "engine/allocation/auction_allocator.h"
+#include "engine/allocation/fleet_state.h"
 #include "engine/map/chu2024_floor.h"
 
 namespace dispatch::server {
@@ -52,8 +56,49 @@ class TrafficGateTest : public ::testing::Test {
     gate_->Reached(id, static_cast<std::uint64_t>(plan[0].seq), 0.0);
     gate_->Report(id, map_->point(P(start)).position, static_cast<std::uint64_t>(plan[0].seq), 0.0);
   }
+  // Three robots at these stations carry one formation order (the auction plans them:
+  // rendezvous slots, then the rigid triangle to the drop), like the dispatcher's awards.
+  void AddFormation(const std::vector<std::string>& starts, const std::string& pick, const std::string& drop,
+                    const std::string& order) {
+    std::vector<engine::FleetRobot> robots;
+    for (std::size_t i = 0; i < starts.size(); ++i) {
+      robots.push_back({"F" + std::to_string(i + 1), P(starts[i]), 0.0});
+    }
+    auto created = engine::FleetState::Create(map_, routes_, robots, {});
+    ASSERT_TRUE(created.ok()) << created.error().message;
+    engine::FleetState fleet = std::move(created).value();
+    engine::Order o;
+    o.id = order;
+    o.picks = {P(pick)};
+    o.drop = P(drop);
+    o.formation = true;
+    o.work_time = 2.0;
+    engine::AuctionAllocator auction;
+    auto award = auction.Allocate(o, fleet);
+    ASSERT_TRUE(award.ok()) << award.error().message;
+    ASSERT_EQ(award->winners.size(), 3u);
+    for (const auto& id : award->winners) {
+      std::vector<engine::Waypoint> plan = fleet.plan(*fleet.FindRobot(id)).waypoints;
+      for (auto& w : plan) w.seq += 1;
+      const engine::PointId start = plan.front().point;
+      gate_->Connect(id, map_->point(start).position, start);
+      GatePlan g;
+      g.waypoints = plan;
+      for (std::size_t i = 0; i < plan.size(); ++i) g.order_of.push_back(i == 0 ? "" : order);
+      g.teams[order] = award->winners;
+      gate_->SetPlan(id, g);
+      sims_[id].plan = plan;
+    }
+    for (const auto& id : award->winners) {
+      const engine::Waypoint& w = sims_[id].plan.front();
+      gate_->Reached(id, static_cast<std::uint64_t>(w.seq), 0.0);
+      gate_->Report(id, w.xy, static_cast<std::uint64_t>(w.seq), 0.0);
+    }
+    team_ = award->winners;
+  }
   // Steps until every robot stands on its plan's last waypoint; false after `max_steps`.
-  bool Run(int max_steps) {
+  // `observe` runs after every step.
+  bool Run(int max_steps, const std::function<void(double)>& observe = {}) {
     double t = 0.0;
     for (int step = 0; step < max_steps; ++step) {
       t += 0.1;
@@ -76,6 +121,7 @@ class TrafficGateTest : public ::testing::Test {
         gate_->Report(id, next.xy, static_cast<std::uint64_t>(next.seq), t);
       }
       gate_->SampleDistances(t);
+      if (observe) observe(t);
       if (done) return true;
     }
     return false;
@@ -86,6 +132,7 @@ class TrafficGateTest : public ::testing::Test {
   std::unique_ptr<TrafficGate> gate_;
   std::map<std::string, Sim> sims_;
   int releases_ = 0;
+  std::vector<std::string> team_;  // AddFormation's members, leader first
 };
 
 TEST_F(TrafficGateTest, ARobotIsReleasedPointByPointToTheEndOfItsPlan) {
@@ -103,6 +150,41 @@ TEST_F(TrafficGateTest, RobotsSharingPickAndDropKeepEps1) {
   AddRobot("R3", "park-P3", {"K3-2-2N"}, "D-B2", "o3");
   ASSERT_TRUE(Run(20000)) << gate_->Describe("R1") << "\n" << gate_->Describe("R2") << "\n"
                           << gate_->Describe("R3");
+  const MinDistance& d = gate_->min_distance();
+  EXPECT_GE(d.distance, 0.6 - 1e-9) << d.a << " and " << d.b << " at t = " << d.time;
+}
+
+TEST_F(TrafficGateTest, AFormationMovesAsOneAgentAndHoldsItsGrantsTogether) {
+  // Chu2024 §3.2 through the gate: the members meet at the pick, cross the floor as one agent
+  // (one grant for the three of them), split after the drop; a solo robot crossing the same
+  // aisles keeps eps2 from the formation (the gate's distance counts agents, not members).
+  AddFormation({"park-P1", "park-P2", "park-P3"}, "K3-2-3N", "D-B2", "f1");
+  AddRobot("R4", "park-P4", {"K3-2-2N"}, "D-B1", "o4");
+  bool all_in_team = false, shared_grant = false;
+  std::set<std::string> seen_formation;
+  ASSERT_TRUE(Run(40000, [&](double) {
+    int in_team = 0;
+    for (const auto& id : team_) {
+      if (gate_->RobotState(id).formation == "f1") {
+        ++in_team;
+        seen_formation.insert(id);
+      }
+    }
+    all_in_team = all_in_team || in_team == 3;
+    for (const GateIntersection& i : gate_->Intersections()) {
+      const std::set<std::string> holders(i.holders.begin(), i.holders.end());
+      if (holders.count(team_[0]) && holders.count(team_[1]) && holders.count(team_[2])) shared_grant = true;
+      // Nobody else holds an intersection the formation holds.
+      if (holders.count(team_[0])) {
+        EXPECT_EQ(holders.count("R4"), 0u);
+      }
+    }
+  })) << gate_->Describe(team_[0]) << "\n" << gate_->Describe(team_[1]) << "\n"
+      << gate_->Describe(team_[2]) << "\n" << gate_->Describe("R4");
+  EXPECT_TRUE(all_in_team);
+  EXPECT_TRUE(shared_grant);
+  EXPECT_EQ(seen_formation.size(), 3u);
+  for (const auto& id : team_) EXPECT_EQ(gate_->RobotState(id).formation, "") << id;  // dissolved
   const MinDistance& d = gate_->min_distance();
   EXPECT_GE(d.distance, 0.6 - 1e-9) << d.a << " and " << d.b << " at t = " << d.time;
 }
