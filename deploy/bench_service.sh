@@ -7,7 +7,7 @@
 #      sortation_large in real time (--time-scale 1) for DURATION s; the release latency
 #      fleet-sim measures (ms a robot stood ready at its release horizon until the Grant or
 #      Resume arrived; waits announced by a Hold excluded): p50/p99 and dispatchd's CPU share.
-#   3. REST: wrk on /api/v1/status at ~200 requests/s (2 connections, 10 ms pacing) while
+#   3. REST: wrk on /api/v1/status at ~200 requests/s (2 connections, 9 ms pacing) while
 #      the streaming fleet runs: latency percentiles.
 # Environment: FLEETS (default "500": the streaming fleet sizes, e.g. "250 500 1000"), DURATION (default 60),
 # INTAKE_ORDERS (default 1000). Results: build-release/bench/*.json and a summary at the end.
@@ -78,7 +78,7 @@ done
 echo
 echo "== Streaming: fleet-sim at 10 Hz reports, real time, ${duration} s per fleet, + REST at 200 req/s =="
 cat >"$out/pace.lua" <<'LUA'
-function delay() return 10 end
+function delay() return 9 end
 LUA
 for n in $fleets; do
   name=stream-$n

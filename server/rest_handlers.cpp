@@ -3,6 +3,8 @@
 #include <cmath>
 #include <cstdint>
 #include <limits>
+#include <set>
+#include <string>
 
 #include "engine/io/map_json.h"
 #include "server/dispatcher.h"
@@ -57,6 +59,16 @@ engine::Result<engine::OrderRequest> RequestOf(const std::string& body) {
     return engine::InvalidArgument(std::string("body is not JSON: ") + e.what());
   }
   if (!j.is_object()) return engine::InvalidArgument("body must be a JSON object");
+  // A misspelt field would otherwise be dropped silently (e.g. "relase_time": the order would
+  // start at once).
+  static const std::set<std::string> kFields = {"client_order_id", "client_id", "priority", "picks",
+                                                "drop", "formation", "work_time", "release_time"};
+  for (const auto& [key, value] : j.items()) {
+    if (!kFields.count(key)) {
+      return engine::InvalidArgument("unknown field '" + key + "' (known: client_order_id, priority, picks, drop, "
+                                     "formation, work_time, release_time)");
+    }
+  }
   engine::OrderRequest r;
   const char* id_key = j.contains("client_order_id") ? "client_order_id" : "client_id";
   if (!j.contains(id_key) || !j[id_key].is_string()) {

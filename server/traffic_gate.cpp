@@ -22,7 +22,7 @@ TrafficGate::~TrafficGate() = default;
 engine::Result<std::unique_ptr<TrafficGate>> TrafficGate::Create(
     std::shared_ptr<const engine::WarehouseMap> map, std::shared_ptr<const engine::RouteTable> routes,
     engine::TrafficControllerConfig config) {
-  auto ctl = engine::TrafficController::Create(map, config, routes);
+  auto ctl = engine::TrafficController::Create(map, config);
   if (!ctl.ok()) return ctl.error();
   auto impl = std::make_unique<Impl>(std::move(map), std::move(routes), config, std::move(ctl).value());
   return std::unique_ptr<TrafficGate>(new TrafficGate(std::move(impl)));

@@ -130,6 +130,15 @@ Result<Order> ResolveOrder(const WarehouseMap& map, const OrderRequest& request,
   if (!std::isfinite(request.work_time) || request.work_time <= 0.0) {
     return InvalidArgument(what + "work time t_w must be > 0 s, got " + Num(request.work_time));
   }
+  if (request.work_time > kMaxWorkTime) {
+    return InvalidArgument(what + "work time t_w must be at most " + Num(kMaxWorkTime) + " s (a day), got " +
+                           Num(request.work_time));
+  }
+  if (request.release_time &&
+      (!std::isfinite(*request.release_time) || std::abs(*request.release_time) > kMaxReleaseTime)) {
+    return InvalidArgument(what + "release time must be finite and within +-" + Num(kMaxReleaseTime) +
+                           " s of the dispatcher's epoch, got " + Num(*request.release_time));
+  }
   Order order;
   order.id = request.id;
   order.client_id = request.client_id;

@@ -93,8 +93,14 @@ struct SnapOptions {
   double tolerance = 0.2;
 };
 
+// Bounds ResolveOrder enforces: a task point's work time (a day), and a release time's
+// distance from the dispatcher's epoch (about 31 years: beyond it an order would never start).
+inline constexpr double kMaxWorkTime = 86400.0;
+inline constexpr double kMaxReleaseTime = 1e9;
+
 // Resolves a request on `map` (state = accepted). Errors:
-//  - kInvalidArgument: no picks; work_time not finite or <= 0; a non-finite coordinate; a
+//  - kInvalidArgument: no picks; work_time not finite, <= 0 or > kMaxWorkTime; a release time
+//    not finite or beyond kMaxReleaseTime; a non-finite coordinate; a
 //    coordinate farther than the tolerance from every candidate (names the coordinate, the
 //    nearest candidate and its distance) or within tolerance of two (names both); a named
 //    point of the wrong kind;

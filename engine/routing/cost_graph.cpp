@@ -129,7 +129,6 @@ Result<MapCostGraph> BuildMapCostGraph(const WarehouseMap& map, const RouteTable
   auto graph = CostGraph::Build(vertex_count, std::move(cost_arcs));
   if (!graph.ok()) return graph.error();
   g.graph = std::move(graph).value();
-  g.speed = options.speed;
   return g;
 }
 

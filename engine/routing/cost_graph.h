@@ -72,7 +72,6 @@ struct MapCostGraph {
   CostGraph graph;
   std::size_t point_count = 0;
   bool expanded = false;        // turn penalty: the arc-expanded graph described above
-  double speed = 0.0;           // RouteTableOptions::speed it was built for
   std::vector<ArcId> map_arc;   // per graph arc: the map arc it drives along
 
   bool IsPointVertex(VertexId v) const { return static_cast<std::size_t>(v) < point_count; }

@@ -466,7 +466,7 @@ Result<StreamResult> SimulateOrderStream(std::shared_ptr<const WarehouseMap> map
   if (!valid.ok()) return valid.error();
   TrafficControllerConfig tc = config.traffic;
   tc.speed = config.allocation.speed;
-  auto ctl = TrafficController::Create(map, tc, routes);
+  auto ctl = TrafficController::Create(map, tc);
   if (!ctl.ok()) return ctl.error();
   StreamSim sim(map, routes, config, std::move(ctl).value());
   Status init = sim.Init(robots, std::move(orders));

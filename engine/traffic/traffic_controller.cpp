@@ -57,7 +57,6 @@ struct Detour {
 
 struct TrafficController::Impl {
   std::shared_ptr<const WarehouseMap> map;
-  std::shared_ptr<const RouteTable> guide;  // A*'s heuristic (Create), or null: straight line
   TrafficControllerConfig config;
   LaneCorridors lanes;
   IntersectionGrants grants{0};
@@ -211,16 +210,10 @@ struct TrafficController::Impl {
     using Item = std::pair<double, PointId>;
     std::priority_queue<Item, std::vector<Item>, std::greater<>> heap;
     const Eigen::Vector2d goal = M().point(to).position;
-    // Both bounds are admissible (the guide only when Create accepted it): the larger, the
-    // fewer points A* expands. +inf: `to` is unreachable from v even without bans.
-    auto h = [&](PointId v) {
-      const double line = (M().point(v).position - goal).norm() / config.speed;
-      return guide ? std::max(line, guide->Cost(v, to)) : line;
-    };
+    auto h = [&](PointId v) { return (M().point(v).position - goal).norm() / config.speed; };
     auto relax = [&](PointId v, double d, ArcId a) {
       const auto i = static_cast<std::size_t>(v);
       if (seen[i] == stamp && dist[i] <= d) return;
-      if (guide && !std::isfinite(guide->Cost(v, to))) return;
       seen[i] = stamp;
       dist[i] = d;
       via[i] = a;
@@ -624,19 +617,11 @@ Status TrafficControllerConfig::Validate() const {
 }
 
 Result<TrafficController> TrafficController::Create(std::shared_ptr<const WarehouseMap> map,
-                                                    const TrafficControllerConfig& config,
-                                                    std::shared_ptr<const RouteTable> routes) {
+                                                    const TrafficControllerConfig& config) {
   if (!map) return InvalidArgument("traffic controller: no map");
   Status valid = config.Validate();
   if (!valid.ok()) return valid.error();
   auto impl = std::make_unique<Impl>();
-  if (routes && routes->point_count() == map->point_count()) {
-    // A lazy table's lookups are O(1) once the goal's search is cached (the goal is a robot's
-    // next stop: the allocation already searched it). Dense tables sit on small floors,
-    // where the straight line is enough.
-    const RouteTableBuildInfo info = routes->build_info();
-    if (info.method == "lazy" && !info.turn_expanded && info.speed >= config.speed) impl->guide = std::move(routes);
-  }
   impl->map = std::move(map);
   impl->config = config;
   const WarehouseMap& m = *impl->map;

@@ -35,8 +35,7 @@
 //    somebody waits for is sent to a siding off the waiter's route (StepAside, "nudge").
 //
 // Costs: Request/Arrived are O(route look-ahead + clearance neighbours); ResolveDeadlocks is
-// O(robots); detours run one bounded A* over the map (reused buffers; guided by the route
-// table's cost to the goal when Create was given a lazy one). No all-pairs work.
+// O(robots); detours run one bounded A* over the map (reused buffers). No all-pairs work.
 // Deterministic. Not thread-safe: one owner (the simulator or the dispatcher loop).
 #pragma once
 
@@ -48,7 +47,6 @@
 
 #include "engine/common/result.h"
 #include "engine/map/warehouse_map.h"
-#include "engine/routing/route_table.h"
 #include "engine/traffic/intersection_grants.h"
 #include "engine/traffic/lane_corridors.h"
 
@@ -100,13 +98,8 @@ struct TrafficStats {
 
 class TrafficController {
  public:
-  // `routes` (optional) guides the detour searches: on a lazy table (large grid floors) its
-  // cost to the goal is A*'s heuristic instead of the straight line, used only when it cannot
-  // overestimate (no turn penalty, built for at least config.speed), so detours stay the
-  // cheapest; a straight-line A* on a 70k-cell floor sweeps thousands of cells per detour.
   static Result<TrafficController> Create(std::shared_ptr<const WarehouseMap> map,
-                                          const TrafficControllerConfig& config = {},
-                                          std::shared_ptr<const RouteTable> routes = nullptr);
+                                          const TrafficControllerConfig& config = {});
   TrafficController(TrafficController&&) noexcept;
   TrafficController& operator=(TrafficController&&) noexcept;
   ~TrafficController();

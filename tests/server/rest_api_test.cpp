@@ -116,6 +116,15 @@ TEST_F(RestApiTest, ErrorsAreJsonWithAReason) {
                                  "application/json"),
                    400});
   cases.push_back({client_->Post("/api/v1/orders", R"({"picks": ["K3-2-3N"], "drop": "D-B1"})", "application/json"), 400});
+  // A misspelt field is named, not dropped (the order would have been released at once).
+  cases.push_back({client_->Post("/api/v1/orders",
+                                 R"({"client_order_id": "y", "picks": ["K3-2-3N"], "drop": "D-B1", "relase_time": 60})",
+                                 "application/json"),
+                   400});
+  cases.push_back({client_->Post("/api/v1/orders",
+                                 R"({"client_order_id": "z", "picks": ["K3-2-3N"], "drop": "D-B1", "release_time": 1e300})",
+                                 "application/json"),
+                   400});
   cases.push_back({client_->Get("/api/v1/orders/ord-424242"), 404});
   cases.push_back({client_->Delete("/api/v1/orders/ord-424242"), 404});
   cases.push_back({client_->Get("/api/v1/orders?state=sleeping"), 400});
@@ -128,6 +137,8 @@ TEST_F(RestApiTest, ErrorsAreJsonWithAReason) {
     ASSERT_TRUE(body.contains("error")) << c.result->body;
     EXPECT_FALSE(body["error"].get<std::string>().empty());
   }
+  EXPECT_NE(json::parse(cases[3].result->body)["error"].get<std::string>().find("relase_time"), std::string::npos);
+  EXPECT_NE(json::parse(cases[4].result->body)["error"].get<std::string>().find("release time"), std::string::npos);
 }
 
 TEST_F(RestApiTest, RobotsAppearWhenTheyConnect) {

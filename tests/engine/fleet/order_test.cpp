@@ -165,13 +165,23 @@ TEST_F(ResolveOrderTest, RejectsEmptyPicksAndBadWorkTime) {
   const Result<Order> empty = ResolveOrder(*map_, Request({}, Eigen::Vector2d(6.5, 2.75)));
   ASSERT_FALSE(empty.ok());
   EXPECT_NE(empty.error().message.find("no pick points"), std::string::npos);
-  for (double t_w : {0.0, -1.0, std::nan("")}) {
+  for (double t_w : {0.0, -1.0, std::nan(""), kMaxWorkTime * 2}) {
     OrderRequest r = Request({Eigen::Vector2d(19, 17)}, Eigen::Vector2d(6.5, 2.75));
     r.work_time = t_w;
     const Result<Order> bad = ResolveOrder(*map_, r);
     ASSERT_FALSE(bad.ok()) << t_w;
     EXPECT_NE(bad.error().message.find("work time"), std::string::npos);
   }
+  for (double release : {1e300, -1e300, std::nan(""), kMaxReleaseTime * 1.5}) {
+    OrderRequest r = Request({Eigen::Vector2d(19, 17)}, Eigen::Vector2d(6.5, 2.75));
+    r.release_time = release;
+    const Result<Order> bad = ResolveOrder(*map_, r);
+    ASSERT_FALSE(bad.ok()) << release;
+    EXPECT_NE(bad.error().message.find("release time"), std::string::npos) << bad.error().message;
+  }
+  OrderRequest later = Request({Eigen::Vector2d(19, 17)}, Eigen::Vector2d(6.5, 2.75));
+  later.release_time = 3600.0;  // an hour on: fine
+  EXPECT_TRUE(ResolveOrder(*map_, later).ok());
   const Result<Order> nan_xy = ResolveOrder(
       *map_, Request({Eigen::Vector2d(std::nan(""), 1.0)}, Eigen::Vector2d(6.5, 2.75)));
   ASSERT_FALSE(nan_xy.ok());

@@ -4,14 +4,12 @@
 
 #include <gtest/gtest.h>
 
-#include <algorithm>
 #include <memory>
 #include <string>
 #include <vector>
 
 #include "engine/io/movingai_map.h"
 #include "engine/map/map_builder.h"
-#include "engine/routing/route_table.h"
 
 namespace dispatch::engine {
 namespace {
@@ -155,39 +153,6 @@ TEST(TrafficControllerTest, WorkingRobotIsNeverMovedAndAWaiterWithoutDetourIsBlo
   EXPECT_NE(ctl.why(b).find("no alternative"), std::string::npos) << ctl.why(b);
   EXPECT_NE(ctl.why(b).find("held by W"), std::string::npos) << ctl.why(b);
   EXPECT_EQ(ctl.At(w), P(*map, "c2"));
-}
-
-TEST(TrafficControllerTest, DetoursGuidedByALazyRouteTableAreTheSame) {
-  // A working robot W blocks row 0; B, waiting behind it, re-plans after T_w2 around the
-  // wall (back to the left gap, along row 2, up the right gap: the only cheapest way). With
-  // a lazy route table as A*'s guide the detour is the same as with the straight line.
-  auto map = Grid({".........", ".@@@@@@@.", "........."});
-  RouteTableOptions options;
-  options.lazy_threshold_points = 0;  // the lazy table, as on large floors
-  std::shared_ptr<const RouteTable> table = MakeRouteTable(map, options).value();
-  ASSERT_EQ(table->method(), "lazy");
-  std::vector<std::vector<PointId>> detours;
-  for (bool guided : {false, true}) {
-    TrafficControllerConfig config;
-    config.t_w2 = 3.0;
-    auto created = TrafficController::Create(map, config, guided ? table : nullptr);
-    ASSERT_TRUE(created.ok());
-    TrafficController ctl = std::move(created).value();
-    const std::size_t w = *ctl.AddRobot("W", P(*map, "c4"));
-    ctl.SetWorking(w, true, 1e9);
-    ctl.SetIdle(w, false);
-    const std::size_t b = *ctl.AddRobot("B", P(*map, "c1"));
-    ASSERT_TRUE(ctl.SetRoute(b, Route(*map, {"c1", "c2", "c3", "c4", "c5", "c6", "c7", "c8"})).ok());
-    double t = 0;
-    for (int i = 0; i < 60 && ctl.stats().replans == 0; ++i) Step(ctl, t += 1.0);
-    ASSERT_EQ(ctl.stats().replans, 1u) << ctl.Describe(b);
-    detours.push_back(ctl.RemainingRoute(b));
-    for (int i = 0; i < 60 && ctl.At(b) != P(*map, "c8"); ++i) Step(ctl, t += 1.0);
-    EXPECT_EQ(ctl.At(b), P(*map, "c8")) << ctl.Describe(b);
-  }
-  EXPECT_EQ(detours[0], detours[1]);
-  EXPECT_EQ(detours[1].back(), P(*map, "c8"));
-  EXPECT_EQ(std::count(detours[1].begin(), detours[1].end(), P(*map, "c4")), 0);
 }
 
 TEST(TrafficControllerTest, IntersectionNeedsAGrantAndReleasesItBehind) {
