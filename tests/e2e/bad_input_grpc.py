@@ -127,6 +127,11 @@ def bad_times(server):
     for i, t in enumerate([float("nan"), float("-inf")]):
         submit_fails(server, bad, order_request(f"bad-rt-{i}", ["K1-1-1N"], "D-B1", release_time=t),
                      "release_time", "finite")
+    # Finite but absurd: an order released in 1e300 s (or taking a week per stop) never ends.
+    submit_fails(server, bad, order_request("bad-rt-far", ["K1-1-1N"], "D-B1", release_time=1e300),
+                 "release time", "1e+300")
+    submit_fails(server, bad, order_request("bad-tw-week", ["K1-1-1N"], "D-B1", work_time=604800.0),
+                 "work time", "at most")
 
 
 def negative_priority(server, book):
