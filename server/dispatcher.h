@@ -23,8 +23,8 @@
 // engine::FleetState from them with every robot at its point now, replays its remaining
 // orders into its queue (ReplayQueue), then auctions the orders in (priority, created) order;
 // back on the loop, the awards whose robots and orders have not changed meanwhile are
-// committed in one store transaction (a new order's waypoints appended to the robots' plans),
-// the others stay `accepted` for the next round. So traffic control (grants, holds) never
+// committed, a few per loop turn and each group in one store transaction (a new order's
+// waypoints appended to the robots' plans); the others stay `accepted` for the next round. So traffic control (grants, holds) never
 // waits for an auction or its route searches. New orders' route searches run on another
 // worker before the loop sees the order (SubmitOrder). Orders stay `accepted` while no robot
 // (or fewer than 3 for a formation) is connected.
@@ -54,6 +54,7 @@
 #include <map>
 #include <memory>
 #include <mutex>
+#include <set>
 #include <string>
 #include <thread>
 #include <unordered_map>
@@ -230,7 +231,7 @@ class Dispatcher {
   };
   struct RoundAward {
     std::string order_id;
-    engine::AwardExplanation award;
+    AllocationRecord record;  // the award and the weights it was made with
     // Per winner (award.winners order): the fleet plan's new waypoints (from its start for a
     // robot with no queue), and the departure the first of them follows (queued robots).
     std::vector<std::vector<engine::Waypoint>> segments;
@@ -240,17 +241,17 @@ class Dispatcher {
   };
   // A round's awards on their way into the store, kCommitChunk per loop turn.
   struct RoundCommit {
-    std::shared_ptr<const RoundInput> input;
     std::map<std::string, RoundKey> keys;  // as the round saw them; then as committed
     std::vector<RoundAward> awards;
     std::size_t next = 0;                  // the first award not looked at yet
-    std::map<std::string, bool> spoiled;   // robots the round may not change any more
+    std::set<std::string> spoiled;         // robots the round may not change any more
   };
   // Loop: starts a round on the allocation worker (or marks one due after the running one).
   void AllocatePending();
-  // The robots a round may use and where a new plan of each would start (loop).
-  RoundKey KeyOf(const RobotRuntime& robot) const;
+  // Loop: whether a round may use the robot; where a new plan of it would start; its key.
   bool Eligible(const RobotRuntime& robot) const;
+  engine::PointId StartOf(const RobotRuntime& robot) const;
+  RoundKey KeyOf(const RobotRuntime& robot) const;
   // Worker: the round's awards.
   std::vector<RoundAward> RunRound(const RoundInput& input);
   // Appends the robot's remaining orders (each as its member's own task; the first one from

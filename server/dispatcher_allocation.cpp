@@ -48,17 +48,20 @@ bool Dispatcher::Eligible(const RobotRuntime& r) const {
          r.record.robot.state != engine::RobotState::kFault && (!gate_ || gate_->Available(r.record.robot.id));
 }
 
+engine::PointId Dispatcher::StartOf(const RobotRuntime& r) const {
+  // A new plan starts where the traffic controller has the robot (standing or arriving).
+  const engine::PointId p = gate_ ? gate_->StartPoint(r.record.robot.id) : engine::kNoPoint;
+  return p != engine::kNoPoint ? p : r.record.robot.current_point;
+}
+
 Dispatcher::RoundKey Dispatcher::KeyOf(const RobotRuntime& r) const {
   RoundKey key;
-  const bool queued = HasOrders(r.assignment, r.has_assignment);
   key.plan_id = r.has_assignment ? r.assignment.plan_id : 0;
-  key.last_order = queued ? r.assignment.order_ids.back() : std::string();
-  key.start = r.record.robot.current_point;
-  if (gate_ && !queued) {
-    // A new plan starts where the traffic controller has the robot (standing or arriving).
-    if (const engine::PointId p = gate_->StartPoint(r.record.robot.id); p != engine::kNoPoint) key.start = p;
+  if (HasOrders(r.assignment, r.has_assignment)) {
+    key.last_order = r.assignment.order_ids.back();  // new work starts at its queue's end
+  } else {
+    key.start = StartOf(r);
   }
-  if (queued) key.start = engine::kNoPoint;  // a queued robot's new work starts at its queue's end
   return key;
 }
 
@@ -93,20 +96,18 @@ void Dispatcher::AllocatePending() {
     const RobotRuntime& r = robots_.at(id);
     RoundRobot robot;
     robot.id = id;
-    const RoundKey key = KeyOf(r);
-    robot.start = key.start == engine::kNoPoint ? r.record.robot.current_point : key.start;
+    robot.start = StartOf(r);
     if (HasOrders(r.assignment, r.has_assignment)) {
       robot.assignment = r.assignment;
       for (const auto& order_id : r.assignment.order_ids) robot.queue.push_back(Find(order_id));
     }
     robot.last_reached = r.last_reached;
     input->robots.push_back(std::move(robot));
-    (*keys)[id] = key;
+    (*keys)[id] = KeyOf(r);
   }
   round_running_ = true;
   allocation_worker_->Run([this, input, keys](bool cancelled) {
     auto commit = std::make_shared<RoundCommit>();
-    commit->input = input;
     commit->keys = std::move(*keys);
     if (!cancelled) commit->awards = RunRound(*input);
     Post([this, commit] { CommitNext(commit); });
@@ -171,9 +172,9 @@ std::vector<Dispatcher::RoundAward> Dispatcher::RunRound(const RoundInput& input
       a.segments.emplace_back(fp.begin() + static_cast<std::ptrdiff_t>(std::min(from, fp.size())), fp.end());
       a.after_departure.push_back(from > 0 && from <= fp.size() ? fp[from - 1].departure() : 0.0);
     }
-    a.award = std::move(award).value();
-    a.detail = AllocationDetail({a.award, options_.allocation.alpha, options_.allocation.beta,
-                                 options_.allocation.zeta, input.now});
+    a.record = {std::move(award).value(), options_.allocation.alpha, options_.allocation.beta,
+                options_.allocation.zeta, input.now};
+    a.detail = AllocationDetail(a.record);
     out.push_back(std::move(a));
   }
   return out;
@@ -227,7 +228,6 @@ void Dispatcher::ReplayQueue(engine::FleetState& fleet, std::size_t index, const
 
 bool Dispatcher::CommitRound(RoundCommit& commit) {
   const double now = Now();
-  const RoundInput& input = *commit.input;
   auto& keys = commit.keys;
   auto& spoiled = commit.spoiled;
   // Each robot's plan after this round's awards (built on a copy, applied once stored).
@@ -246,8 +246,8 @@ bool Dispatcher::CommitRound(RoundCommit& commit) {
     auto view = Find(a.order_id);
     if (!view || view->record.order.state != engine::OrderState::kAccepted) continue;  // cancelled meanwhile
     bool valid = true;
-    for (const auto& w : a.award.winners) {
-      if (spoiled[w]) valid = false;
+    for (const auto& w : a.record.award.winners) {
+      if (spoiled.count(w) != 0) valid = false;
       if (work.count(w) != 0) continue;  // checked at its first award of the round
       const RobotRuntime* r = RobotOf(w);
       auto key = keys.find(w);
@@ -256,12 +256,12 @@ bool Dispatcher::CommitRound(RoundCommit& commit) {
     if (!valid) {
       // Computed on a robot that has moved on (or on an award before it that was dropped):
       // later awards of the round to these robots built on it too.
-      for (const auto& w : a.award.winners) spoiled[w] = true;
+      spoiled.insert(a.record.award.winners.begin(), a.record.award.winners.end());
       round_again_ = true;
       continue;
     }
-    for (std::size_t k = 0; k < a.award.winners.size(); ++k) {
-      const std::string& w = a.award.winners[k];
+    for (std::size_t k = 0; k < a.record.award.winners.size(); ++k) {
+      const std::string& w = a.record.award.winners[k];
       auto [it, first] = work.try_emplace(w);
       Work& wk = it->second;
       if (first) {
@@ -300,10 +300,6 @@ bool Dispatcher::CommitRound(RoundCommit& commit) {
     accepted.push_back(&a);
   }
   if (accepted.empty()) return true;
-  std::vector<AllocationRecord> records;
-  for (const RoundAward* a : accepted) {
-    records.push_back({a->award, options_.allocation.alpha, options_.allocation.beta, options_.allocation.zeta, input.now});
-  }
   std::vector<storage::OrderEvent> events;
   auto committed = store_.RunInTransaction([&](storage::Store& s) -> engine::Status {
     events.clear();
@@ -313,8 +309,8 @@ bool Dispatcher::CommitRound(RoundCommit& commit) {
       t.order_id = a.order_id;
       t.to = engine::OrderState::kAssigned;
       t.time = now;
-      t.robots = a.award.winners;
-      t.detail = a.award.reason;
+      t.robots = a.record.award.winners;
+      t.detail = a.record.award.reason;
       auto e1 = s.TransitionOrder(t);
       if (!e1.ok()) return e1.error();
       events.push_back(*e1);
@@ -337,12 +333,12 @@ bool Dispatcher::CommitRound(RoundCommit& commit) {
     const RoundAward& a = *accepted[i];
     auto view = std::make_shared<OrderView>(*Find(a.order_id));
     view->record.order.state = engine::OrderState::kAssigned;
-    view->record.robots = a.award.winners;
+    view->record.robots = a.record.award.winners;
     view->record.updated_time = now;
-    view->explanation = records[i];
+    view->explanation = a.record;
     Put(view);
     if (options_.metrics) options_.metrics->ObserveAllocation(a.seconds);
-    spdlog::info("order {} assigned: {}", a.order_id, a.award.reason);
+    spdlog::info("order {} assigned: {}", a.order_id, a.record.award.reason);
   }
   for (const auto& e : events) Journal(e);
   for (auto& [id, wk] : work) {

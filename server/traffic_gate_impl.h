@@ -1,5 +1,5 @@
-// TrafficGate's state, shared by traffic_gate.cpp (solo agents) and traffic_gate_teams.cpp
-// (formations). Internal to the server; see traffic_gate.h for the model.
+// TrafficGate's state, shared by traffic_gate.cpp (plans, effects, interface),
+// traffic_gate_solo.cpp (solo agents) and traffic_gate_teams.cpp (formations). Internal to the server; see traffic_gate.h for the model.
 #pragma once
 
 #include <algorithm>
@@ -115,7 +115,7 @@ struct GateImpl {
   void SendRelease(GateBot& b, int intersection, std::vector<GateEffect>& out);
   void Hold(GateBot& b, const std::string& why, std::vector<GateEffect>& out);
 
-  // Solo agents (traffic_gate.cpp).
+  // Solo agents (traffic_gate_solo.cpp).
   bool OnFloor(const GateBot& b) const;
   bool PlaceBot(GateBot& b, engine::PointId at);
   bool PlaceNear(GateBot& b);

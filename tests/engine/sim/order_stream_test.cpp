@@ -99,15 +99,25 @@ void ExpectSafe(const StreamResult& r) {
   }
 }
 
+// 18 robots at the Chu2024 floor's stations and `count` random orders (RandomOrders, `seed`).
+struct Stream {
+  std::vector<FleetRobot> robots;
+  std::vector<Order> orders;
+};
+Stream ChuStream(const World& w, std::size_t count, std::uint64_t seed) {
+  auto robots = PlaceRobots(*w.map, 18);
+  if (!robots.ok()) throw std::runtime_error(robots.error().message);
+  RandomOrderOptions ro;
+  ro.count = count;
+  ro.seed = seed;
+  auto orders = RandomOrders(*w.map, ro);
+  if (!orders.ok()) throw std::runtime_error(orders.error().message);
+  return {std::move(robots).value(), std::move(orders).value()};
+}
+
 TEST(OrderStreamTest, StrategiesOnTwoHundredRandomOrdersOnChu2024) {
   const World w = Chu();
-  auto robots = PlaceRobots(*w.map, 18);
-  ASSERT_TRUE(robots.ok());
-  RandomOrderOptions ro;
-  ro.count = 200;
-  ro.seed = 7;
-  auto orders = RandomOrders(*w.map, ro);
-  ASSERT_TRUE(orders.ok());
+  const Stream st = ChuStream(w, 200, 7);
   std::vector<StreamResult> results;
   for (auto [strategy, zeta] : {std::pair{AllocationStrategy::kAuction, 100.0},
                                 std::pair{AllocationStrategy::kAuction, 0.0},
@@ -117,12 +127,12 @@ TEST(OrderStreamTest, StrategiesOnTwoHundredRandomOrdersOnChu2024) {
     c.allocation.zeta = zeta;
     c.max_time = 5000;
     c.check_safety = true;
-    auto r = SimulateOrderStream(w.map, w.routes, *robots, *orders, c);
+    auto r = SimulateOrderStream(w.map, w.routes, st.robots, st.orders, c);
     ASSERT_TRUE(r.ok()) << r.error().message;
     ExpectSafe(*r);
     EXPECT_TRUE(r->all_completed()) << AllocationStrategyName(strategy) << " " << zeta;
     EXPECT_TRUE(r->blocked.empty());
-    ExpectSane(w, *orders, *r, c);
+    ExpectSane(w, st.orders, *r, c);
     // Point clearance (eps1) holds on the Chu2024 floor: no two robots closer than 0.6 m.
     EXPECT_GE(r->overall_min_distance, 0.6 - 1e-9);
     EXPECT_GT(r->traffic.grants, 0u);  // the floor's intersections were used
@@ -139,18 +149,12 @@ TEST(OrderStreamTest, SelfCheckCatchesCrossingsWithoutIntersectionGrants) {
   // point clearance but enter an intersection whatever crosses it, and the run's CheckSafety
   // says so (the check above can fail).
   const World w = Chu();
-  auto robots = PlaceRobots(*w.map, 18);
-  ASSERT_TRUE(robots.ok());
-  RandomOrderOptions ro;
-  ro.count = 100;
-  ro.seed = 7;
-  auto orders = RandomOrders(*w.map, ro);
-  ASSERT_TRUE(orders.ok());
+  const Stream st = ChuStream(w, 100, 7);
   StreamConfig c;
   c.max_time = 5000;
   c.check_safety = true;
   c.traffic.intersection_grants = false;
-  auto r = SimulateOrderStream(w.map, w.routes, *robots, *orders, c);
+  auto r = SimulateOrderStream(w.map, w.routes, st.robots, st.orders, c);
   ASSERT_TRUE(r.ok()) << r.error().message;
   ASSERT_TRUE(r->safety.has_value());
   std::size_t crossings = 0;
@@ -160,15 +164,11 @@ TEST(OrderStreamTest, SelfCheckCatchesCrossingsWithoutIntersectionGrants) {
 
 TEST(OrderStreamTest, IsDeterministic) {
   const World w = Chu();
-  auto robots = PlaceRobots(*w.map, 18);
-  RandomOrderOptions ro;
-  ro.count = 40;
-  ro.seed = 3;
-  auto orders = RandomOrders(*w.map, ro);
+  const Stream st = ChuStream(w, 40, 3);
   StreamConfig c;
   c.check_safety = false;
-  auto a = SimulateOrderStream(w.map, w.routes, *robots, *orders, c);
-  auto b = SimulateOrderStream(w.map, w.routes, *robots, *orders, c);
+  auto a = SimulateOrderStream(w.map, w.routes, st.robots, st.orders, c);
+  auto b = SimulateOrderStream(w.map, w.routes, st.robots, st.orders, c);
   ASSERT_TRUE(a.ok() && b.ok());
   ASSERT_EQ(a->orders.size(), b->orders.size());
   for (std::size_t i = 0; i < a->orders.size(); ++i) {

@@ -1,0 +1,387 @@
+// TrafficGate's solo agents: placing robots on the floor, their legs (requests, adopted and
+// rewritten routes), reaching waypoints, and the minimum distance between agents. Formations
+// are in traffic_gate_teams.cpp, the public interface in traffic_gate.cpp, the shared state in
+// traffic_gate_impl.h.
+#include <algorithm>
+#include <cmath>
+#include <unordered_map>
+
+#include "engine/fleet/formation.h"
+#include "server/traffic_gate_impl.h"
+
+namespace dispatch::server {
+
+using engine::PointId;
+using engine::TrafficDecision;
+using engine::WaypointAction;
+
+// --- Solo agents --------------------------------------------------------------------------
+
+bool GateImpl::OnFloor(const GateBot& b) const { return b.ctl >= 0 && !ctl.removed(static_cast<std::size_t>(b.ctl)); }
+
+bool GateImpl::PlaceBot(GateBot& b, PointId at) {
+  if (at == engine::kNoPoint) return false;
+  if (b.ctl < 0) {
+    auto added = ctl.AddRobot(b.id, at);
+    if (!added.ok()) return false;
+    b.ctl = static_cast<int>(*added);
+  } else if (ctl.removed(static_cast<std::size_t>(b.ctl))) {
+    if (!ctl.Place(static_cast<std::size_t>(b.ctl), at).ok()) return false;
+  } else {
+    return true;
+  }
+  b.leg_stale = true;
+  b.left = false;
+  return true;
+}
+
+// Re-places a bot that is not on the floor at the free point nearest to where it is.
+bool GateImpl::PlaceNear(GateBot& b) {
+  std::vector<PointId> candidates;
+  const long n = static_cast<long>(b.plan.waypoints.size());
+  if (b.idx >= 0 && b.idx < n) candidates.push_back(b.plan.waypoints[static_cast<std::size_t>(b.idx)].point);
+  if (b.idx + 1 < n) candidates.push_back(b.plan.waypoints[static_cast<std::size_t>(b.idx + 1)].point);
+  if (b.has_xy) candidates.push_back(map->NearestPoint(b.xy));
+  if (b.ctl >= 0) {  // teammates (a formation it is in or just left) do not keep it off
+    const auto keys = TeamKeys(b);
+    ctl.SetGroup(static_cast<std::size_t>(b.ctl), keys.first.empty() ? 0 : GroupOf(keys.first),
+                 keys.second.empty() ? 0 : GroupOf(keys.second));
+  }
+  for (PointId p : candidates) {
+    if (PlaceBot(b, p)) return true;
+  }
+  return false;
+}
+
+// Rewrites b's waypoints after index `cut` (-1: a new anchor too) with moves along `route`
+// (route[0] = the point it stands at), then continues with the old waypoints from `resume`
+// on (re-sequenced and re-timed; -1: none); returns the new index of `resume` (or -1). When the old waypoint at `resume` is at the
+// route's last point it stands for that point (a stop keeps its action and dwell).
+long GateImpl::RewriteLeg(GateBot& b, long cut, const std::vector<PointId>& route, long resume, double t,
+                          std::vector<GateEffect>& out, const Offset& offset) {
+  const std::vector<engine::Waypoint> old = b.plan.waypoints;
+  const std::vector<std::string> old_orders = b.plan.order_of;
+  std::vector<engine::Waypoint> w(old.begin(), old.begin() + (cut + 1));
+  std::vector<std::string> ow(old_orders.begin(), old_orders.begin() + (cut + 1));
+  const std::uint64_t from = cut + 1 < static_cast<long>(old.size())
+                                 ? static_cast<std::uint64_t>(old[static_cast<std::size_t>(cut + 1)].seq)
+                                 : b.plan.next_sequence;
+  double clock = std::max(t, cut >= 0 ? Departure(b, cut) : t);
+  const std::string order = resume >= 0 ? old_orders[static_cast<std::size_t>(resume)] : std::string();
+  auto move = [&](PointId p, PointId prev) {
+    engine::Waypoint m;
+    m.seq = static_cast<int>(b.plan.next_sequence++);
+    m.point = p;
+    m.xy = map->point(p).position + (offset ? offset(prev, p) : Eigen::Vector2d::Zero());
+    m.eta = clock;
+    m.action = WaypointAction::kMove;
+    w.push_back(m);
+    ow.push_back(w.size() == 1 ? std::string() : order);
+  };
+  if (cut < 0) move(route.front(), route.front());  // the anchor: where it stands
+  Eigen::Vector2d at = map->point(route.front()).position;
+  for (std::size_t k = 1; k < route.size(); ++k) {
+    const Eigen::Vector2d xy = map->point(route[k]).position;
+    clock += (xy - at).norm() / std::max(1e-6, config.speed);
+    at = xy;
+    if (k + 1 == route.size() && resume >= 0 && old[static_cast<std::size_t>(resume)].point == route[k]) break;
+    move(route[k], route[k - 1]);
+  }
+  const long resumed = resume >= 0 ? static_cast<long>(w.size()) : -1;
+  if (resume >= 0) {
+    const double shift = std::max(0.0, clock - old[static_cast<std::size_t>(resume)].eta);
+    for (long i = resume; i < static_cast<long>(old.size()); ++i) {
+      engine::Waypoint m = old[static_cast<std::size_t>(i)];
+      m.seq = static_cast<int>(b.plan.next_sequence++);
+      m.eta += shift;
+      w.push_back(m);
+      ow.push_back(old_orders[static_cast<std::size_t>(i)]);
+    }
+  }
+  b.plan.waypoints = std::move(w);
+  b.plan.order_of = std::move(ow);
+  Reindex(b);
+  GateEffect e;
+  e.kind = GateEffect::Kind::kRewrite;
+  e.robot = b.id;
+  e.waypoints = b.plan.waypoints;
+  e.from_sequence = from;
+  out.push_back(std::move(e));
+  return resumed;
+}
+
+void GateImpl::Reindex(GateBot& b) {
+  b.index.clear();
+  for (std::size_t i = 0; i < b.plan.waypoints.size(); ++i) {
+    b.index[static_cast<std::uint64_t>(b.plan.waypoints[i].seq)] = i;
+    b.plan.next_sequence = std::max<std::uint64_t>(b.plan.next_sequence, b.plan.waypoints[i].seq + 1);
+  }
+  b.idx = -1;
+  for (long i = static_cast<long>(b.plan.waypoints.size()) - 1; i >= 0; --i) {
+    if (static_cast<std::uint64_t>(b.plan.waypoints[static_cast<std::size_t>(i)].seq) <= b.reached_seq) {
+      b.idx = i;
+      break;
+    }
+  }
+}
+
+// One solo agent standing or driving: releases, requests, rewrites.
+void GateImpl::StepSolo(GateBot& b, double t, std::vector<GateEffect>& out) {
+  if (!b.team.empty()) return;
+  if (!OnFloor(b)) {
+    if (!PlaceNear(b)) return;
+  }
+  const auto r = static_cast<std::size_t>(b.ctl);
+  const auto& w = b.plan.waypoints;
+  const long n = static_cast<long>(w.size());
+  // On its way to a rendezvous, or leaving one, a member may come closer to its teammates.
+  const auto keys = TeamKeys(b);
+  ctl.SetGroup(r, keys.first.empty() ? 0 : GroupOf(keys.first), keys.second.empty() ? 0 : GroupOf(keys.second));
+  const PointId next = ctl.Next(r);
+  if (next != engine::kNoPoint) {  // driving: the point behind is released once clear of it
+    // Clear of it by eps2 (Chu2024 eq. (11)): a formation may be given the point behind.
+    if (!b.left && b.has_xy &&
+        (b.xy - map->point(ctl.At(r)).position).norm() >= config.point_clearance + engine::FormationRadius()) {
+      ctl.LeftPoint(r);
+      b.left = true;
+    }
+    Release(b, RunEnd(b, b.idx + 1, next, n), map->IntersectionOf(next), out);
+    return;
+  }
+  if (!b.connected || !b.synced) return;
+  const PointId at = ctl.At(r);
+  // The run of waypoints at the point it stands on: released at once (no move needed).
+  std::string join_order;
+  const long join = NextJoin(b, b.idx, &join_order);
+  const long limit = join >= 0 ? join - 1 : n - 1;
+  const long run_end = RunEnd(b, b.idx + 1, at, limit);
+  if (run_end > b.idx) Release(b, run_end, -1, out);
+  const long here = std::max(run_end, b.idx);
+  if (b.idx < here) return;  // still to reach (or work at) the waypoints here
+  if (b.idx >= 0 && t < Departure(b, b.idx)) {
+    WakeAt(Departure(b, b.idx));  // nothing but time keeps it here
+    ctl.SetWorking(r, IsStop(w[static_cast<std::size_t>(b.idx)]), Departure(b, b.idx));
+    return;
+  }
+  ctl.SetWorking(r, false);
+  if (join >= 0 && here == join - 1) {  // at the rendezvous approach: join the team
+    JoinTeam(b, join_order, t, out);
+    return;
+  }
+  if (here + 1 >= n) {  // nothing ahead: idle
+    ctl.SetIdle(r, true);
+    bool aside = false;
+    if (!ctl.HasRoute(r) && !b.stepped_aside && blocks_service[static_cast<std::size_t>(at)]) {
+      // Out of the way of the next robot to serve here: a siding nearby, else home.
+      aside = ctl.StepAside(r, {at});
+      if (!aside && b.home != engine::kNoPoint && b.home != at) {
+        auto path = routes->Path(at, b.home);
+        aside = path.ok() && ctl.SetRoute(r, path->points).ok();
+      }
+    }
+    if (aside) {
+      b.stepped_aside = true;
+      RewriteLeg(b, here, ctl.RemainingRoute(r), -1, t, out);  // a nudge: moves appended
+      b.leg = ctl.RemainingRoute(r);
+      b.leg_stop = -1;
+      b.leg_stale = false;
+    }
+    if (!ctl.HasRoute(r)) return;
+    if (b.leg_stale || ctl.RemainingRoute(r) != b.leg) {
+      // The controller moves it (a nudge or back-off in deadlock breaking): the plan follows.
+      RewriteLeg(b, here, ctl.RemainingRoute(r), -1, t, out);
+      b.leg = ctl.RemainingRoute(r);
+      b.leg_stop = -1;
+      b.leg_stale = false;
+    }
+  } else {
+    ctl.SetIdle(r, false);
+    b.stepped_aside = false;
+  }
+  if (b.leg_stale || !ctl.HasRoute(r)) {
+    if (here + 1 < n) {
+      // The leg: from here to the next stop (or the join approach, or the plan's end).
+      long stop = here + 1;
+      while (stop < limit && !IsStop(w[static_cast<std::size_t>(stop)])) ++stop;
+      std::vector<PointId> leg{at};
+      for (long i = here + 1; i <= stop; ++i) {
+        const PointId p = w[static_cast<std::size_t>(i)].point;
+        if (p != leg.back()) leg.push_back(p);
+      }
+      const bool from_plan = here >= 0 && w[static_cast<std::size_t>(here)].point == at;
+      // An unchanged leg keeps the robot's place in the grant queues.
+      const bool same = from_plan && leg == ctl.RemainingRoute(r);
+      if (!same && (!from_plan || !ctl.SetRoute(r, leg).ok())) {
+        // The robot is not where its plan continues (restart, reconnect elsewhere, a fresh
+        // plan from another point): route from where it stands to the stop.
+        auto path = routes->Path(at, w[static_cast<std::size_t>(stop)].point);
+        if (!path.ok() || !ctl.SetRoute(r, path->points).ok()) {
+          Hold(b, "no route from '" + map->point(at).name + "' to '" +
+                      map->point(w[static_cast<std::size_t>(stop)].point).name + "'", out);
+          return;
+        }
+        stop = RewriteLeg(b, here, path->points, stop, t, out);
+      }
+      b.leg_stop = stop;
+    }
+    b.leg = ctl.RemainingRoute(r);
+    b.leg_stale = false;
+    if (!ctl.HasRoute(r)) return;
+  }
+  RequestSolo(b, t, out);
+}
+
+void GateImpl::RequestSolo(GateBot& b, double t, std::vector<GateEffect>& out) {
+  const auto r = static_cast<std::size_t>(b.ctl);
+  for (int attempt = 0; attempt < 3; ++attempt) {
+    const TrafficDecision d = ctl.Request(r, t);
+    if (d == TrafficDecision::kGo) {
+      b.left = false;
+      b.blocked = false;
+      const PointId next = ctl.Next(r);
+      Release(b, RunEnd(b, b.idx + 1, next, static_cast<long>(b.plan.waypoints.size()) - 1),
+              map->IntersectionOf(next), out);
+      return;
+    }
+    if (d == TrafficDecision::kWait) {
+      Hold(b, ctl.why(r), out);
+      return;
+    }
+    if (d == TrafficDecision::kBlocked) {
+      if (!b.blocked) {
+        b.blocked = true;
+        GateEffect e;
+        e.kind = GateEffect::Kind::kBlocked;
+        e.robot = b.id;
+        e.reason = ctl.why(r);
+        out.push_back(std::move(e));
+      }
+      Hold(b, "blocked: " + ctl.why(r), out);
+      return;
+    }
+    AdoptRoute(b, t, out);  // kReplanned: the controller's detour becomes the leg
+  }
+}
+
+// The controller changed a standing solo robot's route (detour, back-off, nudge): rewrite
+// its leg's waypoints to match. A route that ends at the leg's stop replaces the leg; one that
+// ends elsewhere (a back-off, a nudge) is driven first and the plan continues from its end.
+void GateImpl::AdoptRoute(GateBot& b, double t, std::vector<GateEffect>& out) {
+  const auto r = static_cast<std::size_t>(b.ctl);
+  const std::vector<PointId> route = ctl.RemainingRoute(r);
+  if (route == b.leg || route.size() < 2) return;
+  const long n = static_cast<long>(b.plan.waypoints.size());
+  const long here = std::max(b.idx, RunEnd(b, b.idx + 1, ctl.At(r), n - 1));
+  const long stop = b.leg_stop;
+  const bool to_stop = stop > here && stop < n &&
+                       b.plan.waypoints[static_cast<std::size_t>(stop)].point == route.back();
+  const long resume = to_stop ? stop : (here + 1 < n ? here + 1 : -1);
+  const long resumed = RewriteLeg(b, here, route, resume, t, out);
+  if (to_stop) {
+    b.leg_stop = resumed;
+    b.leg_stale = false;
+  } else {
+    b.leg_stop = -1;
+    b.leg_stale = resume >= 0;  // after the detour, route back into the plan
+  }
+  b.leg = route;
+}
+
+void GateImpl::OnReached(GateBot& b, std::uint64_t seq, double t) {
+  if (seq <= b.reached_seq) return;
+  const long i = IndexOf(b, seq);
+  b.reached_seq = seq;
+  b.reach_time = t;
+  if (i < 0) {  // not in the plan (any more): the last waypoint before it
+    Reindex(b);
+    return;
+  }
+  b.idx = i;
+  if (b.team.empty() && OnFloor(b)) {
+    const auto r = static_cast<std::size_t>(b.ctl);
+    const PointId p = b.plan.waypoints[static_cast<std::size_t>(i)].point;
+    if (p != ctl.At(r) && p != ctl.Next(r)) {
+      // Somewhere the controller did not send it (it drove on a release of the dispatcher
+      // before a restart): the controller follows the robot, and the leg is re-planned.
+      ctl.Remove(r);
+      if (!PlaceBot(b, p)) PlaceNear(b);
+      b.leg_stale = true;
+      return;
+    }
+    if (ctl.Next(r) != engine::kNoPoint && p == ctl.Next(r)) {
+      ctl.Arrived(r, t);
+      b.leg = ctl.RemainingRoute(r);
+      b.stepped_aside = false;  // idle where it arrived: may have to step aside again
+      // Out of the formation's envelope around where it left the team: one agent of its own.
+      const double envelope = config.point_clearance + engine::FormationRadius();
+      auto teammates_out = [&] {  // nobody of its former team still stands in a slot there
+        if (b.former_at == engine::kNoPoint) return true;
+        const Eigen::Vector2d& d = map->point(b.former_at).position;
+        for (const auto& [id, o] : bots) {
+          if (&o == &b || (o.former_team != b.former_team && o.team != b.former_team)) continue;
+          if (!o.has_xy || (o.xy - d).norm() < envelope - 1e-9) return false;
+        }
+        return true;
+      };
+      if (!b.former_team.empty() && !teams.count(b.former_team) &&
+          (b.former_at == engine::kNoPoint ||
+           (map->point(ctl.At(r)).position - map->point(b.former_at).position).norm() >= envelope - 1e-9) &&
+          teammates_out()) {
+        b.former_team.clear();
+        ctl.SetEnvelope(r, 0.0);
+      }
+    }
+  }
+}
+
+// --- Minimum distance ---------------------------------------------------------------------
+
+// The formation orders a robot counts as one agent with: the team it is in or approaches,
+// and the team it left at its last drop until it (and its teammates) have driven off.
+std::pair<std::string, std::string> GateImpl::TeamKeys(const GateBot& b) const {
+  if (b.team.empty() && b.former_team.empty() && b.plan.teams.empty()) return {};  // a robot alone
+  std::string current = b.team;
+  if (current.empty()) {
+    const long i = std::min<long>(b.idx + 1, static_cast<long>(b.plan.order_of.size()) - 1);
+    if (i >= 0) {
+      const std::string& o = b.plan.order_of[static_cast<std::size_t>(i)];
+      if (!o.empty() && b.plan.teams.count(o)) current = o;
+    }
+  }
+  return {current, b.former_team};
+}
+
+void GateImpl::SampleDistances(double t) {
+  struct Item {
+    const GateBot* bot;
+    std::pair<std::string, std::string> keys;
+  };
+  auto same_agent = [](const Item& a, const Item& b) {
+    for (const std::string* x : {&a.keys.first, &a.keys.second}) {
+      if (!x->empty() && (*x == b.keys.first || *x == b.keys.second)) return true;
+    }
+    return false;
+  };
+  std::unordered_map<long long, std::vector<Item>> cells;
+  auto key = [](long long x, long long y) { return (x << 32) ^ (y & 0xffffffffLL); };
+  for (auto& [id, b] : bots) {
+    if (!b.has_xy || !b.connected) continue;
+    const long long cx = static_cast<long long>(std::floor(b.xy.x()));
+    const long long cy = static_cast<long long>(std::floor(b.xy.y()));
+    const Item me{&b, TeamKeys(b)};
+    for (long long dx = -1; dx <= 1; ++dx) {
+      for (long long dy = -1; dy <= 1; ++dy) {
+        auto it = cells.find(key(cx + dx, cy + dy));
+        if (it == cells.end()) continue;
+        for (const Item& o : it->second) {
+          if (same_agent(o, me)) continue;
+          const double d = (o.bot->xy - b.xy).norm();
+          if (d < min_distance.distance) min_distance = {d, o.bot->id, b.id, t};
+        }
+      }
+    }
+    cells[key(cx, cy)].push_back(me);
+  }
+}
+
+}  // namespace dispatch::server
