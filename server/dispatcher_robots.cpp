@@ -3,6 +3,7 @@
 #include <spdlog/spdlog.h>
 
 #include <cmath>
+#include <optional>
 #include <sstream>
 
 #include "server/dispatcher.h"
@@ -237,8 +238,14 @@ void Dispatcher::DoWaypointReached(RobotRuntime& r, const RobotInbound& m) {
       r.last_xy = w[i].xy;
     }
     r.last_reached = std::max(r.last_reached, m.sequence);
-    if (gate_) gate_->Reached(r.record.robot.id, m.sequence, Now());
-    if (std::isfinite(m.pose.position.x()) && std::isfinite(m.pose.position.y())) r.record.robot.pose = m.pose;
+    // The arrival's pose is fresher than the last state report (robots report at a few Hz).
+    std::optional<Eigen::Vector2d> xy;
+    if (OnFloor(*map_, m.pose.position, options_.robot_snap_tolerance)) {
+      xy = m.pose.position;
+      r.record.robot.pose.position = m.pose.position;
+      if (std::isfinite(m.pose.heading)) r.record.robot.pose.heading = m.pose.heading;
+    }
+    if (gate_) gate_->Reached(r.record.robot.id, m.sequence, Now(), xy);
     if (w[i].action == engine::WaypointAction::kPick) {
       const std::string order = OrderOfWaypoint(r.assignment, i);
       StartOrder(order, r.record.robot.id + " reached pick '" + map_->point(w[i].point).name + "'");

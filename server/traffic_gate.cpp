@@ -219,9 +219,15 @@ void TrafficGate::SetPlan(const std::string& robot, GatePlan plan) {
   s.SyncTeams(b);
 }
 
-void TrafficGate::Reached(const std::string& robot, std::uint64_t sequence, double t) {
+void TrafficGate::Reached(const std::string& robot, std::uint64_t sequence, double t,
+                          const std::optional<Eigen::Vector2d>& xy) {
   auto it = impl_->bots.find(robot);
-  if (it != impl_->bots.end()) impl_->OnReached(it->second, sequence, t);
+  if (it == impl_->bots.end()) return;
+  if (xy) {
+    it->second.xy = *xy;
+    it->second.has_xy = true;
+  }
+  impl_->OnReached(it->second, sequence, t);
 }
 
 void TrafficGate::Report(const std::string& robot, const Eigen::Vector2d& xy, std::uint64_t last_waypoint,

@@ -114,7 +114,11 @@ class TrafficGate {
   void Disconnect(const std::string& robot);
   // The robot's plan changed (award, cancel, drop trimmed, restart).
   void SetPlan(const std::string& robot, GatePlan plan);
-  void Reached(const std::string& robot, std::uint64_t sequence, double t);
+  // The robot arrived at waypoint `sequence`; `xy`, the pose it reported with the arrival, is
+  // where it is seen from then on (a state report may be up to a report interval older, and
+  // the minimum distance must not pair one robot's fresh position with another's stale one).
+  void Reached(const std::string& robot, std::uint64_t sequence, double t,
+               const std::optional<Eigen::Vector2d>& xy = std::nullopt);
   // A state report: position and the last waypoint passed.
   void Report(const std::string& robot, const Eigen::Vector2d& xy, std::uint64_t last_waypoint,
               double t);

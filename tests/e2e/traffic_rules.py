@@ -69,7 +69,7 @@ def main():
         closest = traffic["min_robot_distance"]
         check(closest is not None, "no minimum distance measured")
         check(closest["distance"] >= EPS1 - 1e-6,
-              f"robots {closest['robots']} came {closest['distance']:.3f} m close at t = {closest['time']:.1f} s "
+              f"robots {closest['robots']} came {closest['distance']:.6f} m close at t = {closest['time']:.1f} s "
               f"(eps1 = {EPS1} m)")
 
 
