@@ -133,6 +133,12 @@ engine::Status Dispatcher::Recover() {
     r.record.robot.state = engine::RobotState::kOffline;
     r.offline_since = Clock::now();
     time_base_ = std::max(time_base_, record.last_seen);
+    // On line when the old process stopped: where it is now is known when it reports.
+    if (gate_ && record.robot.state != engine::RobotState::kOffline) {
+      awaiting_reconnect_.insert(record.robot.id);
+    } else {
+      PlaceAway(r);
+    }
     robots_.emplace(record.robot.id, std::move(r));
   }
   auto assignments = store_.ListAssignments();
@@ -146,11 +152,17 @@ engine::Status Dispatcher::Recover() {
   }
   spdlog::info("recovered {} orders, {} robots, {} assignments; dispatcher time {:.1f} s",
                orders_.size(), robots_.size(), assignments->size(), time_base_);
+  if (!awaiting_reconnect_.empty()) {
+    spdlog::info("traffic control waits up to {:.1f} s for the {} robots that were on line to report",
+                 options_.heartbeat_timeout, awaiting_reconnect_.size());
+  }
   return engine::Ok{};
 }
 
 void Dispatcher::Start() {
   if (started_.exchange(true)) return;
+  awaiting_until_ = Clock::now() + std::chrono::duration_cast<Clock::duration>(
+                                       std::chrono::duration<double>(options_.heartbeat_timeout));
   thread_ = std::thread([this] { Loop(); });
 }
 
@@ -302,6 +314,7 @@ void Dispatcher::Publish() {
     t.deadlocks_resolved = gate_->stats().deadlocks_resolved;
     t.head_on_conflicts = gate_->stats().head_on_conflicts;
     t.nudges = gate_->stats().nudges;
+    t.awaiting_reconnect.assign(awaiting_reconnect_.begin(), awaiting_reconnect_.end());
     if (std::isfinite(min_distance_.distance)) {
       t.min_distance = min_distance_.distance;
       t.min_pair_a = min_distance_.a;

@@ -42,6 +42,14 @@
 // orders go back to accepted and are re-allocated, and its in_progress orders fail (the load
 // is on a robot that is gone).
 //
+// Restart: robots stored offline are placed in the gate at their stored points (obstacles
+// until they reconnect). Robots the old process had on line may have driven on since their
+// record was written, and may still be driving to the horizon it released: until every one
+// of them has reconnected and sent a state report, or heartbeat_timeout has passed since the
+// loop started, the gate releases nothing (a robot back first must not be given a point one
+// still away stands on or drives into). Those still away then are placed at their stored
+// points; /api/v1/status lists whom the wait is for (traffic.awaiting_reconnect).
+//
 // Thread safety: the public methods are thread-safe; everything else runs on the loop thread.
 #pragma once
 
@@ -296,6 +304,12 @@ class Dispatcher {
   void DoTaskEvent(RobotRuntime& robot, const RobotInbound& message);
   void DoRobotGone(const std::shared_ptr<RobotLink>& link);
   void MarkOffline(RobotRuntime& robot, const std::string& why);
+  // Places a robot that is not connected in the gate at its stored point (an obstacle).
+  void PlaceAway(const RobotRuntime& robot);
+  // The robot reported after a restart; the wait ends when nobody is awaited any more.
+  void Reported(const std::string& robot_id);
+  // The wait after a restart is over: traffic control resumes (dispatcher_traffic.cpp).
+  void EndRecoveryWait(bool timed_out);
   void StartOrder(const std::string& order_id, const std::string& detail);
   void Tick();
   void Publish();
@@ -356,6 +370,10 @@ class Dispatcher {
   MinDistance min_distance_;
   std::unordered_map<std::string, double> order_distance_;  // metres driven, open orders
   Clock::time_point next_distance_sample_{};
+  // Restart (see the top): robots on line before it that have not reported since, and when
+  // the gate stops waiting for them.
+  std::set<std::string> awaiting_reconnect_;
+  Clock::time_point awaiting_until_{};
   struct {
     std::uint64_t grants = 0, holds = 0, replans = 0;
   } traffic_counts_;

@@ -94,6 +94,7 @@ void Dispatcher::DoRobotMessage(const std::shared_ptr<RobotLink>& link, const Ro
           numbered >= 0 && m.sequence <= static_cast<std::uint64_t>(numbered) ? m.sequence : 0;
       r->last_reached = std::max(r->last_reached, passed);
       if (gate_) gate_->Report(r->record.robot.id, m.pose.position, passed, Now());
+      if (!awaiting_reconnect_.empty()) Reported(r->record.robot.id);
       break;
     }
     case RobotInbound::Kind::kWaypointReached: DoWaypointReached(*r, m); break;

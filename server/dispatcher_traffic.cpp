@@ -42,14 +42,51 @@ std::uint64_t Dispatcher::ReleasedUpTo(const RobotRuntime& r) const {
 
 std::vector<std::pair<std::string, std::string>> Dispatcher::TrafficLines() const {
   std::vector<std::pair<std::string, std::string>> out;
+  std::string awaiting;
+  for (const auto& id : awaiting_reconnect_) awaiting += (awaiting.empty() ? "" : ", ") + id;
   for (const auto& [id, r] : robots_) {
-    out.emplace_back(id, gate_ ? gate_->Describe(id) : std::string("traffic control off"));
+    std::string line = gate_ ? gate_->Describe(id) : std::string("traffic control off");
+    if (!awaiting.empty()) line += "; nothing released until these robots report after the restart: " + awaiting;
+    out.emplace_back(id, std::move(line));
   }
   return out;
 }
 
+void Dispatcher::PlaceAway(const RobotRuntime& r) {
+  const engine::PointId p = r.record.robot.current_point;
+  if (!gate_ || p == engine::kNoPoint || static_cast<std::size_t>(p) >= map_->points().size()) return;
+  gate_->Connect(r.record.robot.id, map_->point(p).position, p);
+  gate_->Disconnect(r.record.robot.id);
+}
+
+void Dispatcher::Reported(const std::string& robot_id) {
+  if (awaiting_reconnect_.erase(robot_id) == 0) return;
+  dirty_ = true;
+  if (awaiting_reconnect_.empty()) EndRecoveryWait(false);
+}
+
+void Dispatcher::EndRecoveryWait(bool timed_out) {
+  if (timed_out) {
+    std::string away;
+    for (const auto& id : awaiting_reconnect_) {
+      away += (away.empty() ? "" : ", ") + id;
+      if (auto it = robots_.find(id); it != robots_.end() && !it->second.link) PlaceAway(it->second);
+    }
+    spdlog::warn("traffic control resumes after {:.1f} s without a report from {} (placed at their stored points)",
+                 options_.heartbeat_timeout, away);
+  } else {
+    spdlog::info("every robot that was on line before the restart has reported: traffic control resumes");
+  }
+  awaiting_reconnect_.clear();
+  dirty_ = true;
+}
+
 void Dispatcher::StepTraffic() {
   if (!gate_) return;
+  if (!awaiting_reconnect_.empty()) {  // after a restart: nothing moves until the fleet is known
+    if (Clock::now() < awaiting_until_) return;
+    EndRecoveryWait(true);
+  }
   const double now = Now();
   std::vector<GateEffect> effects = gate_->Step(now);
   for (GateEffect& e : effects) ApplyGateEffect(e);

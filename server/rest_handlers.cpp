@@ -194,6 +194,7 @@ RestReply RestHandlers::Status() const {
                   {"deadlocks_resolved", t.deadlocks_resolved},
                   {"head_on_conflicts", t.head_on_conflicts},
                   {"nudges", t.nudges},
+                  {"awaiting_reconnect", t.awaiting_reconnect},
                   {"min_robot_distance", nullptr}};
   if (t.min_distance >= 0) {
     traffic["min_robot_distance"] = {{"distance", t.min_distance},

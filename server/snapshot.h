@@ -72,6 +72,8 @@ struct TrafficView {
   double min_distance = -1.0;  // m between robot centres of different agents; < 0: none yet
   std::string min_pair_a, min_pair_b;
   double min_time = 0.0;
+  // After a restart: robots the gate waits for before it releases anything (Dispatcher).
+  std::vector<std::string> awaiting_reconnect;
 };
 
 struct Snapshot {

@@ -129,6 +129,16 @@ struct GateImpl {
   // Teams (traffic_gate_teams.cpp).
   void SyncTeams(GateBot& b);
   void JoinTeam(GateBot& b, const std::string& order, double t, std::vector<GateEffect>& out);
+  // Puts the team's agent (pooled or new) on `p`; false when the point is taken.
+  bool PlaceTeamAgent(GateTeam& team, engine::PointId p, double t);
+  // The formation order whose segment b is inside (from the rendezvous run to before the
+  // drop) while its team is still forming and b is not in it: after a restart, where the
+  // gate's teams are gone but the members' plans and positions are not.
+  std::optional<std::pair<std::string, TeamSpan>> SpanAround(const GateBot& b) const;
+  // Forms the team again there (SpanAround): in the rendezvous run as at the approach; past
+  // the first pick, once every member has reported, at the least advanced member's point.
+  void RejoinTeam(GateBot& b, const std::string& order, const TeamSpan& span, double t,
+                  std::vector<GateEffect>& out);
   void StepTeams(double t, std::vector<GateEffect>& out);
   void StepTeamsAfterDeadlocks(double t, std::vector<GateEffect>& out);
   void BreakTeam(GateTeam& team);

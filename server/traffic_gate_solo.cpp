@@ -128,6 +128,12 @@ void GateImpl::Reindex(GateBot& b) {
 // One solo agent standing or driving: releases, requests, rewrites.
 void GateImpl::StepSolo(GateBot& b, double t, std::vector<GateEffect>& out) {
   if (!b.team.empty()) return;
+  if (b.connected && b.synced && !b.plan.teams.empty()) {
+    if (auto inside = SpanAround(b)) {  // inside its formation's segment without the team
+      RejoinTeam(b, inside->first, inside->second, t, out);
+      return;
+    }
+  }
   if (!OnFloor(b)) {
     if (!PlaceNear(b)) return;
   }

@@ -94,33 +94,11 @@ void GateImpl::JoinTeam(GateBot& b, const std::string& order, double t, std::vec
   if (team.ctl < 0 || ctl.removed(static_cast<std::size_t>(team.ctl))) {
     const bool on_p = ctl.At(r) == p;
     if (on_p) ctl.Remove(r);  // it stands on the rendezvous point itself: the team takes it over
-    bool placed = false;
-    const int group = GroupOf(order);
-    if (team.ctl >= 0) {
-      ctl.SetGroup(static_cast<std::size_t>(team.ctl), group);
-      placed = ctl.Place(static_cast<std::size_t>(team.ctl), p).ok();
-    } else if (!team_pool.empty()) {
-      const std::size_t pooled = team_pool.back();
-      ctl.SetGroup(pooled, group);
-      placed = ctl.Place(pooled, p).ok();
-      if (placed) {
-        team_pool.pop_back();
-        team.ctl = static_cast<int>(pooled);
-      }
-    } else {
-      auto added = ctl.AddRobot("formation-" + std::to_string(++team_agents), p, group);
-      placed = added.ok();
-      if (placed) team.ctl = static_cast<int>(*added);
-    }
-    if (!placed) {
+    if (!PlaceTeamAgent(team, p, t)) {
       if (on_p) (void)ctl.Place(r, p);
       Hold(b, "formation " + order + ": rendezvous point '" + map->point(p).name + "' is occupied", out);
       return;
     }
-    const auto tr = static_cast<std::size_t>(team.ctl);
-    ctl.SetIdle(tr, false);
-    ctl.SetEnvelope(tr, engine::FormationRadius());
-    ctl.SetWorking(tr, true, t + 3600.0);  // assembling: never asked to yield
   }
   // Into its slot: the rendezvous run up to the formation's first pick. It keeps its point
   // until it is clear of it (StepTeams), then the team agent stands for it.
@@ -129,6 +107,93 @@ void GateImpl::JoinTeam(GateBot& b, const std::string& order, double t, std::vec
   b.leg_stale = true;
   team.joined.insert(b.id);
   (void)t;
+}
+
+bool GateImpl::PlaceTeamAgent(GateTeam& team, PointId p, double t) {
+  bool placed = false;
+  const int group = GroupOf(team.order);
+  if (team.ctl >= 0) {
+    ctl.SetGroup(static_cast<std::size_t>(team.ctl), group);
+    placed = ctl.Place(static_cast<std::size_t>(team.ctl), p).ok();
+  } else if (!team_pool.empty()) {
+    const std::size_t pooled = team_pool.back();
+    ctl.SetGroup(pooled, group);
+    placed = ctl.Place(pooled, p).ok();
+    if (placed) {
+      team_pool.pop_back();
+      team.ctl = static_cast<int>(pooled);
+    }
+  } else {
+    auto added = ctl.AddRobot("formation-" + std::to_string(++team_agents), p, group);
+    placed = added.ok();
+    if (placed) team.ctl = static_cast<int>(*added);
+  }
+  if (!placed) return false;
+  const auto tr = static_cast<std::size_t>(team.ctl);
+  ctl.SetIdle(tr, false);
+  ctl.SetEnvelope(tr, engine::FormationRadius());
+  ctl.SetWorking(tr, true, t + 3600.0);  // assembling: never asked to yield
+  return true;
+}
+
+std::optional<std::pair<std::string, GateImpl::TeamSpan>> GateImpl::SpanAround(const GateBot& b) const {
+  if (!b.team.empty() || b.plan.teams.empty() || b.idx < 0) return std::nullopt;
+  const auto n = static_cast<long>(b.plan.order_of.size());
+  const long i = std::min(b.idx + 1, n - 1);  // the waypoint it stands on or drives to
+  if (i < 0) return std::nullopt;
+  const std::string& order = b.plan.order_of[static_cast<std::size_t>(i)];
+  auto team = teams.find(order);
+  if (order.empty() || team == teams.end() || team->second.phase != GateTeam::Phase::kForming) {
+    return std::nullopt;
+  }
+  auto span = SpanOf(b, order);
+  if (!span || b.idx < span->join || b.idx >= span->drop) return std::nullopt;
+  return std::make_pair(order, *span);
+}
+
+void GateImpl::RejoinTeam(GateBot& b, const std::string& order, const TeamSpan& span, double t,
+                          std::vector<GateEffect>& out) {
+  GateTeam& team = teams.at(order);
+  if (b.idx < span.first_pick) {  // moving into its slot: it joins as it would have
+    if (!OnFloor(b) && !PlaceNear(b)) return;
+    JoinTeam(b, order, t, out);
+    return;
+  }
+  // Past the first pick the members move rigidly: every one must be back, past it too.
+  std::vector<GateBot*> members;
+  long k = -1;  // the least advanced member's formation index
+  for (const std::string& id : team.members) {
+    auto m = bots.find(id);
+    if (m == bots.end() || !m->second.connected || !m->second.synced || !m->second.team.empty()) {
+      Hold(b, "formation " + order + ": waiting for " + id + " to report", out);
+      return;
+    }
+    auto s = SpanOf(m->second, order);
+    if (!s || m->second.idx < s->first_pick || m->second.idx >= s->drop) {
+      Hold(b, "formation " + order + ": " + id + " is not in the formation's segment", out);
+      return;
+    }
+    k = k < 0 ? m->second.idx - s->first_pick : std::min(k, m->second.idx - s->first_pick);
+    members.push_back(&m->second);
+  }
+  const PointId p = b.plan.waypoints[static_cast<std::size_t>(span.first_pick + k)].point;
+  for (GateBot* m : members) {  // the team agent stands for them from now on
+    if (OnFloor(*m)) ctl.Remove(static_cast<std::size_t>(m->ctl));
+  }
+  if (!PlaceTeamAgent(team, p, t)) {
+    for (GateBot* m : members) {
+      if (!OnFloor(*m)) PlaceNear(*m);
+    }
+    Hold(b, "formation " + order + ": point '" + map->point(p).name + "' is occupied", out);
+    return;
+  }
+  for (GateBot* m : members) {
+    m->team = order;
+    m->leg_stale = true;
+    team.joined.insert(m->id);
+  }
+  spdlog::info("formation {} formed again at '{}' (its waypoint {} of {})", order, map->point(p).name, k + 1,
+               span.drop - span.first_pick + 1);
 }
 
 void GateImpl::StepTeams(double t, std::vector<GateEffect>& out) {
@@ -174,7 +239,9 @@ void GateImpl::StepTeams(double t, std::vector<GateEffect>& out) {
         continue;
       }
       team.phase = GateTeam::Phase::kMoving;
-      team.k = 0;
+      // From the first pick (formed again after a restart: where the last member is).
+      team.k = m[0].bot->idx - m[0].first_pick;
+      for (const MemberView& v : m) team.k = std::min(team.k, v.bot->idx - v.first_pick);
       team.leg_stale = true;
       ctl.SetLoaded(static_cast<std::size_t>(team.ctl), true);
     }

@@ -7,7 +7,9 @@ fleet-sim (which reconnects by itself) finds it again. Then:
     and under the same server id, none lost, none added, and none went back in its lifecycle
     or changed robots;
   - submitting the same file again returns the same orders (idempotent on client ids);
-  - every robot reconnects and every order completes.
+  - every robot reconnects and every order completes;
+  - traffic control released nothing until every robot had reported back, and no two robots
+    came closer than eps1 after the restart.
 
     durability_kill9.py --stubs DIR --dispatchd BIN --fleet-sim BIN --wmsctl BIN --scenarios DIR
 """
@@ -21,6 +23,7 @@ from e2e_harness import (ASSIGNED, COMPLETED, IN_PROGRESS, RANK, TERMINAL, Harne
 from warehouse.dispatch.v1 import orders_pb2  # noqa: E402
 
 ROBOTS = 18
+EPS1 = 0.6
 SERVER_ARGS = ["--time-scale", "10"]
 
 
@@ -109,8 +112,20 @@ def main():
         check(sorted(o.client_order_id for o in done) == sorted(acked),
               "the final order list differs from the acknowledged orders")
         check(all(o.state == COMPLETED for o in done), "ListOrders disagrees with the journal")
-        recovered = [ln for ln in server.log_text().splitlines() if "recovered" in ln]
+        log = server.log_text()
+        recovered = [ln for ln in log.splitlines() if "recovered" in ln]
         h.log("dispatchd#2: " + (recovered[0] if recovered else "(no recovery line)"))
+        for line in log.splitlines():
+            if "traffic control" in line or "formed again" in line:
+                h.log("dispatchd#2: " + line)
+        # Traffic control waited for the fleet: nothing was released until every robot that
+        # was on line had reported, and nobody came closer than eps1 after the restart.
+        check("every robot that was on line before the restart has reported" in log,
+              "dispatchd#2 never saw the whole fleet report back (or did not wait for it)")
+        closest = server.rest("/api/v1/status")["traffic"]["min_robot_distance"]
+        check(closest is None or closest["distance"] >= EPS1 - 1e-6,
+              f"after the restart robots {closest and closest['robots']} came "
+              f"{closest and closest['distance']:.6f} m close (eps1 = {EPS1} m)")
 
 
 if __name__ == "__main__":

@@ -201,8 +201,9 @@ class FakeRobot {
   }
 
   // The next message with the given body (others are skipped but remembered in `seen`).
-  std::optional<pb::ServerMessage> WaitFor(pb::ServerMessage::BodyCase body) {
-    const auto deadline = std::chrono::steady_clock::now() + kTimeout;
+  std::optional<pb::ServerMessage> WaitFor(pb::ServerMessage::BodyCase body,
+                                           std::chrono::milliseconds timeout = kTimeout) {
+    const auto deadline = std::chrono::steady_clock::now() + timeout;
     for (;;) {
       const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(deadline - std::chrono::steady_clock::now());
       if (left.count() <= 0) return std::nullopt;

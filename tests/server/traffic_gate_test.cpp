@@ -34,7 +34,29 @@ class TrafficGateTest : public ::testing::Test {
   struct Sim {
     std::vector<engine::Waypoint> plan;
     std::size_t at = 0;  // index of the waypoint it stands on
+    std::string order;   // the one order it serves
+    std::vector<std::string> team;  // its formation's members, or empty
   };
+  GatePlan GatePlanOf(const Sim& s) const {
+    GatePlan g;
+    g.waypoints = s.plan;
+    for (std::size_t i = 0; i < s.plan.size(); ++i) g.order_of.push_back(i == 0 ? "" : s.order);
+    if (!s.team.empty()) g.teams[s.order] = s.team;
+    return g;
+  }
+  // The server restarts: a new gate; every robot reconnects where it stands and reports.
+  void Restart() {
+    auto gate = TrafficGate::Create(map_, routes_, {});
+    ASSERT_TRUE(gate.ok()) << gate.error().message;
+    gate_ = std::move(gate).value();
+    for (auto& [id, s] : sims_) {
+      const engine::Waypoint& w = s.plan[s.at];
+      gate_->Connect(id, w.xy, map_->NearestPoint(w.xy));
+      gate_->SetPlan(id, GatePlanOf(s));
+      gate_->Reached(id, static_cast<std::uint64_t>(w.seq), t_, w.xy);
+      gate_->Report(id, w.xy, static_cast<std::uint64_t>(w.seq), t_);
+    }
+  }
   // A robot at station point `start` serving one order (picks, drop) from t = 0.
   void AddRobot(const std::string& id, const std::string& start, std::vector<std::string> picks,
                 const std::string& drop, const std::string& order) {
@@ -47,11 +69,9 @@ class TrafficGateTest : public ::testing::Test {
     std::vector<engine::Waypoint> plan = built->waypoints;
     for (auto& w : plan) w.seq += 1;  // sequences start at 1
     gate_->Connect(id, map_->point(P(start)).position, P(start));
-    GatePlan g;
-    g.waypoints = plan;
-    for (std::size_t i = 0; i < g.waypoints.size(); ++i) g.order_of.push_back(i == 0 ? "" : order);
-    gate_->SetPlan(id, g);
     sims_[id].plan = plan;
+    sims_[id].order = order;
+    gate_->SetPlan(id, GatePlanOf(sims_[id]));
     // It stands on its first waypoint: reached at once, as fleet-sim reports it.
     gate_->Reached(id, static_cast<std::uint64_t>(plan[0].seq), 0.0);
     gate_->Report(id, map_->point(P(start)).position, static_cast<std::uint64_t>(plan[0].seq), 0.0);
@@ -82,12 +102,10 @@ class TrafficGateTest : public ::testing::Test {
       for (auto& w : plan) w.seq += 1;
       const engine::PointId start = plan.front().point;
       gate_->Connect(id, map_->point(start).position, start);
-      GatePlan g;
-      g.waypoints = plan;
-      for (std::size_t i = 0; i < plan.size(); ++i) g.order_of.push_back(i == 0 ? "" : order);
-      g.teams[order] = award->winners;
-      gate_->SetPlan(id, g);
       sims_[id].plan = plan;
+      sims_[id].order = order;
+      sims_[id].team = award->winners;
+      gate_->SetPlan(id, GatePlanOf(sims_[id]));
     }
     for (const auto& id : award->winners) {
       const engine::Waypoint& w = sims_[id].plan.front();
@@ -96,10 +114,11 @@ class TrafficGateTest : public ::testing::Test {
     }
     team_ = award->winners;
   }
-  // Steps until every robot stands on its plan's last waypoint; false after `max_steps`.
-  // `observe` runs after every step.
-  bool Run(int max_steps, const std::function<void(double)>& observe = {}) {
-    double t = 0.0;
+  // Steps until every robot stands on its plan's last waypoint (or `until` holds); false after
+  // `max_steps`. `observe` runs after every step.
+  bool Run(int max_steps, const std::function<void(double)>& observe = {},
+           const std::function<bool()>& until = {}) {
+    double& t = t_;
     for (int step = 0; step < max_steps; ++step) {
       t += 0.1;
       for (GateEffect& e : gate_->Step(t)) {
@@ -126,7 +145,7 @@ class TrafficGateTest : public ::testing::Test {
       }
       gate_->SampleDistances(t);
       if (observe) observe(t);
-      if (done) return true;
+      if (done || (until && until())) return true;
     }
     return false;
   }
@@ -137,6 +156,7 @@ class TrafficGateTest : public ::testing::Test {
   std::map<std::string, Sim> sims_;
   int releases_ = 0;
   int report_every_ = 1;
+  double t_ = 0.0;  // the simulated time
   std::vector<std::string> team_;  // AddFormation's members, leader first
 };
 
@@ -220,6 +240,37 @@ TEST_F(TrafficGateTest, AFormationMovesAsOneAgentAndHoldsItsGrantsTogether) {
   EXPECT_TRUE(shared_grant);
   EXPECT_EQ(seen_formation.size(), 3u);
   for (const auto& id : team_) EXPECT_EQ(gate_->RobotState(id).formation, "") << id;  // dissolved
+  const MinDistance& d = gate_->min_distance();
+  EXPECT_GE(d.distance, 0.6 - 1e-9) << d.a << " and " << d.b << " at t = " << d.time;
+}
+
+TEST_F(TrafficGateTest, AFormationMovingWhenTheServerRestartsIsFormedAgainWhereItIs) {
+  // The gate's teams live in memory only: after a restart the members must not go on as three
+  // single robots (their slots are D_f off the points the controller keeps apart).
+  AddFormation({"park-P1", "park-P2", "park-P3"}, "K3-2-3N", "D-B2", "f1");
+  AddRobot("R4", "park-P4", {"K3-2-2N"}, "D-B1", "o4");
+  auto past_pick = [&](const std::string& id) {
+    const Sim& s = sims_[id];
+    std::size_t pick = 0;
+    while (pick < s.plan.size() && s.plan[pick].action != engine::WaypointAction::kPick) ++pick;
+    return static_cast<long>(s.at) - static_cast<long>(pick);
+  };
+  ASSERT_TRUE(Run(40000, {}, [&] {
+    for (const auto& id : team_) {
+      if (past_pick(id) < 3) return false;
+    }
+    return true;
+  }));
+  for (const auto& id : team_) ASSERT_LT(sims_[id].at + 1, sims_[id].plan.size()) << id << " is done already";
+  Restart();
+  bool formed_again = false;
+  ASSERT_TRUE(Run(40000, [&](double) {
+    int in_team = 0;
+    for (const auto& id : team_) in_team += gate_->RobotState(id).formation == "f1";
+    formed_again = formed_again || in_team == 3;
+  })) << gate_->Describe(team_[0]) << "\n" << gate_->Describe(team_[1]) << "\n"
+      << gate_->Describe(team_[2]) << "\n" << gate_->Describe("R4");
+  EXPECT_TRUE(formed_again);
   const MinDistance& d = gate_->min_distance();
   EXPECT_GE(d.distance, 0.6 - 1e-9) << d.a << " and " << d.b << " at t = " << d.time;
 }
