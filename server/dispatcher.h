@@ -72,16 +72,22 @@
 #include "engine/fleet/order.h"
 #include "engine/routing/route_table.h"
 #include "engine/traffic/traffic_controller.h"
+#include "engine/traffic/traffic_gate.h"
 #include "server/metrics.h"
 #include "server/robot_link.h"
 #include "server/service_status.h"
 #include "server/snapshot.h"
-#include "server/traffic_gate.h"
 #include "server/watch_hub.h"
 #include "server/worker_thread.h"
 #include "storage/store.h"
 
 namespace dispatch::server {
+
+using engine::GateEffect;
+using engine::GatePlan;
+using engine::GateRobotState;
+using engine::MinDistance;
+using engine::TrafficGate;
 
 struct DispatcherOptions {
   engine::AllocationConfig allocation;
@@ -93,8 +99,8 @@ struct DispatcherOptions {
   engine::SnapOptions snap;          // order stops
   double robot_snap_tolerance = 1.0;  // metres from a Hello pose to its nearest point
   std::string map_version;
-  // Traffic control (server/traffic_gate.h): waypoints released point by point through the
-  // engine's TrafficController. Off: every waypoint is sent released (no grants or holds).
+  // Traffic control (engine/traffic/traffic_gate.h): waypoints released point by point
+  // through the engine's TrafficController. Off: every waypoint is sent released (no grants or holds).
   bool traffic_control = true;
   engine::TrafficControllerConfig traffic;
   // Where allocation latency and grant waits are observed (optional; must outlive the

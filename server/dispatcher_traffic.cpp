@@ -1,4 +1,4 @@
-// Dispatcher: traffic control on the wire. The TrafficGate (server/traffic_gate.h) runs the
+// Dispatcher: traffic control on the wire. The TrafficGate (engine/traffic/traffic_gate.h) runs the
 // engine's TrafficController on what robots report; here its effects become Grant, Hold,
 // Resume and PlanUpdate messages, and blocked robots give their orders back.
 #include <spdlog/spdlog.h>
@@ -90,6 +90,7 @@ void Dispatcher::StepTraffic() {
   const double now = Now();
   std::vector<GateEffect> effects = gate_->Step(now);
   for (GateEffect& e : effects) ApplyGateEffect(e);
+  for (const std::string& note : gate_->TakeNotes()) spdlog::info("{}", note);
   if (const auto wall = Clock::now(); wall >= next_distance_sample_) {  // 20 Hz: reports come at ~10
     gate_->SampleDistances(now);
     next_distance_sample_ = wall + std::chrono::milliseconds(50);

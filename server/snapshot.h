@@ -60,7 +60,7 @@ struct IntersectionView {
   std::vector<std::string> waiting;
 };
 
-// The traffic layer's counters and the closest two robots seen (server/traffic_gate.h).
+// The traffic layer's counters and the closest two robots seen (engine/traffic/traffic_gate.h).
 struct TrafficView {
   bool enabled = false;
   std::uint64_t grants = 0;    // releases sent as Grant messages

@@ -295,6 +295,7 @@ class Harness(contextlib.AbstractContextManager):
                     return orders
         except grpc.RpcError as err:
             if err.code() == grpc.StatusCode.DEADLINE_EXCEEDED:
+                self.log_traffic(server)
                 raise TestFailure(f"timed out after {timeout} s waiting for {what}; last states: "
                                   + ", ".join(f"{k}={state_name(v.state)}"
                                               for k, v in sorted(orders.items())))
@@ -303,6 +304,14 @@ class Harness(contextlib.AbstractContextManager):
         finally:
             call.cancel()
         raise TestFailure(f"the watch ended before {what}")
+
+    def log_traffic(self, server):
+        """Logs every robot's traffic state (REST /api/v1/traffic), for a failure's report."""
+        try:
+            for robot, line in sorted(server.rest("/api/v1/traffic")["robots"].items()):
+                self.log(f"traffic {robot}: {line}")
+        except Exception as err:  # the report of a failure must not hide it
+            self.log(f"traffic state not readable: {err}")
 
     def wait_for(self, predicate, timeout, what, interval=0.05):
         """Polls predicate() (a real condition) until true or the deadline."""

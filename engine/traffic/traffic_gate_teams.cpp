@@ -2,18 +2,15 @@
 // formation as one agent with its envelope; grants are held for the whole formation").
 // See traffic_gate.h for the phases: forming at the rendezvous point, moving as one agent,
 // leaving the drop point one member at a time.
-#include <spdlog/spdlog.h>
-
 #include <algorithm>
 #include <cmath>
+#include <string>
 
 #include "engine/fleet/formation.h"
-#include "server/traffic_gate_impl.h"
+#include "engine/traffic/traffic_gate_impl.h"
 
-namespace dispatch::server {
+namespace dispatch::engine {
 
-using engine::PointId;
-using engine::TrafficDecision;
 
 namespace {
 
@@ -29,7 +26,7 @@ struct MemberView {
 void GateImpl::SyncTeams(GateBot& b) {
   std::set<std::string> in_plan(b.plan.order_of.begin(), b.plan.order_of.end());
   for (const auto& [order, members] : b.plan.teams) {
-    if (!in_plan.count(order) || members.size() != static_cast<std::size_t>(engine::kFormationTeamSize)) continue;
+    if (!in_plan.count(order) || members.size() != static_cast<std::size_t>(kFormationTeamSize)) continue;
     if (finished_teams.count(order)) continue;  // its drop is done (a late drop report may follow)
     GateTeam& team = teams[order];
     if (team.order.empty()) {
@@ -67,7 +64,7 @@ void GateImpl::SyncTeams(GateBot& b) {
 }
 
 void GateImpl::BreakTeam(GateTeam& team) {
-  spdlog::debug("formation {} broken up", team.order);
+  notes.push_back("formation " + team.order + " broken up");
   if (team.ctl >= 0 && !ctl.removed(static_cast<std::size_t>(team.ctl))) {
     ctl.Remove(static_cast<std::size_t>(team.ctl));
   }
@@ -78,7 +75,7 @@ void GateImpl::BreakTeam(GateTeam& team) {
     if (it == bots.end() || it->second.team != team.order) continue;
     it->second.team.clear();  // StepSolo puts it back on the floor where it stands
     it->second.former_team = team.order;
-    it->second.former_at = engine::kNoPoint;  // broken up on the way: until its next point
+    it->second.former_at = kNoPoint;  // broken up on the way: until its next point
     it->second.leg_stale = true;
   }
 }
@@ -89,9 +86,10 @@ void GateImpl::JoinTeam(GateBot& b, const std::string& order, double t, std::vec
   if (it == teams.end() || !span) return;
   GateTeam& team = it->second;
   if (team.phase != GateTeam::Phase::kForming) return;
-  const auto r = static_cast<std::size_t>(b.ctl);
   const PointId p = span->rendezvous;
   if (team.ctl < 0 || ctl.removed(static_cast<std::size_t>(team.ctl))) {
+    if (!OnFloor(b)) return;
+    const auto r = static_cast<std::size_t>(b.ctl);
     const bool on_p = ctl.At(r) == p;
     if (on_p) ctl.Remove(r);  // it stands on the rendezvous point itself: the team takes it over
     if (!PlaceTeamAgent(team, p, t)) {
@@ -131,7 +129,7 @@ bool GateImpl::PlaceTeamAgent(GateTeam& team, PointId p, double t) {
   if (!placed) return false;
   const auto tr = static_cast<std::size_t>(team.ctl);
   ctl.SetIdle(tr, false);
-  ctl.SetEnvelope(tr, engine::FormationRadius());
+  ctl.SetEnvelope(tr, FormationRadius());
   ctl.SetWorking(tr, true, t + 3600.0);  // assembling: never asked to yield
   return true;
 }
@@ -147,53 +145,88 @@ std::optional<std::pair<std::string, GateImpl::TeamSpan>> GateImpl::SpanAround(c
     return std::nullopt;
   }
   auto span = SpanOf(b, order);
-  if (!span || b.idx < span->join || b.idx >= span->drop) return std::nullopt;
+  if (!span || b.idx < span->join || b.idx > span->drop) return std::nullopt;
   return std::make_pair(order, *span);
 }
 
-void GateImpl::RejoinTeam(GateBot& b, const std::string& order, const TeamSpan& span, double t,
+bool GateImpl::RejoinTeam(GateBot& b, const std::string& order, const TeamSpan& span, double t,
                           std::vector<GateEffect>& out) {
   GateTeam& team = teams.at(order);
-  if (b.idx < span.first_pick) {  // moving into its slot: it joins as it would have
-    if (!OnFloor(b) && !PlaceNear(b)) return;
-    JoinTeam(b, order, t, out);
-    return;
-  }
-  // Past the first pick the members move rigidly: every one must be back, past it too.
-  std::vector<GateBot*> members;
-  long k = -1;  // the least advanced member's formation index
+  // Has the formation moved off its first pick (members in lockstep may be a point apart),
+  // or has a member left its drop already?
+  bool moved = false, left = false;
   for (const std::string& id : team.members) {
     auto m = bots.find(id);
-    if (m == bots.end() || !m->second.connected || !m->second.synced || !m->second.team.empty()) {
+    if (m == bots.end()) continue;
+    auto s = SpanOf(m->second, order);
+    moved = moved || (s && m->second.idx > s->first_pick);
+    left = left || (m->second.synced && (!s || m->second.idx > s->drop));
+  }
+  if (left) {  // the team was leaving its drop: the others leave as its former members
+    const PointId d = b.plan.waypoints[static_cast<std::size_t>(span.drop)].point;
+    for (const std::string& id : team.members) {
+      auto m = bots.find(id);
+      if (m == bots.end() || !m->second.team.empty()) continue;
+      m->second.former_team = order;
+      m->second.former_at = d;
+    }
+    BreakTeam(team);
+    finished_teams.insert(order);
+    teams.erase(order);
+    return false;
+  }
+  if (!moved) {  // assembling: it joins (or is in its slot already) as it would have
+    // (Near the rendezvous point the agent may hold every point it could be placed at.)
+    const bool agent_there = team.ctl >= 0 && !ctl.removed(static_cast<std::size_t>(team.ctl));
+    if (!agent_there && !OnFloor(b) && !PlaceNear(b)) return true;
+    JoinTeam(b, order, t, out);
+    return true;
+  }
+  // Moving: every member must be back, within the segment; the team agent goes to the least
+  // advanced member's point.
+  std::vector<GateBot*> members;
+  long k = -1;
+  for (const std::string& id : team.members) {
+    auto m = bots.find(id);
+    if (m == bots.end() || !m->second.connected || !m->second.synced) {
       Hold(b, "formation " + order + ": waiting for " + id + " to report", out);
-      return;
+      return true;
     }
     auto s = SpanOf(m->second, order);
-    if (!s || m->second.idx < s->first_pick || m->second.idx >= s->drop) {
+    if (!s || m->second.idx < s->first_pick || m->second.idx > s->drop) {
       Hold(b, "formation " + order + ": " + id + " is not in the formation's segment", out);
-      return;
+      return true;
     }
     k = k < 0 ? m->second.idx - s->first_pick : std::min(k, m->second.idx - s->first_pick);
     members.push_back(&m->second);
   }
   const PointId p = b.plan.waypoints[static_cast<std::size_t>(span.first_pick + k)].point;
+  std::vector<GateBot*> removed;
   for (GateBot* m : members) {  // the team agent stands for them from now on
-    if (OnFloor(*m)) ctl.Remove(static_cast<std::size_t>(m->ctl));
-  }
-  if (!PlaceTeamAgent(team, p, t)) {
-    for (GateBot* m : members) {
-      if (!OnFloor(*m)) PlaceNear(*m);
+    if (m->team.empty() && OnFloor(*m)) {
+      ctl.Remove(static_cast<std::size_t>(m->ctl));
+      removed.push_back(m);
     }
-    Hold(b, "formation " + order + ": point '" + map->point(p).name + "' is occupied", out);
-    return;
+  }
+  const bool agent_on_floor = team.ctl >= 0 && !ctl.removed(static_cast<std::size_t>(team.ctl));
+  const PointId agent_at = agent_on_floor ? ctl.At(static_cast<std::size_t>(team.ctl)) : kNoPoint;
+  if (agent_at != p) {
+    if (agent_on_floor) ctl.Remove(static_cast<std::size_t>(team.ctl));
+    if (!PlaceTeamAgent(team, p, t)) {
+      if (agent_on_floor) (void)ctl.Place(static_cast<std::size_t>(team.ctl), agent_at);
+      for (GateBot* m : removed) PlaceNear(*m);
+      Hold(b, "formation " + order + ": point '" + map->point(p).name + "' is occupied", out);
+      return true;
+    }
   }
   for (GateBot* m : members) {
     m->team = order;
     m->leg_stale = true;
     team.joined.insert(m->id);
   }
-  spdlog::info("formation {} formed again at '{}' (its waypoint {} of {})", order, map->point(p).name, k + 1,
-               span.drop - span.first_pick + 1);
+  notes.push_back("formation " + order + " formed again at '" + map->point(p).name + "' (its waypoint " +
+                  std::to_string(k + 1) + " of " + std::to_string(span.drop - span.first_pick + 1) + ")");
+  return true;
 }
 
 void GateImpl::StepTeams(double t, std::vector<GateEffect>& out) {
@@ -271,7 +304,7 @@ void GateImpl::StepTeams(double t, std::vector<GateEffect>& out) {
           return true;
         };
         const PointId next = ctl.Next(tr);
-        if (next != engine::kNoPoint) {
+        if (next != kNoPoint) {
           if (!team.left) {
             // Every member clear of the point by eps2 (Chu2024 eq. (11)): whoever is given the
             // point next (a single robot, or a formation's centre) keeps its distance.
@@ -279,7 +312,7 @@ void GateImpl::StepTeams(double t, std::vector<GateEffect>& out) {
             bool clear = true;
             for (const MemberView& v : m) {
               clear = clear && v.bot->has_xy &&
-                      (v.bot->xy - at).norm() >= config.point_clearance + engine::FormationRadius();
+                      (v.bot->xy - at).norm() >= config.point_clearance + FormationRadius();
             }
             if (clear) {
               ctl.LeftPoint(tr);
@@ -293,7 +326,7 @@ void GateImpl::StepTeams(double t, std::vector<GateEffect>& out) {
             team.leg = ctl.RemainingRoute(tr);
           }
         }
-        if (ctl.Next(tr) == engine::kNoPoint) {
+        if (ctl.Next(tr) == kNoPoint) {
           const long rk = run_end(team.k);
           release_all(rk, -1);
           double departure = 0.0;
@@ -386,7 +419,7 @@ bool GateImpl::StepLeaving(GateTeam& team, double t, std::vector<GateEffect>& ou
                    [&](const GateBot* a, const GateBot* b) { return (onward(*a) >= 0) > (onward(*b) >= 0); });
   auto back = [&](GateBot& b) {
     // Until it has left the formation's envelope it still stands in its slot, D_f off the point.
-    ctl.SetEnvelope(static_cast<std::size_t>(b.ctl), engine::FormationRadius());
+    ctl.SetEnvelope(static_cast<std::size_t>(b.ctl), FormationRadius());
     b.team.clear();
     b.former_team = team.order;
     b.former_at = d;
@@ -406,16 +439,16 @@ bool GateImpl::StepLeaving(GateTeam& team, double t, std::vector<GateEffect>& ou
   };
   for (std::size_t k = 0; k < pending.size(); ++k) {
     GateBot& b = *pending[k];
-    if (d == engine::kNoPoint) {  // no agent to leave from (e.g. after a restart): where it stands
+    if (d == kNoPoint) {  // no agent to leave from (e.g. after a restart): where it stands
       if (PlaceNear(b)) back(b);
-      spdlog::debug("formation {}: {} placed near where it stands", team.order, b.id);
+      notes.push_back("formation " + team.order + ": " + b.id + " placed near where it stands");
       continue;
     }
     const bool last = k + 1 == pending.size();
     if (last) {
       // The team agent keeps D (and its envelope over the slots) until the others have
       // driven to the points they were placed at.
-      const double envelope = config.point_clearance + engine::FormationRadius();
+      const double envelope = config.point_clearance + FormationRadius();
       for (const std::string& id : team.members) {
         const GateBot& o = bots.at(id);
         if (&o == &b || !o.team.empty()) continue;
@@ -431,13 +464,14 @@ bool GateImpl::StepLeaving(GateTeam& team, double t, std::vector<GateEffect>& ou
       if (team.ctl >= 0) team_pool.push_back(static_cast<std::size_t>(team.ctl));
       team.ctl = -1;
       back(b);
-      spdlog::debug("formation {}: {} takes '{}' over, the team is done", team.order, b.id, map->point(d).name);
+      notes.push_back("formation " + team.order + ": " + b.id + " takes '" + map->point(d).name +
+                      "' over, the team is done");
       return true;
     }
     const long j = onward(b);
-    PointId target = j >= 0 ? b.plan.waypoints[static_cast<std::size_t>(j)].point : engine::kNoPoint;
-    if (target == engine::kNoPoint) {
-      for (engine::ArcId a : map->out_arcs(d)) {
+    PointId target = j >= 0 ? b.plan.waypoints[static_cast<std::size_t>(j)].point : kNoPoint;
+    if (target == kNoPoint) {
+      for (ArcId a : map->out_arcs(d)) {
         const PointId q = map->arc(a).to;
         if (!IsServicePoint(map->point(q).kind) && map->IntersectionOf(q) < 0) {
           target = q;
@@ -445,9 +479,9 @@ bool GateImpl::StepLeaving(GateTeam& team, double t, std::vector<GateEffect>& ou
         }
       }
     }
-    if (target == engine::kNoPoint || !place(b, target)) return false;  // retried next step
-    spdlog::debug("formation {}: {} leaves '{}' for '{}' (onward waypoint {})", team.order, b.id,
-                  map->point(d).name, map->point(target).name, j);
+    if (target == kNoPoint || !place(b, target)) return false;  // retried next step
+    notes.push_back("formation " + team.order + ": " + b.id + " leaves '" + map->point(d).name + "' for '" +
+                    map->point(target).name + "' (onward waypoint " + std::to_string(j) + ")");
     long first_new = j;
     if (j < 0) {  // idle: a move to the neighbour
       RewriteLeg(b, static_cast<long>(b.plan.waypoints.size()) - 1, {d, target}, -1, t, out);
@@ -460,7 +494,7 @@ bool GateImpl::StepLeaving(GateTeam& team, double t, std::vector<GateEffect>& ou
     }
     back(b);
   }
-  return pending.empty() || d == engine::kNoPoint;
+  return pending.empty() || d == kNoPoint;
 }
 
 // A detour of a moving team (head-on, timeouts, deadlocks): every member's waypoints follow
@@ -469,7 +503,7 @@ void GateImpl::StepTeamsAfterDeadlocks(double t, std::vector<GateEffect>& out) {
   for (auto& [order, team] : teams) {
     if (team.phase != GateTeam::Phase::kMoving || team.ctl < 0) continue;
     const auto tr = static_cast<std::size_t>(team.ctl);
-    if (ctl.removed(tr) || ctl.Next(tr) != engine::kNoPoint) continue;
+    if (ctl.removed(tr) || ctl.Next(tr) != kNoPoint) continue;
     const std::vector<PointId> route = ctl.RemainingRoute(tr);
     if (route.size() < 2 || route == team.leg) continue;
     for (std::size_t i = 0; i < team.members.size(); ++i) {
@@ -492,7 +526,7 @@ void GateImpl::StepTeamsAfterDeadlocks(double t, std::vector<GateEffect>& out) {
       const Offset offset = [this, i](PointId from, PointId to) {
         const Eigen::Vector2d d = map->point(to).position - map->point(from).position;
         const double heading = d.norm() > 1e-9 ? std::atan2(d.y(), d.x()) : 0.0;
-        return engine::FormationOffsets(heading)[i];
+        return FormationOffsets(heading)[i];
       };
       RewriteLeg(bot, span->first_pick + rk, route, resume < static_cast<long>(bot.plan.waypoints.size()) ? resume : -1,
                  t, out, offset);
@@ -517,4 +551,4 @@ void GateImpl::StepTeamsAfterDeadlocks(double t, std::vector<GateEffect>& out) {
   }
 }
 
-}  // namespace dispatch::server
+}  // namespace dispatch::engine

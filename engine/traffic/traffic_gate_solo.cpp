@@ -7,20 +7,17 @@
 #include <unordered_map>
 
 #include "engine/fleet/formation.h"
-#include "server/traffic_gate_impl.h"
+#include "engine/traffic/traffic_gate_impl.h"
 
-namespace dispatch::server {
+namespace dispatch::engine {
 
-using engine::PointId;
-using engine::TrafficDecision;
-using engine::WaypointAction;
 
 // --- Solo agents --------------------------------------------------------------------------
 
 bool GateImpl::OnFloor(const GateBot& b) const { return b.ctl >= 0 && !ctl.removed(static_cast<std::size_t>(b.ctl)); }
 
 bool GateImpl::PlaceBot(GateBot& b, PointId at) {
-  if (at == engine::kNoPoint) return false;
+  if (at == kNoPoint) return false;
   if (b.ctl < 0) {
     auto added = ctl.AddRobot(b.id, at);
     if (!added.ok()) return false;
@@ -59,9 +56,9 @@ bool GateImpl::PlaceNear(GateBot& b) {
 // route's last point it stands for that point (a stop keeps its action and dwell).
 long GateImpl::RewriteLeg(GateBot& b, long cut, const std::vector<PointId>& route, long resume, double t,
                           std::vector<GateEffect>& out, const Offset& offset) {
-  const std::vector<engine::Waypoint> old = b.plan.waypoints;
+  const std::vector<Waypoint> old = b.plan.waypoints;
   const std::vector<std::string> old_orders = b.plan.order_of;
-  std::vector<engine::Waypoint> w(old.begin(), old.begin() + (cut + 1));
+  std::vector<Waypoint> w(old.begin(), old.begin() + (cut + 1));
   std::vector<std::string> ow(old_orders.begin(), old_orders.begin() + (cut + 1));
   const std::uint64_t from = cut + 1 < static_cast<long>(old.size())
                                  ? static_cast<std::uint64_t>(old[static_cast<std::size_t>(cut + 1)].seq)
@@ -69,7 +66,7 @@ long GateImpl::RewriteLeg(GateBot& b, long cut, const std::vector<PointId>& rout
   double clock = std::max(t, cut >= 0 ? Departure(b, cut) : t);
   const std::string order = resume >= 0 ? old_orders[static_cast<std::size_t>(resume)] : std::string();
   auto move = [&](PointId p, PointId prev) {
-    engine::Waypoint m;
+    Waypoint m;
     m.seq = static_cast<int>(b.plan.next_sequence++);
     m.point = p;
     m.xy = map->point(p).position + (offset ? offset(prev, p) : Eigen::Vector2d::Zero());
@@ -91,7 +88,7 @@ long GateImpl::RewriteLeg(GateBot& b, long cut, const std::vector<PointId>& rout
   if (resume >= 0) {
     const double shift = std::max(0.0, clock - old[static_cast<std::size_t>(resume)].eta);
     for (long i = resume; i < static_cast<long>(old.size()); ++i) {
-      engine::Waypoint m = old[static_cast<std::size_t>(i)];
+      Waypoint m = old[static_cast<std::size_t>(i)];
       m.seq = static_cast<int>(b.plan.next_sequence++);
       m.eta += shift;
       w.push_back(m);
@@ -130,8 +127,7 @@ void GateImpl::StepSolo(GateBot& b, double t, std::vector<GateEffect>& out) {
   if (!b.team.empty()) return;
   if (b.connected && b.synced && !b.plan.teams.empty()) {
     if (auto inside = SpanAround(b)) {  // inside its formation's segment without the team
-      RejoinTeam(b, inside->first, inside->second, t, out);
-      return;
+      if (RejoinTeam(b, inside->first, inside->second, t, out)) return;
     }
   }
   if (!OnFloor(b)) {
@@ -144,10 +140,10 @@ void GateImpl::StepSolo(GateBot& b, double t, std::vector<GateEffect>& out) {
   const auto keys = TeamKeys(b);
   ctl.SetGroup(r, keys.first.empty() ? 0 : GroupOf(keys.first), keys.second.empty() ? 0 : GroupOf(keys.second));
   const PointId next = ctl.Next(r);
-  if (next != engine::kNoPoint) {  // driving: the point behind is released once clear of it
+  if (next != kNoPoint) {  // driving: the point behind is released once clear of it
     // Clear of it by eps2 (Chu2024 eq. (11)): a formation may be given the point behind.
     if (!b.left && b.has_xy &&
-        (b.xy - map->point(ctl.At(r)).position).norm() >= config.point_clearance + engine::FormationRadius()) {
+        (b.xy - map->point(ctl.At(r)).position).norm() >= config.point_clearance + FormationRadius()) {
       ctl.LeftPoint(r);
       b.left = true;
     }
@@ -180,7 +176,7 @@ void GateImpl::StepSolo(GateBot& b, double t, std::vector<GateEffect>& out) {
     if (!ctl.HasRoute(r) && !b.stepped_aside && blocks_service[static_cast<std::size_t>(at)]) {
       // Out of the way of the next robot to serve here: a siding nearby, else home.
       aside = ctl.StepAside(r, {at});
-      if (!aside && b.home != engine::kNoPoint && b.home != at) {
+      if (!aside && b.home != kNoPoint && b.home != at) {
         auto path = routes->Path(at, b.home);
         aside = path.ok() && ctl.SetRoute(r, path->points).ok();
       }
@@ -314,14 +310,14 @@ void GateImpl::OnReached(GateBot& b, std::uint64_t seq, double t) {
       b.leg_stale = true;
       return;
     }
-    if (ctl.Next(r) != engine::kNoPoint && p == ctl.Next(r)) {
+    if (ctl.Next(r) != kNoPoint && p == ctl.Next(r)) {
       ctl.Arrived(r, t);
       b.leg = ctl.RemainingRoute(r);
       b.stepped_aside = false;  // idle where it arrived: may have to step aside again
       // Out of the formation's envelope around where it left the team: one agent of its own.
-      const double envelope = config.point_clearance + engine::FormationRadius();
+      const double envelope = config.point_clearance + FormationRadius();
       auto teammates_out = [&] {  // nobody of its former team still stands in a slot there
-        if (b.former_at == engine::kNoPoint) return true;
+        if (b.former_at == kNoPoint) return true;
         const Eigen::Vector2d& d = map->point(b.former_at).position;
         for (const auto& [id, o] : bots) {
           if (&o == &b || (o.former_team != b.former_team && o.team != b.former_team)) continue;
@@ -330,7 +326,7 @@ void GateImpl::OnReached(GateBot& b, std::uint64_t seq, double t) {
         return true;
       };
       if (!b.former_team.empty() && !teams.count(b.former_team) &&
-          (b.former_at == engine::kNoPoint ||
+          (b.former_at == kNoPoint ||
            (map->point(ctl.At(r)).position - map->point(b.former_at).position).norm() >= envelope - 1e-9) &&
           teammates_out()) {
         b.former_team.clear();
@@ -390,4 +386,4 @@ void GateImpl::SampleDistances(double t) {
   }
 }
 
-}  // namespace dispatch::server
+}  // namespace dispatch::engine

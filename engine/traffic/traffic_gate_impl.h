@@ -12,9 +12,9 @@
 #include <unordered_map>
 #include <vector>
 
-#include "server/traffic_gate.h"
+#include "engine/traffic/traffic_gate.h"
 
-namespace dispatch::server {
+namespace dispatch::engine {
 
 // One robot as the gate knows it.
 struct GateBot {
@@ -36,13 +36,13 @@ struct GateBot {
   bool resume_pending = false;  // reconnected: resend Resume if it was held
   bool blocked = false;   // kBlocked reported for the current wait
   bool stepped_aside = false;
-  engine::PointId home = engine::kNoPoint;  // the parking point it first connected at
+  PointId home = kNoPoint;  // the parking point it first connected at
   std::string team;       // the formation order whose team it has joined ("": none)
   // The team it left (at point former_at), until it has driven out of the team's envelope.
   std::string former_team;
-  engine::PointId former_at = engine::kNoPoint;
+  PointId former_at = kNoPoint;
   std::uint64_t leave_seq = 0;  // leaving a team: the waypoint it was placed at (to reach first)
-  std::vector<engine::PointId> leg;  // the controller route as last set or adopted
+  std::vector<PointId> leg;  // the controller route as last set or adopted
   long leg_stop = -1;     // plan index of the leg's last waypoint (-1: none)
   bool leg_stale = true;  // recompute the leg before the next request
 };
@@ -57,35 +57,36 @@ struct GateTeam {
   std::set<std::string> joined;
   long k = 0;        // formation index of the first waypoint of the run the team stands at
   long next_k = -1;  // formation index of the first waypoint at the point it drives to
-  std::vector<engine::PointId> leg;
+  std::vector<PointId> leg;
   long leg_stop = -1;  // formation index of the leg's stop
   bool leg_stale = true;
   bool left = false;
   bool blocked = false;
-  engine::PointId drop = engine::kNoPoint;  // where the team leaves from
+  PointId drop = kNoPoint;  // where the team leaves from
   std::map<std::string, std::uint64_t> drop_seq;  // member -> sequence of its drop waypoint
 };
 
 struct GateImpl {
   struct TeamSpan {
     long join = -1, first_pick = -1, drop = -1;
-    engine::PointId rendezvous = engine::kNoPoint;
+    PointId rendezvous = kNoPoint;
     std::uint64_t seq_first_pick = 0, seq_drop = 0;
   };
 
-  GateImpl(std::shared_ptr<const engine::WarehouseMap> map, std::shared_ptr<const engine::RouteTable> routes,
-           engine::TrafficControllerConfig config, engine::TrafficController ctl);
+  GateImpl(std::shared_ptr<const WarehouseMap> map, std::shared_ptr<const RouteTable> routes,
+           TrafficControllerConfig config, TrafficController ctl);
 
-  std::shared_ptr<const engine::WarehouseMap> map;
-  std::shared_ptr<const engine::RouteTable> routes;
-  engine::TrafficControllerConfig config;
-  engine::TrafficController ctl;
+  std::shared_ptr<const WarehouseMap> map;
+  std::shared_ptr<const RouteTable> routes;
+  TrafficControllerConfig config;
+  TrafficController ctl;
   std::map<std::string, GateBot> bots;
   std::map<std::string, GateTeam> teams;  // by formation order id
   std::set<std::string> finished_teams;   // formations that have left their drop point
   std::vector<std::size_t> team_pool;     // removed team agents, reusable
   std::size_t team_agents = 0;            // team agents ever added (their ids)
   MinDistance min_distance;
+  std::vector<std::string> notes;  // TrafficGate::TakeNotes
   // The earliest planned departure (dispatcher seconds) a standing robot or team waits for,
   // seen by the last Step: nothing else may change by then (+inf: none).
   double next_wake = std::numeric_limits<double>::infinity();
@@ -99,14 +100,14 @@ struct GateImpl {
   static long IndexOf(const GateBot& b, std::uint64_t seq);
   // Last index of the run of waypoints at point p starting at `from` (at most `limit`);
   // from - 1 when waypoint `from` is not at p.
-  static long RunEnd(const GateBot& b, long from, engine::PointId p, long limit);
+  static long RunEnd(const GateBot& b, long from, PointId p, long limit);
   double Departure(const GateBot& b, long i) const;
-  static bool IsStop(const engine::Waypoint& w);
+  static bool IsStop(const Waypoint& w);
   std::optional<TeamSpan> SpanOf(const GateBot& b, const std::string& order) const;
   long NextJoin(const GateBot& b, long from, std::string* order) const;
   void Reindex(GateBot& b);
-  using Offset = std::function<Eigen::Vector2d(engine::PointId from, engine::PointId to)>;
-  long RewriteLeg(GateBot& b, long cut, const std::vector<engine::PointId>& route, long resume, double t,
+  using Offset = std::function<Eigen::Vector2d(PointId from, PointId to)>;
+  long RewriteLeg(GateBot& b, long cut, const std::vector<PointId>& route, long resume, double t,
                   std::vector<GateEffect>& out, const Offset& offset = {});
 
   // Effects.
@@ -117,7 +118,7 @@ struct GateImpl {
 
   // Solo agents (traffic_gate_solo.cpp).
   bool OnFloor(const GateBot& b) const;
-  bool PlaceBot(GateBot& b, engine::PointId at);
+  bool PlaceBot(GateBot& b, PointId at);
   bool PlaceNear(GateBot& b);
   void StepSolo(GateBot& b, double t, std::vector<GateEffect>& out);
   void RequestSolo(GateBot& b, double t, std::vector<GateEffect>& out);
@@ -130,14 +131,17 @@ struct GateImpl {
   void SyncTeams(GateBot& b);
   void JoinTeam(GateBot& b, const std::string& order, double t, std::vector<GateEffect>& out);
   // Puts the team's agent (pooled or new) on `p`; false when the point is taken.
-  bool PlaceTeamAgent(GateTeam& team, engine::PointId p, double t);
-  // The formation order whose segment b is inside (from the rendezvous run to before the
-  // drop) while its team is still forming and b is not in it: after a restart, where the
-  // gate's teams are gone but the members' plans and positions are not.
+  bool PlaceTeamAgent(GateTeam& team, PointId p, double t);
+  // The formation order whose segment b is inside (from the rendezvous run to the drop)
+  // while its team is still forming and b is not in it: after a restart, where the gate's
+  // teams are gone but the members' plans and positions are not.
   std::optional<std::pair<std::string, TeamSpan>> SpanAround(const GateBot& b) const;
-  // Forms the team again there (SpanAround): in the rendezvous run as at the approach; past
-  // the first pick, once every member has reported, at the least advanced member's point.
-  void RejoinTeam(GateBot& b, const std::string& order, const TeamSpan& span, double t,
+  // Forms the team again there (SpanAround): while it assembles, b joins as at the approach;
+  // once it has moved off the first pick, when every member has reported, the team agent
+  // goes to the least advanced member's point (at the drop it then leaves as usual). If a
+  // member has left the drop already, the others become former members (exempt from one
+  // another until they have driven off) and b goes on alone: false.
+  bool RejoinTeam(GateBot& b, const std::string& order, const TeamSpan& span, double t,
                   std::vector<GateEffect>& out);
   void StepTeams(double t, std::vector<GateEffect>& out);
   void StepTeamsAfterDeadlocks(double t, std::vector<GateEffect>& out);
@@ -149,4 +153,4 @@ struct TrafficGate::Impl : GateImpl {
   using GateImpl::GateImpl;
 };
 
-}  // namespace dispatch::server
+}  // namespace dispatch::engine

@@ -1,28 +1,26 @@
 // TrafficGate: creation, the plan helpers and effects shared by solo agents and teams, and the
 // public interface. Solo agents are in traffic_gate_solo.cpp, formations (team agents) in
 // traffic_gate_teams.cpp, the shared state in traffic_gate_impl.h.
-#include "server/traffic_gate.h"
+#include "engine/traffic/traffic_gate.h"
 
 #include <algorithm>
 #include <cmath>
 #include <unordered_map>
+#include <utility>
 
 #include "engine/fleet/formation.h"
-#include "server/traffic_gate_impl.h"
+#include "engine/traffic/traffic_gate_impl.h"
 
-namespace dispatch::server {
+namespace dispatch::engine {
 
-using engine::PointId;
-using engine::TrafficDecision;
-using engine::WaypointAction;
 
 TrafficGate::TrafficGate(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
 TrafficGate::~TrafficGate() = default;
 
-engine::Result<std::unique_ptr<TrafficGate>> TrafficGate::Create(
-    std::shared_ptr<const engine::WarehouseMap> map, std::shared_ptr<const engine::RouteTable> routes,
-    engine::TrafficControllerConfig config) {
-  auto ctl = engine::TrafficController::Create(map, config);
+Result<std::unique_ptr<TrafficGate>> TrafficGate::Create(
+    std::shared_ptr<const WarehouseMap> map, std::shared_ptr<const RouteTable> routes,
+    TrafficControllerConfig config) {
+  auto ctl = TrafficController::Create(map, config);
   if (!ctl.ok()) return ctl.error();
   auto impl = std::make_unique<Impl>(std::move(map), std::move(routes), config, std::move(ctl).value());
   return std::unique_ptr<TrafficGate>(new TrafficGate(std::move(impl)));
@@ -30,20 +28,20 @@ engine::Result<std::unique_ptr<TrafficGate>> TrafficGate::Create(
 
 // --- Impl: plan helpers ------------------------------------------------------------------
 
-GateImpl::GateImpl(std::shared_ptr<const engine::WarehouseMap> m,
-                   std::shared_ptr<const engine::RouteTable> r, engine::TrafficControllerConfig c,
-                   engine::TrafficController controller)
+GateImpl::GateImpl(std::shared_ptr<const WarehouseMap> m,
+                   std::shared_ptr<const RouteTable> r, TrafficControllerConfig c,
+                   TrafficController controller)
     : map(std::move(m)), routes(std::move(r)), config(c), ctl(std::move(controller)) {
   // Service points by 1 m cell, then every point against the service points around it.
-  const double reach = config.point_clearance + engine::FormationRadius();
+  const double reach = config.point_clearance + FormationRadius();
   auto cell = [&](const Eigen::Vector2d& p) {
     return std::pair<long, long>{static_cast<long>(std::floor(p.x() / std::max(reach, 1e-3))),
                                  static_cast<long>(std::floor(p.y() / std::max(reach, 1e-3)))};
   };
   std::map<std::pair<long, long>, std::vector<PointId>> service;
   for (std::size_t i = 0; i < map->point_count(); ++i) {
-    const engine::Point& p = map->point(static_cast<PointId>(i));
-    if (IsServicePoint(p.kind) && p.kind != engine::PointKind::kPark) {
+    const Point& p = map->point(static_cast<PointId>(i));
+    if (IsServicePoint(p.kind) && p.kind != PointKind::kPark) {
       service[cell(p.position)].push_back(static_cast<PointId>(i));
     }
   }
@@ -80,7 +78,7 @@ long GateImpl::RunEnd(const GateBot& b, long from, PointId p, long limit) {
 
 double GateImpl::Departure(const GateBot& b, long i) const {
   if (i < 0) return 0.0;
-  const engine::Waypoint& w = b.plan.waypoints[static_cast<std::size_t>(i)];
+  const Waypoint& w = b.plan.waypoints[static_cast<std::size_t>(i)];
   double t = w.departure();
   if (i == b.idx) t = std::max(t, b.reach_time + w.dwell);
   return t;
@@ -167,7 +165,7 @@ int GateImpl::GroupOf(const std::string& order) {
   return static_cast<int>(std::hash<std::string>{}(order) & 0x3fffffff) | 1;
 }
 
-bool GateImpl::IsStop(const engine::Waypoint& w) {
+bool GateImpl::IsStop(const Waypoint& w) {
   return w.action != WaypointAction::kMove || w.dwell > 0.0;
 }
 
@@ -181,8 +179,8 @@ void TrafficGate::Connect(const std::string& robot, const Eigen::Vector2d& xy, P
   b.synced = false;
   b.resume_pending = true;  // it may still hold on a Hold from before the stream broke
   b.held = false;
-  const engine::PointKind kind = s.map->point(point).kind;
-  if (b.home == engine::kNoPoint && (kind == engine::PointKind::kPark || kind == engine::PointKind::kCharge)) {
+  const PointKind kind = s.map->point(point).kind;
+  if (b.home == kNoPoint && (kind == PointKind::kPark || kind == PointKind::kCharge)) {
     b.home = point;
   }
   b.xy = xy;
@@ -260,7 +258,7 @@ std::vector<GateEffect> TrafficGate::Step(double t) {
   for (auto& [id, b] : s.bots) {
     if (!b.team.empty() || !s.OnFloor(b) || !b.connected || b.leg_stale) continue;
     const auto r = static_cast<std::size_t>(b.ctl);
-    if (s.ctl.Next(r) == engine::kNoPoint && s.ctl.RemainingRoute(r) != b.leg) s.AdoptRoute(b, t, out);
+    if (s.ctl.Next(r) == kNoPoint && s.ctl.RemainingRoute(r) != b.leg) s.AdoptRoute(b, t, out);
   }
   s.StepTeamsAfterDeadlocks(t, out);
   return out;
@@ -280,9 +278,9 @@ bool TrafficGate::Available(const std::string& robot) const {
 PointId TrafficGate::StartPoint(const std::string& robot) const {
   const Impl& s = *impl_;
   auto it = s.bots.find(robot);
-  if (it == s.bots.end() || !it->second.team.empty() || !s.OnFloor(it->second)) return engine::kNoPoint;
+  if (it == s.bots.end() || !it->second.team.empty() || !s.OnFloor(it->second)) return kNoPoint;
   const auto r = static_cast<std::size_t>(it->second.ctl);
-  return s.ctl.Next(r) != engine::kNoPoint ? s.ctl.Next(r) : s.ctl.At(r);
+  return s.ctl.Next(r) != kNoPoint ? s.ctl.Next(r) : s.ctl.At(r);
 }
 
 std::uint64_t TrafficGate::ReleasedUpTo(const std::string& robot) const {
@@ -330,7 +328,7 @@ std::vector<GateIntersection> TrafficGate::Intersections() const {
     }
     return out;
   };
-  const engine::IntersectionGrants& grants = s.ctl.grants();
+  const IntersectionGrants& grants = s.ctl.grants();
   std::vector<GateIntersection> out(grants.guard_count());
   for (std::size_t g = 0; g < out.size(); ++g) {
     out[g].holders = robots_of(grants.Holders(g));
@@ -350,6 +348,8 @@ GateRobotState TrafficGate::RobotState(const std::string& robot) const {
 }
 
 const MinDistance& TrafficGate::min_distance() const { return impl_->min_distance; }
-const engine::TrafficStats& TrafficGate::stats() const { return impl_->ctl.stats(); }
 
-}  // namespace dispatch::server
+std::vector<std::string> TrafficGate::TakeNotes() { return std::exchange(impl_->notes, {}); }
+const TrafficStats& TrafficGate::stats() const { return impl_->ctl.stats(); }
+
+}  // namespace dispatch::engine

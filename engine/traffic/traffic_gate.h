@@ -1,5 +1,5 @@
-// TrafficGate: the engine's TrafficController (SPEC §3.5) driven by the dispatcher loop from
-// what robots report, turned into releases of their timed waypoints (issue 5 §1: waypoints
+// TrafficGate: the TrafficController (SPEC §3.5) driven from what robots report (by the
+// server's dispatcher loop), turned into releases of their timed waypoints (issue 5 §1: waypoints
 // beyond the next point are sent unreleased; a Grant releases them).
 //
 // Model. Every connected robot is an agent of the controller standing at (or driving to) a
@@ -31,7 +31,8 @@
 // approach to the rendezvous until the formation has dissolved: after the drop, until every
 // former member has driven out of the team's envelope (eps1 + D_f) around the drop point.
 //
-// Not thread-safe: one owner (the dispatcher loop).
+// Not thread-safe: one owner (the dispatcher loop). Pure: no clocks, no I/O (TakeNotes
+// hands its log lines to the owner).
 #pragma once
 
 #include <Eigen/Core>
@@ -50,7 +51,7 @@
 #include "engine/routing/route_table.h"
 #include "engine/traffic/traffic_controller.h"
 
-namespace dispatch::server {
+namespace dispatch::engine {
 
 struct GateEffect {
   enum class Kind { kRelease, kHold, kRewrite, kBlocked };
@@ -67,13 +68,13 @@ struct GateEffect {
   std::uint64_t hold_at = 0;
   // kRewrite: the robot's whole new plan (same orders and stops); waypoints from
   // from_sequence on are new.
-  std::vector<engine::Waypoint> waypoints;
+  std::vector<Waypoint> waypoints;
   std::uint64_t from_sequence = 0;
 };
 
 // A robot's plan as the dispatcher holds it.
 struct GatePlan {
-  std::vector<engine::Waypoint> waypoints;  // seq = the robot's life-long waypoint sequence
+  std::vector<Waypoint> waypoints;  // seq = the robot's life-long waypoint sequence
   std::vector<std::string> order_of;        // per waypoint: the order it serves ("" if none)
   // Formation orders among them: order id -> members, leader first.
   std::map<std::string, std::vector<std::string>> teams;
@@ -101,15 +102,15 @@ struct GateRobotState {
 
 class TrafficGate {
  public:
-  static engine::Result<std::unique_ptr<TrafficGate>> Create(
-      std::shared_ptr<const engine::WarehouseMap> map,
-      std::shared_ptr<const engine::RouteTable> routes, engine::TrafficControllerConfig config);
+  static Result<std::unique_ptr<TrafficGate>> Create(
+      std::shared_ptr<const WarehouseMap> map,
+      std::shared_ptr<const RouteTable> routes, TrafficControllerConfig config);
   ~TrafficGate();
   TrafficGate(const TrafficGate&) = delete;
   TrafficGate& operator=(const TrafficGate&) = delete;
 
   // The robot's stream is up; it stands near `xy` (nearest point `point`).
-  void Connect(const std::string& robot, const Eigen::Vector2d& xy, engine::PointId point);
+  void Connect(const std::string& robot, const Eigen::Vector2d& xy, PointId point);
   // The stream is gone: the robot keeps its place but asks for nothing.
   void Disconnect(const std::string& robot);
   // The robot's plan changed (award, cancel, drop trimmed, restart).
@@ -134,14 +135,17 @@ class TrafficGate {
   // False while the robot still stands in a finished formation's slot, waiting to leave it.
   bool Available(const std::string& robot) const;
   // Where a new plan of the robot must start: the point it drives to, or stands at.
-  engine::PointId StartPoint(const std::string& robot) const;
+  PointId StartPoint(const std::string& robot) const;
   // Highest waypoint sequence released to the robot.
   std::uint64_t ReleasedUpTo(const std::string& robot) const;
   // One entry per map intersection (index = intersection index).
   std::vector<GateIntersection> Intersections() const;
   GateRobotState RobotState(const std::string& robot) const;
   const MinDistance& min_distance() const;
-  const engine::TrafficStats& stats() const;
+  // What happened to formations since the last call (formed again, broken up, members
+  // leaving the drop), one line each, for the owner's log.
+  std::vector<std::string> TakeNotes();
+  const TrafficStats& stats() const;
   // One line on the robot's traffic state (for logs): where, route, what it waits on.
   std::string Describe(const std::string& robot) const;
 
@@ -151,4 +155,4 @@ class TrafficGate {
   std::unique_ptr<Impl> impl_;
 };
 
-}  // namespace dispatch::server
+}  // namespace dispatch::engine

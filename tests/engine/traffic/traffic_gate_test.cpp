@@ -1,7 +1,7 @@
 // TrafficGate on the Chu2024 floor with simulated robots that jump one waypoint per step as
 // far as their release allows: every plan is driven to its end, releases come point by point,
 // and robots of different agents are never given points closer than eps1.
-#include "server/traffic_gate.h"
+#include "engine/traffic/traffic_gate.h"
 
 #include <gtest/gtest.h>
 
@@ -13,26 +13,26 @@
 #include "engine/allocation/fleet_state.h"
 #include "engine/map/chu2024_floor.h"
 
-namespace dispatch::server {
+namespace dispatch::engine {
 namespace {
 
 class TrafficGateTest : public ::testing::Test {
  protected:
   void SetUp() override {
-    auto floor = engine::BuildChu2024Floor();
+    auto floor = BuildChu2024Floor();
     ASSERT_TRUE(floor.ok());
-    map_ = std::make_shared<const engine::WarehouseMap>(std::move(floor).value());
-    auto routes = engine::MakeRouteTable(map_, {});
+    map_ = std::make_shared<const WarehouseMap>(std::move(floor).value());
+    auto routes = MakeRouteTable(map_, {});
     ASSERT_TRUE(routes.ok());
-    routes_ = std::shared_ptr<const engine::RouteTable>(std::move(routes).value());
+    routes_ = std::shared_ptr<const RouteTable>(std::move(routes).value());
     auto gate = TrafficGate::Create(map_, routes_, {});
     ASSERT_TRUE(gate.ok()) << gate.error().message;
     gate_ = std::move(gate).value();
   }
-  engine::PointId P(const std::string& name) const { return *map_->FindPoint(name); }
+  PointId P(const std::string& name) const { return *map_->FindPoint(name); }
 
   struct Sim {
-    std::vector<engine::Waypoint> plan;
+    std::vector<Waypoint> plan;
     std::size_t at = 0;  // index of the waypoint it stands on
     std::string order;   // the one order it serves
     std::vector<std::string> team;  // its formation's members, or empty
@@ -50,7 +50,7 @@ class TrafficGateTest : public ::testing::Test {
     ASSERT_TRUE(gate.ok()) << gate.error().message;
     gate_ = std::move(gate).value();
     for (auto& [id, s] : sims_) {
-      const engine::Waypoint& w = s.plan[s.at];
+      const Waypoint& w = s.plan[s.at];
       gate_->Connect(id, w.xy, map_->NearestPoint(w.xy));
       gate_->SetPlan(id, GatePlanOf(s));
       gate_->Reached(id, static_cast<std::uint64_t>(w.seq), t_, w.xy);
@@ -60,13 +60,13 @@ class TrafficGateTest : public ::testing::Test {
   // A robot at station point `start` serving one order (picks, drop) from t = 0.
   void AddRobot(const std::string& id, const std::string& start, std::vector<std::string> picks,
                 const std::string& drop, const std::string& order) {
-    engine::PlanTask task;
+    PlanTask task;
     for (const auto& p : picks) task.picks.push_back(P(p));
     task.drop = P(drop);
     task.work_time = 2.0;
-    auto built = engine::BuildPlan(*map_, *routes_, P(start), 0.0, 1.0, {task});
+    auto built = BuildPlan(*map_, *routes_, P(start), 0.0, 1.0, {task});
     ASSERT_TRUE(built.ok()) << built.error().message;
-    std::vector<engine::Waypoint> plan = built->waypoints;
+    std::vector<Waypoint> plan = built->waypoints;
     for (auto& w : plan) w.seq += 1;  // sequences start at 1
     gate_->Connect(id, map_->point(P(start)).position, P(start));
     sims_[id].plan = plan;
@@ -80,27 +80,27 @@ class TrafficGateTest : public ::testing::Test {
   // rendezvous slots, then the rigid triangle to the drop), like the dispatcher's awards.
   void AddFormation(const std::vector<std::string>& starts, const std::string& pick, const std::string& drop,
                     const std::string& order) {
-    std::vector<engine::FleetRobot> robots;
+    std::vector<FleetRobot> robots;
     for (std::size_t i = 0; i < starts.size(); ++i) {
       robots.push_back({"F" + std::to_string(i + 1), P(starts[i]), 0.0});
     }
-    auto created = engine::FleetState::Create(map_, routes_, robots, {});
+    auto created = FleetState::Create(map_, routes_, robots, {});
     ASSERT_TRUE(created.ok()) << created.error().message;
-    engine::FleetState fleet = std::move(created).value();
-    engine::Order o;
+    FleetState fleet = std::move(created).value();
+    Order o;
     o.id = order;
     o.picks = {P(pick)};
     o.drop = P(drop);
     o.formation = true;
     o.work_time = 2.0;
-    engine::AuctionAllocator auction;
+    AuctionAllocator auction;
     auto award = auction.Allocate(o, fleet);
     ASSERT_TRUE(award.ok()) << award.error().message;
     ASSERT_EQ(award->winners.size(), 3u);
     for (const auto& id : award->winners) {
-      std::vector<engine::Waypoint> plan = fleet.plan(*fleet.FindRobot(id)).waypoints;
+      std::vector<Waypoint> plan = fleet.plan(*fleet.FindRobot(id)).waypoints;
       for (auto& w : plan) w.seq += 1;
-      const engine::PointId start = plan.front().point;
+      const PointId start = plan.front().point;
       gate_->Connect(id, map_->point(start).position, start);
       sims_[id].plan = plan;
       sims_[id].order = order;
@@ -108,7 +108,7 @@ class TrafficGateTest : public ::testing::Test {
       gate_->SetPlan(id, GatePlanOf(sims_[id]));
     }
     for (const auto& id : award->winners) {
-      const engine::Waypoint& w = sims_[id].plan.front();
+      const Waypoint& w = sims_[id].plan.front();
       gate_->Reached(id, static_cast<std::uint64_t>(w.seq), 0.0);
       gate_->Report(id, w.xy, static_cast<std::uint64_t>(w.seq), 0.0);
     }
@@ -132,8 +132,8 @@ class TrafficGateTest : public ::testing::Test {
         const std::uint64_t released = gate_->ReleasedUpTo(id);
         if (s.at + 1 < s.plan.size()) done = false;
         if (s.at + 1 >= s.plan.size()) continue;
-        const engine::Waypoint& here = s.plan[s.at];
-        const engine::Waypoint& next = s.plan[s.at + 1];
+        const Waypoint& here = s.plan[s.at];
+        const Waypoint& next = s.plan[s.at + 1];
         if (static_cast<std::uint64_t>(next.seq) > released || t < here.departure()) continue;
         ++s.at;
         gate_->Reached(id, static_cast<std::uint64_t>(next.seq), t, next.xy);
@@ -150,8 +150,8 @@ class TrafficGateTest : public ::testing::Test {
     return false;
   }
 
-  std::shared_ptr<const engine::WarehouseMap> map_;
-  std::shared_ptr<const engine::RouteTable> routes_;
+  std::shared_ptr<const WarehouseMap> map_;
+  std::shared_ptr<const RouteTable> routes_;
   std::unique_ptr<TrafficGate> gate_;
   std::map<std::string, Sim> sims_;
   int releases_ = 0;
@@ -252,7 +252,7 @@ TEST_F(TrafficGateTest, AFormationMovingWhenTheServerRestartsIsFormedAgainWhereI
   auto past_pick = [&](const std::string& id) {
     const Sim& s = sims_[id];
     std::size_t pick = 0;
-    while (pick < s.plan.size() && s.plan[pick].action != engine::WaypointAction::kPick) ++pick;
+    while (pick < s.plan.size() && s.plan[pick].action != WaypointAction::kPick) ++pick;
     return static_cast<long>(s.at) - static_cast<long>(pick);
   };
   ASSERT_TRUE(Run(40000, {}, [&] {
@@ -275,5 +275,39 @@ TEST_F(TrafficGateTest, AFormationMovingWhenTheServerRestartsIsFormedAgainWhereI
   EXPECT_GE(d.distance, 0.6 - 1e-9) << d.a << " and " << d.b << " at t = " << d.time;
 }
 
+TEST_F(TrafficGateTest, AFormationOrderCompletesWhateverMomentTheServerRestartsAt) {
+  // Approaching, assembling, moving, at the drop, leaving it: the restart comes at one of 60
+  // moments until the team has dissolved.
+  auto start = [&] {
+    AddFormation({"park-P1", "park-P2", "park-P3"}, "K3-2-3N", "D-B2", "f1");
+    AddRobot("R4", "park-P4", {"K3-2-2N"}, "D-B1", "o4");
+  };
+  start();
+  int steps = 0, dissolved = -1;
+  bool formed = false;
+  ASSERT_TRUE(Run(40000, [&](double) {
+    ++steps;
+    const bool in_team = gate_->RobotState(team_[0]).formation == "f1";
+    formed = formed || in_team;
+    if (formed && !in_team && dissolved < 0) dissolved = steps;
+  }));
+  ASSERT_GT(dissolved, 0);
+  for (int cut = 1; cut <= 60; ++cut) {
+    const int at = cut * dissolved / 60;
+    SCOPED_TRACE("restart at step " + std::to_string(at) + " of " + std::to_string(steps));
+    sims_.clear();
+    t_ = 0.0;
+    SetUp();
+    start();
+    int step = 0;
+    ASSERT_TRUE(Run(40000, {}, [&] { return ++step >= at; }));
+    Restart();
+    ASSERT_TRUE(Run(40000)) << gate_->Describe(team_[0]) << "\n" << gate_->Describe(team_[1]) << "\n"
+                            << gate_->Describe(team_[2]) << "\n" << gate_->Describe("R4");
+    const MinDistance& d = gate_->min_distance();
+    EXPECT_GE(d.distance, 0.6 - 1e-9) << d.a << " and " << d.b << " at t = " << d.time;
+  }
+}
+
 }  // namespace
-}  // namespace dispatch::server
+}  // namespace dispatch::engine
