@@ -55,7 +55,7 @@ engine::Result<std::unique_ptr<Dispatcher>> Dispatcher::Create(
                                                std::move(options), std::move(allocator)));
   if (d->options_.traffic_control) {
     if (auto valid = d->options_.traffic.Validate(); !valid.ok()) return valid.error();
-    auto gate = TrafficGate::Create(d->map_, d->routes_, d->options_.traffic);
+    auto gate = engine::TrafficGate::Create(d->map_, d->routes_, d->options_.traffic);
     if (!gate.ok()) return gate.error();
     d->gate_ = std::move(gate).value();
   }
@@ -294,7 +294,7 @@ void Dispatcher::Publish() {
       view.waypoints = r.assignment.plan.waypoints.size();
     }
     if (gate_) {
-      GateRobotState traffic = gate_->RobotState(id);
+      engine::GateRobotState traffic = gate_->RobotState(id);
       view.held = traffic.held;
       view.hold_reason = std::move(traffic.reason);
       view.formation = std::move(traffic.formation);

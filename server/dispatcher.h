@@ -83,12 +83,6 @@
 
 namespace dispatch::server {
 
-using engine::GateEffect;
-using engine::GatePlan;
-using engine::GateRobotState;
-using engine::MinDistance;
-using engine::TrafficGate;
-
 struct DispatcherOptions {
   engine::AllocationConfig allocation;
   std::string strategy = "auction";  // auction | greedy
@@ -316,6 +310,7 @@ class Dispatcher {
   void Reported(const std::string& robot_id);
   // The wait after a restart is over: traffic control resumes (dispatcher_traffic.cpp).
   void EndRecoveryWait(bool timed_out);
+  std::string AwaitedList() const;  // "R3, R7": the robots the wait is for
   void StartOrder(const std::string& order_id, const std::string& detail);
   void Tick();
   void Publish();
@@ -325,10 +320,10 @@ class Dispatcher {
   std::vector<ZoneView> ZoneViews(const std::map<std::string, RobotView>& robots) const;
 
   // Traffic control (dispatcher_traffic.cpp).
-  GatePlan GatePlanOf(const RobotRuntime& robot) const;
+  engine::GatePlan GatePlanOf(const RobotRuntime& robot) const;
   void SyncGate(const RobotRuntime& robot);  // tells the gate the robot's current plan
   void StepTraffic();
-  void ApplyGateEffect(GateEffect& effect);
+  void ApplyGateEffect(engine::GateEffect& effect);
   std::uint64_t ReleasedUpTo(const RobotRuntime& robot) const;
 
   const std::shared_ptr<const engine::WarehouseMap> map_;
@@ -353,7 +348,7 @@ class Dispatcher {
   // Allocation worker state (only rounds on allocation_worker_ touch it).
   std::unique_ptr<engine::Allocator> allocator_;
   // Loop-thread state (no lock: only the loop touches it after Start).
-  std::unique_ptr<TrafficGate> gate_;  // null when traffic control is off
+  std::unique_ptr<engine::TrafficGate> gate_;  // null when traffic control is off
   Clock::time_point wall_start_;
   double time_base_ = 0.0;  // dispatcher seconds at wall_start_
   std::vector<std::shared_ptr<const OrderView>> orders_;
@@ -373,7 +368,7 @@ class Dispatcher {
   bool allocation_due_ = false;  // an allocation round runs at the end of this batch
   bool round_running_ = false;   // a round is on the worker or waits to be committed
   bool round_again_ = false;     // a round became due meanwhile
-  MinDistance min_distance_;
+  engine::MinDistance min_distance_;
   std::unordered_map<std::string, double> order_distance_;  // metres driven, open orders
   Clock::time_point next_distance_sample_{};
   // Restart (see the top): robots on line before it that have not reported since, and when

@@ -231,7 +231,8 @@ void Dispatcher::DoWaypointReached(RobotRuntime& r, const RobotInbound& m) {
   for (std::size_t i = 0; i < w.size(); ++i) {
     if (static_cast<std::uint64_t>(w[i].seq) != m.sequence) continue;
     r.record.robot.current_point = w[i].point;
-    if (m.sequence > r.last_reached) {  // distance driven, for the order it serves
+    const bool fresh = m.sequence > r.last_reached;  // not a repeat of an older arrival
+    if (fresh) {  // distance driven, for the order it serves
       if (r.last_xy) {
         const std::string order = OrderOfWaypoint(r.assignment, i);
         if (!order.empty()) order_distance_[order] += (w[i].xy - *r.last_xy).norm();
@@ -239,12 +240,16 @@ void Dispatcher::DoWaypointReached(RobotRuntime& r, const RobotInbound& m) {
       r.last_xy = w[i].xy;
     }
     r.last_reached = std::max(r.last_reached, m.sequence);
-    // The arrival's pose is fresher than the last state report (robots report at a few Hz).
+    // Where it is now: a new arrival is fresher than the last state report (robots report at
+    // a few Hz). Its pose, if it is near the waypoint (a missing pose reads as (0, 0)), else
+    // the waypoint's own position.
     std::optional<Eigen::Vector2d> xy;
-    if (OnFloor(*map_, m.pose.position, options_.robot_snap_tolerance)) {
-      xy = m.pose.position;
-      r.record.robot.pose.position = m.pose.position;
-      if (std::isfinite(m.pose.heading)) r.record.robot.pose.heading = m.pose.heading;
+    if (fresh) {
+      const bool near = m.pose.position.allFinite() &&
+                        (m.pose.position - w[i].xy).norm() <= options_.robot_snap_tolerance;
+      xy = near ? m.pose.position : w[i].xy;
+      r.record.robot.pose.position = *xy;
+      if (near && std::isfinite(m.pose.heading)) r.record.robot.pose.heading = m.pose.heading;
     }
     if (gate_) gate_->Reached(r.record.robot.id, m.sequence, Now(), xy);
     if (w[i].action == engine::WaypointAction::kPick) {

@@ -9,8 +9,8 @@
 
 namespace dispatch::server {
 
-GatePlan Dispatcher::GatePlanOf(const RobotRuntime& r) const {
-  GatePlan g;
+engine::GatePlan Dispatcher::GatePlanOf(const RobotRuntime& r) const {
+  engine::GatePlan g;
   const auto& w = r.assignment.plan.waypoints;
   g.waypoints = w;
   g.order_of = OrdersOfWaypoints(r.assignment);
@@ -30,7 +30,7 @@ void Dispatcher::SyncGate(const RobotRuntime& r) {
   if (r.has_assignment) {
     gate_->SetPlan(r.record.robot.id, GatePlanOf(r));
   } else {
-    gate_->SetPlan(r.record.robot.id, GatePlan{});
+    gate_->SetPlan(r.record.robot.id, engine::GatePlan{});
   }
 }
 
@@ -42,8 +42,7 @@ std::uint64_t Dispatcher::ReleasedUpTo(const RobotRuntime& r) const {
 
 std::vector<std::pair<std::string, std::string>> Dispatcher::TrafficLines() const {
   std::vector<std::pair<std::string, std::string>> out;
-  std::string awaiting;
-  for (const auto& id : awaiting_reconnect_) awaiting += (awaiting.empty() ? "" : ", ") + id;
+  const std::string awaiting = AwaitedList();
   for (const auto& [id, r] : robots_) {
     std::string line = gate_ ? gate_->Describe(id) : std::string("traffic control off");
     if (!awaiting.empty()) line += "; nothing released until these robots report after the restart: " + awaiting;
@@ -59,6 +58,12 @@ void Dispatcher::PlaceAway(const RobotRuntime& r) {
   gate_->Disconnect(r.record.robot.id);
 }
 
+std::string Dispatcher::AwaitedList() const {
+  std::string out;
+  for (const auto& id : awaiting_reconnect_) out += (out.empty() ? "" : ", ") + id;
+  return out;
+}
+
 void Dispatcher::Reported(const std::string& robot_id) {
   if (awaiting_reconnect_.erase(robot_id) == 0) return;
   dirty_ = true;
@@ -67,13 +72,11 @@ void Dispatcher::Reported(const std::string& robot_id) {
 
 void Dispatcher::EndRecoveryWait(bool timed_out) {
   if (timed_out) {
-    std::string away;
     for (const auto& id : awaiting_reconnect_) {
-      away += (away.empty() ? "" : ", ") + id;
       if (auto it = robots_.find(id); it != robots_.end() && !it->second.link) PlaceAway(it->second);
     }
     spdlog::warn("traffic control resumes after {:.1f} s without a report from {} (placed at their stored points)",
-                 options_.heartbeat_timeout, away);
+                 options_.heartbeat_timeout, AwaitedList());
   } else {
     spdlog::info("every robot that was on line before the restart has reported: traffic control resumes");
   }
@@ -88,14 +91,14 @@ void Dispatcher::StepTraffic() {
     EndRecoveryWait(true);
   }
   const double now = Now();
-  std::vector<GateEffect> effects = gate_->Step(now);
-  for (GateEffect& e : effects) ApplyGateEffect(e);
+  std::vector<engine::GateEffect> effects = gate_->Step(now);
+  for (engine::GateEffect& e : effects) ApplyGateEffect(e);
   for (const std::string& note : gate_->TakeNotes()) spdlog::info("{}", note);
   if (const auto wall = Clock::now(); wall >= next_distance_sample_) {  // 20 Hz: reports come at ~10
     gate_->SampleDistances(now);
     next_distance_sample_ = wall + std::chrono::milliseconds(50);
   }
-  const MinDistance& d = gate_->min_distance();
+  const engine::MinDistance& d = gate_->min_distance();
   if (d.distance != min_distance_.distance || d.time != min_distance_.time) {
     if (d.distance < options_.traffic.point_clearance - 1e-6) {
       spdlog::warn("robots {} and {} {:.3f} m apart (closer than eps1): {} | {}", d.a, d.b, d.distance,
@@ -106,12 +109,12 @@ void Dispatcher::StepTraffic() {
   }
 }
 
-void Dispatcher::ApplyGateEffect(GateEffect& e) {
+void Dispatcher::ApplyGateEffect(engine::GateEffect& e) {
   RobotRuntime* r = RobotOf(e.robot);
   if (!r) return;
   dirty_ = true;  // the snapshot shows grants and holds (intersections, robots' hold state)
   switch (e.kind) {
-    case GateEffect::Kind::kRelease: {
+    case engine::GateEffect::Kind::kRelease: {
       RobotOutbound m;
       m.released_up_to = e.release_up_to;
       if (r->held_since) {
@@ -133,7 +136,7 @@ void Dispatcher::ApplyGateEffect(GateEffect& e) {
       SendTo(*r, std::move(m));
       break;
     }
-    case GateEffect::Kind::kHold: {
+    case engine::GateEffect::Kind::kHold: {
       RobotOutbound m;
       m.kind = RobotOutbound::Kind::kHold;
       m.stop_at_sequence = e.hold_at;
@@ -144,7 +147,7 @@ void Dispatcher::ApplyGateEffect(GateEffect& e) {
       SendTo(*r, std::move(m));
       break;
     }
-    case GateEffect::Kind::kRewrite: {
+    case engine::GateEffect::Kind::kRewrite: {
       storage::AssignmentRecord a = r->assignment;
       if (a.robot_id.empty()) {  // an idle robot without a stored plan sent aside
         a.robot_id = a.plan.robot_id = e.robot;
@@ -168,7 +171,7 @@ void Dispatcher::ApplyGateEffect(GateEffect& e) {
       dirty_ = true;
       break;
     }
-    case GateEffect::Kind::kBlocked: {
+    case engine::GateEffect::Kind::kBlocked: {
       spdlog::warn("robot {} blocked: {} ({})", e.robot, e.reason, gate_->Describe(e.robot));
       for (const auto& [id, other] : robots_) spdlog::debug("traffic: {}", gate_->Describe(id));
       r->record.robot.state = engine::RobotState::kFault;

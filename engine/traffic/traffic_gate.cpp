@@ -13,7 +13,6 @@
 
 namespace dispatch::engine {
 
-
 TrafficGate::TrafficGate(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
 TrafficGate::~TrafficGate() = default;
 

@@ -1,5 +1,6 @@
 // TrafficGate's state, shared by traffic_gate.cpp (plans, effects, interface),
-// traffic_gate_solo.cpp (solo agents) and traffic_gate_teams.cpp (formations). Internal to the server; see traffic_gate.h for the model.
+// traffic_gate_solo.cpp (solo agents) and traffic_gate_teams.cpp (formations). Internal to
+// the gate; see traffic_gate.h for the model.
 #pragma once
 
 #include <algorithm>
@@ -130,6 +131,7 @@ struct GateImpl {
   // Teams (traffic_gate_teams.cpp).
   void SyncTeams(GateBot& b);
   void JoinTeam(GateBot& b, const std::string& order, double t, std::vector<GateEffect>& out);
+  bool TeamAgentOnFloor(const GateTeam& team) const;
   // Puts the team's agent (pooled or new) on `p`; false when the point is taken.
   bool PlaceTeamAgent(GateTeam& team, PointId p, double t);
   // The formation order whose segment b is inside (from the rendezvous run to the drop)

@@ -11,7 +11,6 @@
 
 namespace dispatch::engine {
 
-
 // --- Solo agents --------------------------------------------------------------------------
 
 bool GateImpl::OnFloor(const GateBot& b) const { return b.ctl >= 0 && !ctl.removed(static_cast<std::size_t>(b.ctl)); }

@@ -11,7 +11,6 @@
 
 namespace dispatch::engine {
 
-
 namespace {
 
 // A member's formation index -> plan index, or -1 when its plan no longer holds the order.
@@ -104,7 +103,6 @@ void GateImpl::JoinTeam(GateBot& b, const std::string& order, double t, std::vec
   b.team = order;
   b.leg_stale = true;
   team.joined.insert(b.id);
-  (void)t;
 }
 
 bool GateImpl::PlaceTeamAgent(GateTeam& team, PointId p, double t) {
@@ -136,32 +134,45 @@ bool GateImpl::PlaceTeamAgent(GateTeam& team, PointId p, double t) {
 
 std::optional<std::pair<std::string, GateImpl::TeamSpan>> GateImpl::SpanAround(const GateBot& b) const {
   if (!b.team.empty() || b.plan.teams.empty() || b.idx < 0) return std::nullopt;
-  const auto n = static_cast<long>(b.plan.order_of.size());
-  const long i = std::min(b.idx + 1, n - 1);  // the waypoint it stands on or drives to
-  if (i < 0) return std::nullopt;
-  const std::string& order = b.plan.order_of[static_cast<std::size_t>(i)];
-  auto team = teams.find(order);
-  if (order.empty() || team == teams.end() || team->second.phase != GateTeam::Phase::kForming) {
-    return std::nullopt;
+  for (const auto& [order, members] : b.plan.teams) {
+    auto team = teams.find(order);
+    if (team == teams.end() || team->second.phase != GateTeam::Phase::kForming) continue;
+    auto span = SpanOf(b, order);
+    if (span && span->join <= b.idx && b.idx <= span->drop) return std::make_pair(order, *span);
   }
-  auto span = SpanOf(b, order);
-  if (!span || b.idx < span->join || b.idx > span->drop) return std::nullopt;
-  return std::make_pair(order, *span);
+  return std::nullopt;
+}
+
+bool GateImpl::TeamAgentOnFloor(const GateTeam& team) const {
+  return team.ctl >= 0 && !ctl.removed(static_cast<std::size_t>(team.ctl));
 }
 
 bool GateImpl::RejoinTeam(GateBot& b, const std::string& order, const TeamSpan& span, double t,
                           std::vector<GateEffect>& out) {
   GateTeam& team = teams.at(order);
-  // Has the formation moved off its first pick (members in lockstep may be a point apart),
-  // or has a member left its drop already?
-  bool moved = false, left = false;
+  struct Member {
+    GateBot* bot;
+    std::optional<TeamSpan> span;  // none: its plan no longer holds the order
+  };
+  std::vector<Member> members;
+  bool moved = false, left = false, all_back = true;
   for (const std::string& id : team.members) {
     auto m = bots.find(id);
-    if (m == bots.end()) continue;
-    auto s = SpanOf(m->second, order);
-    moved = moved || (s && m->second.idx > s->first_pick);
-    left = left || (m->second.synced && (!s || m->second.idx > s->drop));
+    if (m == bots.end() || !m->second.connected || !m->second.synced) {
+      all_back = false;
+      continue;
+    }
+    Member v{&m->second, SpanOf(m->second, order)};
+    // Off the first pick (members in lockstep may be a point apart), or off the drop.
+    moved = moved || (v.span && v.bot->idx > v.span->first_pick);
+    left = left || !v.span || v.bot->idx > v.span->drop;
+    members.push_back(v);
   }
+  auto hold = [&](const std::string& why) {
+    if (!OnFloor(b)) PlaceNear(b);  // it keeps a point meanwhile
+    Hold(b, "formation " + order + ": " + why, out);
+    return true;
+  };
   if (left) {  // the team was leaving its drop: the others leave as its former members
     const PointId d = b.plan.waypoints[static_cast<std::size_t>(span.drop)].point;
     for (const std::string& id : team.members) {
@@ -173,59 +184,66 @@ bool GateImpl::RejoinTeam(GateBot& b, const std::string& order, const TeamSpan& 
     BreakTeam(team);
     finished_teams.insert(order);
     teams.erase(order);
+    notes.push_back("formation " + order + " was leaving its drop: its members go on alone");
     return false;
   }
   if (!moved) {  // assembling: it joins (or is in its slot already) as it would have
     // (Near the rendezvous point the agent may hold every point it could be placed at.)
-    const bool agent_there = team.ctl >= 0 && !ctl.removed(static_cast<std::size_t>(team.ctl));
-    if (!agent_there && !OnFloor(b) && !PlaceNear(b)) return true;
+    if (!TeamAgentOnFloor(team) && !OnFloor(b) && !PlaceNear(b)) return true;
     JoinTeam(b, order, t, out);
     return true;
   }
-  // Moving: every member must be back, within the segment; the team agent goes to the least
-  // advanced member's point.
-  std::vector<GateBot*> members;
-  long k = -1;
-  for (const std::string& id : team.members) {
-    auto m = bots.find(id);
-    if (m == bots.end() || !m->second.connected || !m->second.synced) {
-      Hold(b, "formation " + order + ": waiting for " + id + " to report", out);
-      return true;
-    }
-    auto s = SpanOf(m->second, order);
-    if (!s || m->second.idx < s->first_pick || m->second.idx > s->drop) {
-      Hold(b, "formation " + order + ": " + id + " is not in the formation's segment", out);
-      return true;
-    }
-    k = k < 0 ? m->second.idx - s->first_pick : std::min(k, m->second.idx - s->first_pick);
-    members.push_back(&m->second);
+  // Moving: every member must be back; the team agent stands at the least advanced member's
+  // point and drives to the most advanced one's (the lockstep step they were in).
+  if (!all_back) return hold("waiting for every member to report");
+  long k = -1, k_ahead = -1;
+  for (const Member& v : members) {
+    if (v.bot->idx < v.span->first_pick) return hold(v.bot->id + " is not in the formation's segment");
+    const long mk = v.bot->idx - v.span->first_pick;
+    k = k < 0 ? mk : std::min(k, mk);
+    k_ahead = std::max(k_ahead, mk);
   }
-  const PointId p = b.plan.waypoints[static_cast<std::size_t>(span.first_pick + k)].point;
-  std::vector<GateBot*> removed;
-  for (GateBot* m : members) {  // the team agent stands for them from now on
-    if (m->team.empty() && OnFloor(*m)) {
-      ctl.Remove(static_cast<std::size_t>(m->ctl));
-      removed.push_back(m);
+  auto point_at = [&](long i) { return b.plan.waypoints[static_cast<std::size_t>(span.first_pick + i)].point; };
+  const PointId p = point_at(k);
+  const bool agent_was_on_floor = TeamAgentOnFloor(team);
+  const PointId agent_at = agent_was_on_floor ? ctl.At(static_cast<std::size_t>(team.ctl)) : kNoPoint;
+  auto undo = [&](const std::string& why) {
+    if (TeamAgentOnFloor(team)) ctl.Remove(static_cast<std::size_t>(team.ctl));
+    if (agent_was_on_floor) (void)ctl.Place(static_cast<std::size_t>(team.ctl), agent_at);
+    for (const Member& v : members) {
+      if (v.bot->team.empty() && !OnFloor(*v.bot)) PlaceNear(*v.bot);
+    }
+    return hold(why);
+  };
+  for (const Member& v : members) {  // the team agent stands for them from now on
+    if (v.bot->team.empty() && OnFloor(*v.bot)) ctl.Remove(static_cast<std::size_t>(v.bot->ctl));
+  }
+  if (agent_was_on_floor) ctl.Remove(static_cast<std::size_t>(team.ctl));
+  if (!PlaceTeamAgent(team, p, t)) return undo("point '" + map->point(p).name + "' is occupied");
+  const auto tr = static_cast<std::size_t>(team.ctl);
+  if (k_ahead > k) {  // the members ahead stand on a point the agent must hold too
+    std::vector<PointId> leg{p};
+    for (long i = k + 1; i <= k_ahead; ++i) {
+      if (point_at(i) != leg.back()) leg.push_back(point_at(i));
+    }
+    if (leg.size() > 1) {
+      ctl.SetWorking(tr, false);
+      if (!ctl.SetRoute(tr, leg).ok() || ctl.Request(tr, t) != TrafficDecision::kGo) {
+        return undo("point '" + map->point(leg[1]).name + "' is taken");
+      }
+      team.next_k = k_ahead;
+      team.leg = ctl.RemainingRoute(tr);
     }
   }
-  const bool agent_on_floor = team.ctl >= 0 && !ctl.removed(static_cast<std::size_t>(team.ctl));
-  const PointId agent_at = agent_on_floor ? ctl.At(static_cast<std::size_t>(team.ctl)) : kNoPoint;
-  if (agent_at != p) {
-    if (agent_on_floor) ctl.Remove(static_cast<std::size_t>(team.ctl));
-    if (!PlaceTeamAgent(team, p, t)) {
-      if (agent_on_floor) (void)ctl.Place(static_cast<std::size_t>(team.ctl), agent_at);
-      for (GateBot* m : removed) PlaceNear(*m);
-      Hold(b, "formation " + order + ": point '" + map->point(p).name + "' is occupied", out);
-      return true;
-    }
-  }
-  for (GateBot* m : members) {
-    m->team = order;
-    m->leg_stale = true;
-    team.joined.insert(m->id);
+  for (const Member& v : members) {
+    v.bot->team = order;
+    v.bot->leg_stale = true;
+    team.joined.insert(v.bot->id);
+    if (k_ahead > k) Release(*v.bot, v.span->first_pick + k_ahead, -1, out);  // on to the step's end
   }
   notes.push_back("formation " + order + " formed again at '" + map->point(p).name + "' (its waypoint " +
-                  std::to_string(k + 1) + " of " + std::to_string(span.drop - span.first_pick + 1) + ")");
+                  std::to_string(k + 1) + " of " + std::to_string(span.drop - span.first_pick + 1) + ")" +
+                  (k_ahead > k ? ", driving on to its waypoint " + std::to_string(k_ahead + 1) : ""));
   return true;
 }
 

@@ -1,7 +1,7 @@
 // Traffic control across a restart (Dispatcher, "Restart"): robots that were on line when the
 // old process stopped may have driven on since their stored record, so the gate releases
-// nothing until every one of them has reconnected and reported, or heartbeat_timeout has
-// passed. A robot back first is not given a point another robot, still away, may stand on.
+// nothing (no Grant, nothing released in the resent plan beyond the robot's point) until
+// every one of them has reconnected and reported, or heartbeat_timeout has passed.
 #include <gtest/gtest.h>
 
 #include <chrono>
@@ -96,6 +96,9 @@ TEST_F(RestartTrafficTest, NothingIsReleasedUntilEveryRobotThatWasOnLineHasRepor
   first.Connect(StartOf(busy).x, StartOf(busy).y);
   auto plan = first.WaitFor(pb::ServerMessage::kAssignment);
   ASSERT_TRUE(plan);
+  const auto& waypoints = plan->assignment().waypoints();
+  ASSERT_GT(waypoints.size(), 1);
+  EXPECT_LT(plan->assignment().released_up_to_sequence(), waypoints[waypoints.size() - 1].sequence());
   Report(first, StartOf(busy));
   ASSERT_TRUE(WaitForSnapshot([&](const Snapshot& s) {
     return s.traffic.awaiting_reconnect == std::vector<std::string>{other};
@@ -106,6 +109,12 @@ TEST_F(RestartTrafficTest, NothingIsReleasedUntilEveryRobotThatWasOnLineHasRepor
   second.Connect(StartOf(other).x, StartOf(other).y);
   auto welcome = second.WaitFor(pb::ServerMessage::kWelcome);
   ASSERT_TRUE(welcome);
+  // Connected is not enough: where it is counts, so the wait ends with its report.
+  ASSERT_TRUE(WaitForSnapshot([&](const Snapshot& s) {
+    auto r = s.robots.find(other);
+    return r != s.robots.end() && r->second.connected;
+  }));
+  EXPECT_EQ(server_->dispatcher().snapshot()->traffic.awaiting_reconnect, std::vector<std::string>{other});
   Report(second, StartOf(other));
   auto grant = first.WaitFor(pb::ServerMessage::kGrant);
   ASSERT_TRUE(grant) << "no release after every robot had reported";
@@ -116,9 +125,9 @@ TEST_F(RestartTrafficTest, NothingIsReleasedUntilEveryRobotThatWasOnLineHasRepor
 }
 
 TEST_F(RestartTrafficTest, ARobotThatDoesNotComeBackIsWaitedForOneHeartbeatTimeout) {
-  config_.heartbeat_timeout = 1.0;  // wall seconds
   const std::string busy = AssignAndStopWithTheFleetOnLine();
   ASSERT_FALSE(busy.empty());
+  config_.heartbeat_timeout = 1.0;  // wall seconds, from the restart on
   StartServer();
   const double restarted = server_->dispatcher().snapshot()->time;
   FakeRobot first(channel_, busy);
