@@ -8,6 +8,7 @@
 #include <map>
 
 #include "server/dispatcher.h"
+#include "server/explanation.h"
 #include "server/json_convert.h"
 
 namespace dispatch::server {
@@ -174,6 +175,7 @@ std::vector<Dispatcher::RoundAward> Dispatcher::RunRound(const RoundInput& input
     }
     a.record = {std::move(award).value(), options_.allocation.alpha, options_.allocation.beta,
                 options_.allocation.zeta, input.now};
+    KeepBestBids(a.record);
     a.detail = AllocationDetail(a.record);
     out.push_back(std::move(a));
   }

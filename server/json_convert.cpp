@@ -46,7 +46,8 @@ json RawAllocation(const AllocationRecord& a) {
   return {{"order_id", a.award.order_id}, {"strategy", a.award.strategy},
           {"alpha", a.alpha}, {"beta", a.beta}, {"zeta", a.zeta}, {"time", a.time},
           {"bids", bids}, {"companion_bids", companions}, {"winners", a.award.winners},
-          {"reason", a.award.reason}};
+          {"reason", a.award.reason}, {"bids_total", a.bids_total},
+          {"companion_bids_total", a.companion_bids_total}};
 }
 
 }  // namespace
@@ -71,6 +72,9 @@ std::optional<AllocationRecord> ParseAllocationDetail(const std::string& detail)
     for (const auto& b : j.at("companion_bids")) a.award.companion_bids.push_back(BidOf(b));
     a.award.winners = j.at("winners").get<std::vector<std::string>>();
     a.award.reason = j.at("reason").get<std::string>();
+    // (Explanations stored before the totals kept every bid.)
+    a.bids_total = j.value("bids_total", a.award.bids.size());
+    a.companion_bids_total = j.value("companion_bids_total", a.award.companion_bids.size());
     return a;
   } catch (const json::exception&) {
     return std::nullopt;

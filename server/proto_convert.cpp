@@ -260,6 +260,8 @@ void AllocationToProto(const AllocationRecord& a, const engine::WarehouseMap& ma
   out->set_zeta(a.zeta);
   for (const auto& b : a.award.bids) BidToProto(b, map, a.award.winners, out->add_bids());
   for (const auto& b : a.award.companion_bids) BidToProto(b, map, a.award.winners, out->add_companion_bids());
+  out->set_bids_total(static_cast<std::uint32_t>(a.bids_total));
+  out->set_companion_bids_total(static_cast<std::uint32_t>(a.companion_bids_total));
   for (const auto& w : a.award.winners) out->add_winner_ids(w);
   out->set_reason(a.award.reason);
   out->set_time(a.time);

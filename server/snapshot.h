@@ -25,6 +25,9 @@ struct AllocationRecord {
   double beta = 0.0;
   double zeta = 0.0;
   double time = 0.0;  // dispatcher seconds when the auction ran
+  // How many bids there were; award.bids / companion_bids keep the best (KeepBestBids).
+  std::size_t bids_total = 0;
+  std::size_t companion_bids_total = 0;
 };
 
 struct OrderView {

@@ -102,12 +102,17 @@ window.WebMap = window.WebMap || {};
     let html = `<h3>Allocation <span class="muted">${esc(a.strategy || "")} · α ${esc(a.alpha ?? "–")} · ` +
       `β ${esc(a.beta ?? "–")} · ζ ${esc(a.zeta ?? "–")} · t ${num(a.time)} s</span></h3>`;
     html += `<p class="reason">${esc(a.reason || "no reason given")}</p>`;
-    html += bidsTable(a.bids || [], new Set(companions ? all.slice(0, 1) : all), companions ? "leader bids" : "bids");
-    if (companions) html += bidsTable(companions, new Set(all.slice(1)), "companion bids (cost to reach the first pick)");
+    html += bidsTable(a.bids || [], a.bids_total, new Set(companions ? all.slice(0, 1) : all),
+                      companions ? "leader bids" : "bids");
+    if (companions) {
+      html += bidsTable(companions, a.companion_bids_total, new Set(all.slice(1)),
+                        "companion bids (cost to reach the first pick)");
+    }
     return html;
   }
 
-  function bidsTable(bids, winners, caption) {
+  // `total`: how many there were (the explanation keeps the winners' and the lowest others').
+  function bidsTable(bids, total, winners, caption) {
     const key = b => (b.reachable === false || b.priced === false ? Infinity : b.bid ?? Infinity);
     const sorted = [...bids].sort((x, y) => key(x) - key(y));
     const rows = sorted.map(b => {
@@ -118,7 +123,8 @@ window.WebMap = window.WebMap || {};
         `<td>${num(b.flow, 4)}</td><td>${note ? `<span class="muted">${note}</span>` : num(b.bid, 2)}</td>` +
         `<td class="win">${win ? "✔" : ""}</td></tr>`;
     });
-    return `<table class="bids"><caption>${esc(caption)} (${bids.length})</caption>` +
+    const count = total && total > bids.length ? `the lowest ${bids.length} of ${total}` : `${bids.length}`;
+    return `<table class="bids"><caption>${esc(caption)} (${count})</caption>` +
       `<thead><tr><th>robot</th><th title="total time">T<sub>t</sub></th><th title="driving time">T<sub>d</sub></th>` +
       `<th title="waiting time">T<sub>w</sub></th><th title="traffic flow term">F</th><th>bid</th><th title="winner">win</th></tr></thead>` +
       `<tbody>${rows.join("")}</tbody></table>`;

@@ -130,6 +130,7 @@ TEST_F(OrderFlowTest, SubmitAssignCompleteWithARobot) {
   ASSERT_TRUE(orders_->ExplainAllocation(WithDeadline(ctx), explain, &explanation).ok());
   EXPECT_EQ(explanation.strategy(), "auction");
   ASSERT_EQ(explanation.bids_size(), 1);
+  EXPECT_EQ(explanation.bids_total(), 1u);
   EXPECT_EQ(explanation.bids(0).robot_id(), "R1");
   EXPECT_TRUE(explanation.bids(0).winner());
   EXPECT_GT(explanation.bids(0).total(), 0.0);
