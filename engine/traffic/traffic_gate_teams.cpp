@@ -458,7 +458,8 @@ bool GateImpl::StepLeaving(GateTeam& team, double t, std::vector<GateEffect>& ou
   for (std::size_t k = 0; k < pending.size(); ++k) {
     GateBot& b = *pending[k];
     if (d == kNoPoint) {  // no agent to leave from (e.g. after a restart): where it stands
-      if (PlaceNear(b)) back(b);
+      if (!PlaceNear(b)) continue;  // retried next step
+      back(b);
       notes.push_back("formation " + team.order + ": " + b.id + " placed near where it stands");
       continue;
     }
@@ -512,7 +513,16 @@ bool GateImpl::StepLeaving(GateTeam& team, double t, std::vector<GateEffect>& ou
     }
     back(b);
   }
-  return pending.empty() || d == kNoPoint;
+  if (d == kNoPoint) {  // done once every member is back on the floor
+    for (const GateBot* b : pending) {
+      if (!b->team.empty()) return false;
+    }
+    if (agent_on_floor) ctl.Remove(static_cast<std::size_t>(team.ctl));
+    if (team.ctl >= 0) team_pool.push_back(static_cast<std::size_t>(team.ctl));
+    team.ctl = -1;
+    return true;
+  }
+  return pending.empty();
 }
 
 // A detour of a moving team (head-on, timeouts, deadlocks): every member's waypoints follow
