@@ -64,7 +64,7 @@ void GateImpl::SyncTeams(GateBot& b) {
 
 void GateImpl::BreakTeam(GateTeam& team) {
   notes.push_back("formation " + team.order + " broken up");
-  if (team.ctl >= 0 && !ctl.removed(static_cast<std::size_t>(team.ctl))) {
+  if (TeamAgentOnFloor(team)) {
     ctl.Remove(static_cast<std::size_t>(team.ctl));
   }
   if (team.ctl >= 0) team_pool.push_back(static_cast<std::size_t>(team.ctl));
@@ -86,7 +86,7 @@ void GateImpl::JoinTeam(GateBot& b, const std::string& order, double t, std::vec
   GateTeam& team = it->second;
   if (team.phase != GateTeam::Phase::kForming) return;
   const PointId p = span->rendezvous;
-  if (team.ctl < 0 || ctl.removed(static_cast<std::size_t>(team.ctl))) {
+  if (!TeamAgentOnFloor(team)) {
     if (!OnFloor(b)) return;
     const auto r = static_cast<std::size_t>(b.ctl);
     const bool on_p = ctl.At(r) == p;
@@ -418,7 +418,7 @@ void GateImpl::StepTeams(double t, std::vector<GateEffect>& out) {
 // takes D itself from the team agent. True when every member is back.
 bool GateImpl::StepLeaving(GateTeam& team, double t, std::vector<GateEffect>& out) {
   const int group = GroupOf(team.order);
-  const bool agent_on_floor = team.ctl >= 0 && !ctl.removed(static_cast<std::size_t>(team.ctl));
+  const bool agent_on_floor = TeamAgentOnFloor(team);
 
   const PointId d = team.drop;
   std::vector<GateBot*> pending;
