@@ -14,18 +14,12 @@
 
 #include "tests/storage/sqlite_test_support.h"
 
-namespace dispatch::storage {
+// In the helpers' namespace (sqlite_test_support.h).
+namespace dispatch::storage::testing {
 namespace {
 
 using engine::ErrorCode;
 using engine::OrderState;
-using testing::FastOptions;
-using testing::MakeOrder;
-using testing::OpenOrDie;
-using testing::RawExec;
-using testing::RawQuery;
-using testing::SqliteStoreTest;
-using testing::TempDir;
 
 TEST_F(SqliteStoreTest, ReadersOnAnotherConnectionAreNotBlockedByAnOpenWrite) {
   auto writer = OpenOrDie(db_path());
@@ -296,4 +290,4 @@ TEST_F(SqliteStoreTest, RandomOperationsMatchAnInMemoryModel) {
 }
 
 }  // namespace
-}  // namespace dispatch::storage
+}  // namespace dispatch::storage::testing

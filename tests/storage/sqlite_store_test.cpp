@@ -12,18 +12,12 @@
 #include "storage/migrations.h"
 #include "tests/storage/sqlite_test_support.h"
 
-namespace dispatch::storage {
+// In the helpers' namespace (sqlite_test_support.h).
+namespace dispatch::storage::testing {
 namespace {
 
 using engine::ErrorCode;
 using engine::OrderState;
-using testing::FastOptions;
-using testing::MakeOrder;
-using testing::OpenOrDie;
-using testing::RawExec;
-using testing::RawQuery;
-using testing::SqliteStoreTest;
-using testing::TempDir;
 
 TEST_F(SqliteStoreTest, MigratesAnEmptyFileInOrderAndReopenIsIdempotent) {
   const int latest = static_cast<int>(Migrations().size());
@@ -388,4 +382,4 @@ TEST_F(SqliteStoreTest, ListOrdersPagesWithAStateFilter) {
 }
 
 }  // namespace
-}  // namespace dispatch::storage
+}  // namespace dispatch::storage::testing
