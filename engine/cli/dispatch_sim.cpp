@@ -2,10 +2,11 @@
 //   dispatch-sim plan --table ../shared/scenarios/chu2024-table1.csv --rules both --csv fig8.csv
 //       allocate a task table with the auction on the Chu2024 floor (R1..R18), execute the
 //       timed plans with the Chu2024 rules off and/or on (seed 000 Fig. 8, Tables 3-4).
-//   dispatch-sim stream --map chu2024 --robots 18 (--orders FILE | --random 200 --seed 1)
-//       [--strategy auction|greedy] [--zeta 100] [--csv series.csv] [--orders-csv out.csv]
-//       [--check-safety]
-//       an order stream with release times under the online traffic controller.
+//   dispatch-sim stream --map chu2024 --robots 18 (--orders FILE | --random 200 --seed 1
+//       [--formations 0.2]) [--strategy auction|greedy] [--zeta 100] [--csv series.csv]
+//       [--orders-csv out.csv] [--check-safety]
+//       an order stream with release times (formation orders too) under the online traffic
+//       controller.
 //   dispatch-sim compare [--random 200 --seed 1 --robots 18 --map chu2024]
 //       auction zeta=100, auction zeta=0 and greedy on one random stream (issue 4 §4).
 //   dispatch-sim headon
@@ -144,7 +145,7 @@ struct StreamArgs {
   std::string map = "chu2024", orders, csv, orders_csv, strategy = "auction";
   std::size_t robots = 18, random = 0;
   std::uint64_t seed = 1;
-  double interval = 2.0, zeta = 100.0, dt = 0.1, max_time = 36000.0;
+  double interval = 2.0, zeta = 100.0, dt = 0.1, max_time = 36000.0, formations = 0.0;
   bool check_safety = false;
 };
 
@@ -175,6 +176,7 @@ Result<Setup> Prepare(const StreamArgs& a) {
     ro.count = a.random;
     ro.seed = a.seed;
     ro.interval = a.interval;
+    ro.formation_share = a.formations;
     auto orders = RandomOrders(*s.map, ro);
     if (!orders.ok()) return orders.error();
     s.orders = std::move(orders).value();
@@ -233,9 +235,11 @@ int RunStream(const StreamArgs& a) {
   if (!a.orders_csv.empty()) {
     std::ofstream out(a.orders_csv);
     if (!out) return Fail("cannot write " + a.orders_csv);
-    out << "order,robot,release,completion,completed,failure\n";
+    out << "order,robots,release,completion,completed,failure\n";
     for (const StreamOrderOutcome& o : r->orders) {
-      out << o.order_id << ',' << o.robot << ',' << o.release_time << ',';
+      std::string robots = o.robot;  // a formation: its members, leader first
+      for (std::size_t k = 1; k < o.team.size(); ++k) robots += ' ' + o.team[k];
+      out << o.order_id << ',' << robots << ',' << o.release_time << ',';
       if (o.completed) out << o.completion_time;
       out << ',' << (o.completed ? 1 : 0) << ",\"" << o.failure << "\"\n";
     }
@@ -317,6 +321,8 @@ int Main(int argc, char** argv) {
     c->add_option("--random", a.random, "Random orders instead of a table");
     c->add_option("--seed", a.seed, "Seed of the random orders")->capture_default_str();
     c->add_option("--interval", a.interval, "Mean seconds between random releases")->capture_default_str();
+    c->add_option("--formations", a.formations, "Share of random orders that are formation orders")
+        ->capture_default_str()->check(CLI::Range(0.0, 1.0));
     c->add_option("--dt", a.dt, "Time step, s")->capture_default_str()->check(CLI::PositiveNumber);
     c->add_option("--max-time", a.max_time, "Simulated seconds before giving up")->capture_default_str();
     c->add_flag("--check-safety", a.check_safety,

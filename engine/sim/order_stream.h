@@ -18,8 +18,20 @@
 //     sampled with a spatial hash (pairs farther apart than `distance_cap` are not measured).
 // A blocked robot (TrafficController::kBlocked) leaves the floor as faulted; its orders fail
 // with the controller's reason. Orders the strategy cannot allocate fail with its error.
-// Formation orders are not supported here (kInvalidArgument): they run in the plan simulator
-// (simulator.h).
+//
+// Formation orders (Chu2024 §3.2, issue 4 §3; order_stream_teams.cpp, the model of
+// TrafficGate's teams): the strategy awards three robots. Once all three have the order first
+// in their queues each leaves for the first pick P so as to arrive with the slowest (until
+// then it waits like an idle robot); the first to stand on P hands it to the team's agent (one
+// controller agent with the formation's envelope D_f: eps2 to singles, eps3 to formations) and
+// the others join from the point before P, each driving into its slot of the triangle (eq. (9)).
+// Then the agent serves the order like one robot, every grant and point held for the whole
+// formation, the members rigidly in their slots (turning in place about the centre before an
+// arc with a new heading), and after the drop the members go back to the controller one at a
+// time. Members count as one agent (distance series, CheckSafety groups) from their approach
+// until each is eps1 from its former mates. A formation that cannot form (a member blocked,
+// its order failed) breaks up; a blocked formation's order fails and its members leave it
+// where it stands, as at a drop.
 //
 // Cost per step: O(robots) plus allocation at release steps and Dijkstra on detours.
 // Pure function of its inputs (no clocks, no randomness); thread-safe.
@@ -65,15 +77,18 @@ struct StreamConfig {
   bool record_series = true;            // times / min_distance per step
   double distance_cap = 2.0;            // m: spatial-hash cell; farther pairs not measured
   // The run checks itself (as the plan simulator does, simulator.h): every step's robot
-  // positions go through CheckSafety with eps1 = traffic.point_clearance (no formations here:
-  // every robot is its own agent), into StreamResult::safety. On by default in debug builds;
-  // it keeps every step's positions, so long release-build runs leave it off.
+  // positions go through CheckSafety with eps1 = traffic.point_clearance (eps2, eps3 add the
+  // formation's D_f), into StreamResult::safety. On by default in debug builds; it keeps every
+  // step's positions, so long release-build runs leave it off.
   bool check_safety = kCheckSafetyByDefault;
+  // Every step's robot positions (with their agents and groups) in StreamResult::frames.
+  bool record_frames = false;
 };
 
 struct StreamOrderOutcome {
   std::string order_id;
-  std::string robot;
+  std::string robot;              // the robot (a formation's leader)
+  std::vector<std::string> team;  // a formation's three members, leader first
   double release_time = 0.0;
   double completion_time = 0.0;  // end of the drop's work
   bool completed = false;
@@ -97,6 +112,7 @@ struct StreamResult {
   double overall_min_distance = std::numeric_limits<double>::infinity();
   std::size_t steps = 0;
   std::optional<SafetyReport> safety;  // when StreamConfig::check_safety
+  std::vector<SafetyFrame> frames;     // when StreamConfig::record_frames
   bool all_completed() const { return completed == orders.size(); }
 };
 

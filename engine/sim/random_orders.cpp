@@ -13,6 +13,9 @@ Result<std::vector<Order>> RandomOrders(const WarehouseMap& map, const RandomOrd
   if (!std::isfinite(options.work_time) || options.work_time <= 0) {
     return InvalidArgument("random orders: work_time must be finite and > 0");
   }
+  if (!(options.formation_share >= 0 && options.formation_share <= 1)) {
+    return InvalidArgument("random orders: formation_share must be in [0, 1]");
+  }
   std::vector<PointId> picks, drops;
   for (std::size_t p = 0; p < map.point_count(); ++p) {
     const PointKind kind = map.points()[p].kind;
@@ -35,6 +38,8 @@ Result<std::vector<Order>> RandomOrders(const WarehouseMap& map, const RandomOrd
     o.drop = drops[below(drops.size())];
     if (o.drop == o.picks.front() && drops.size() > 1) o.drop = drops[(below(drops.size() - 1) + 1) % drops.size()];
     o.work_time = options.work_time;
+    // Drawn only when asked for, so streams without formations stay what they were.
+    if (options.formation_share > 0) o.formation = unit() < options.formation_share;
     const double release =
         (static_cast<double>(i) + (options.jitter ? unit() : 0.0)) * options.interval;
     o.created_time = release;

@@ -19,11 +19,16 @@ struct Box {
 // One agent's stay inside one intersection box: frames [first, last].
 struct Visit {
   std::string agent;
-  std::string group;
+  std::string group, group2;
   int intersection = -1;
   std::size_t first = 0, last = 0;
   PointId entry = kNoPoint, exit = kNoPoint;
 };
+
+bool SharesGroup(const std::string& a, const std::string& a2, const std::string& b,
+                 const std::string& b2) {
+  return a == b || (!a2.empty() && (a2 == b || a2 == b2)) || (!b2.empty() && a == b2);
+}
 
 PointId NearestInner(const WarehouseMap& map, const Intersection& in, const Eigen::Vector2d& p) {
   PointId best = kNoPoint;
@@ -63,7 +68,7 @@ SafetyReport CheckSafety(const std::vector<SafetyFrame>& frames, const Warehouse
     std::map<std::pair<std::string, std::string>, std::size_t> still_open;
     for (std::size_t i = 0; i < rs.size(); ++i) {
       for (std::size_t j = i + 1; j < rs.size(); ++j) {
-        if (rs[i].group == rs[j].group) continue;
+        if (SharesGroup(rs[i].group, rs[i].group2, rs[j].group, rs[j].group2)) continue;
         const double d = (rs[i].xy - rs[j].xy).norm();
         report.min_robot_distance = std::min(report.min_robot_distance, d);
         const double need = config.RobotClearance(rs[i].formation, rs[j].formation);
@@ -101,12 +106,12 @@ SafetyReport CheckSafety(const std::vector<SafetyFrame>& frames, const Warehouse
   std::map<std::string, std::size_t> current;  // agent -> open visit index
   for (std::size_t f = 0; f < frames.size(); ++f) {
     std::map<std::string, std::pair<Eigen::Vector2d, int>> refs;
-    std::map<std::string, std::string> group_of;
+    std::map<std::string, const RobotSample*> group_of;
     for (const RobotSample& r : frames[f].robots) {
       auto& e = refs.try_emplace(r.agent, Eigen::Vector2d::Zero(), 0).first->second;
       e.first += r.xy;
       ++e.second;
-      group_of[r.agent] = r.group;
+      group_of[r.agent] = &r;
     }
     std::map<std::string, std::size_t> next;
     for (auto& [agent, sum] : refs) {
@@ -124,7 +129,7 @@ SafetyReport CheckSafety(const std::vector<SafetyFrame>& frames, const Warehouse
         next[agent] = it->second;
       } else {
         const PointId p = NearestInner(map, in, ref);
-        visits.push_back({agent, group_of[agent], inside, f, f, p, p});
+        visits.push_back({agent, group_of[agent]->group, group_of[agent]->group2, inside, f, f, p, p});
         next[agent] = visits.size() - 1;
       }
     }
@@ -134,9 +139,12 @@ SafetyReport CheckSafety(const std::vector<SafetyFrame>& frames, const Warehouse
     for (std::size_t j = i + 1; j < visits.size(); ++j) {
       const Visit& a = visits[i];
       const Visit& b = visits[j];
-      if (a.intersection != b.intersection || a.group == b.group) continue;
+      if (a.intersection != b.intersection || SharesGroup(a.group, a.group2, b.group, b.group2)) continue;
       if (a.last < b.first || b.last < a.first) continue;
-      if (a.entry == b.entry && a.exit == b.exit) continue;  // same movement: may share
+      // Agents that entered by the same inner point came one behind the other along one lane
+      // (the spacing rule keeps them apart there); inside they may go on alike or diverge
+      // (the one ahead turns off, or re-plans) without crossing each other's path.
+      if (a.entry == b.entry) continue;
       SafetyViolation v;
       v.kind = ViolationKind::kCrossing;
       v.t = frames[std::max(a.first, b.first)].t;

@@ -2,15 +2,17 @@
 // checker"; Chu2024 §3.3 eqs. (10)-(15); used by the simulator tests).
 //
 // Input: frames of sampled robot positions, each robot tagged with the agent that moves it
-// (its own id, or a formation's id while the formation moves as one agent) and its group
-// (robots of one formation, including while they gather for the rendezvous, share a group and
-// are exempt from each other). Reports:
+// (its own id, or a formation's id while the formation moves as one agent) and its groups
+// (robots of one formation, including while they gather for the rendezvous and until they have
+// split up after its drop, share a group and are exempt from each other). Reports:
 //  - kSpacing: two robots of different groups closer than the pair's robot clearance
 //    (TrafficConfig::RobotClearance: eps1 with defaults; eqs. (10)-(12));
 //  - kCrossing: two agents inside one intersection's I_w (the bounding box of its inner
 //    points, grown by `box_margin`) at the same time with different movements, a movement
 //    being (nearest inner point when the agent's reference point entered the box, nearest
-//    inner point when it left) (eqs. (13)-(15)); agents of one group are exempt.
+//    inner point when it left) (eqs. (13)-(15)); agents of one group are exempt, and so are
+//    agents that entered by the same inner point (one behind the other in one lane: they may
+//    diverge inside, the one ahead turning off, but not cross).
 // Also returns the minimum robot distance over all frames (pairs of different groups).
 // Pure function; thread-safe.
 #pragma once
@@ -41,6 +43,9 @@ struct RobotSample {
   std::string group;  // robots of one group never violate each other
   bool formation = false;
   Eigen::Vector2d xy = Eigen::Vector2d::Zero();
+  // A second group, or "": a robot that has just left one formation's drop while it already
+  // approaches the next formation's rendezvous is exempt from the members of both.
+  std::string group2 = {};
 };
 
 struct SafetyFrame {

@@ -769,6 +769,19 @@ Status TrafficController::Place(std::size_t r, PointId at) {
   return Ok{};
 }
 bool TrafficController::removed(std::size_t r) const { return impl_->robots.at(r).removed; }
+int TrafficController::HolderOf(PointId p) const { return impl_->holder.at(static_cast<std::size_t>(p)); }
+int TrafficController::WaitsOn(std::size_t r) const {
+  const RobotState& x = impl_->robots.at(r);
+  return x.wait == WaitKind::kNone ? -1 : x.waits_on;
+}
+void TrafficController::WaitOn(std::size_t r, int other, double t, const std::string& why) {
+  RobotState& x = impl_->robots.at(r);
+  if (other < 0 || static_cast<std::size_t>(other) >= impl_->robots.size() || static_cast<std::size_t>(other) == r) {
+    if (x.wait != WaitKind::kNone) impl_->ClearWait(x);
+    return;
+  }
+  (void)impl_->Wait(r, WaitKind::kPoint, other, t, why);
+}
 const std::string& TrafficController::why(std::size_t r) const { return impl_->robots.at(r).why; }
 std::string TrafficController::Describe(std::size_t r) const {
   const Impl& s = *impl_;

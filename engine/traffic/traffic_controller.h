@@ -150,6 +150,15 @@ class TrafficController {
   // point (or one within point_clearance) held by another robot.
   Status Place(std::size_t r, PointId at);
   bool removed(std::size_t r) const;
+  // The robot holding point p (standing there, driving to it, or not yet clear of it), or -1.
+  int HolderOf(PointId p) const;
+  // The robot r waits on (see ResolveDeadlocks), or -1 when it does not wait.
+  int WaitsOn(std::size_t r) const;
+  // A wait the owner sees and the controller cannot: robot r (standing, no route: e.g. a
+  // formation's agent waiting for a member to arrive, or for a point to put a member on) waits
+  // on robot `other` since t (-1: no longer). ResolveDeadlocks then breaks cycles through it
+  // by moving the others (r itself has nothing to re-plan).
+  void WaitOn(std::size_t r, int other, double t, const std::string& why);
   const std::string& why(std::size_t r) const;  // reason of the last kWait / kBlocked
   // "R3 at 'c9' -> 'c8' route 'c9' 'c8' ... waiting on R4 (point 'c8' held by R4)".
   std::string Describe(std::size_t r) const;

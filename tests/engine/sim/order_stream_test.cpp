@@ -13,107 +13,11 @@
 #include <string>
 
 #include "engine/cli/scenario.h"
-#include "engine/io/movingai_map.h"
-#include "engine/map/chu2024_floor.h"
-#include "engine/sim/fleet_placement.h"
 #include "engine/sim/head_on_scenario.h"
-#include "engine/sim/random_orders.h"
+#include "tests/engine/sim/order_stream_test_support.h"
 
-namespace dispatch::engine {
+namespace dispatch::engine::testing {
 namespace {
-
-struct World {
-  std::shared_ptr<const WarehouseMap> map;
-  std::shared_ptr<const RouteTable> routes;
-};
-
-World Chu() {
-  static const World w = [] {
-    auto m = BuildChu2024Floor();
-    if (!m.ok()) throw std::runtime_error(m.error().message);
-    World x;
-    x.map = std::make_shared<const WarehouseMap>(std::move(m).value());
-    auto t = MakeRouteTable(x.map, {});
-    if (!t.ok()) throw std::runtime_error(t.error().message);
-    x.routes = std::move(t).value();
-    return x;
-  }();
-  return w;
-}
-
-World GridWorld(const std::string& rows) {
-  const std::size_t width = rows.find('\n');
-  const std::size_t height = static_cast<std::size_t>(std::count(rows.begin(), rows.end(), '\n'));
-  auto m = ParseMovingAiMap("type octile\nheight " + std::to_string(height) + "\nwidth " +
-                                std::to_string(width) + "\nmap\n" + rows,
-                            "grid");
-  if (!m.ok()) throw std::runtime_error(m.error().message);
-  World x;
-  x.map = std::make_shared<const WarehouseMap>(std::move(m).value());
-  auto t = MakeRouteTable(x.map, {});
-  if (!t.ok()) throw std::runtime_error(t.error().message);
-  x.routes = std::move(t).value();
-  return x;
-}
-
-// Invariants every run must satisfy, whatever the numbers.
-void ExpectSane(const World& w, const std::vector<Order>& orders, const StreamResult& r,
-                const StreamConfig& c) {
-  ASSERT_EQ(r.orders.size(), orders.size());
-  double total_direct = 0, last_release = 0;
-  for (std::size_t i = 0; i < orders.size(); ++i) {
-    const Order& o = orders[i];
-    const StreamOrderOutcome& out = r.orders[i];
-    EXPECT_EQ(out.order_id, o.id);
-    const double direct = w.routes->Cost(o.picks.front(), o.drop);
-    if (out.completed) {
-      // Released, driven from the pick to the drop at most at speed v, worked twice.
-      EXPECT_GE(out.completion_time + 1e-6, *o.release_time + direct + 2 * o.work_time) << o.id;
-      EXPECT_LE(out.completion_time, r.makespan + 1e-9);
-      EXPECT_FALSE(out.robot.empty());
-      total_direct += direct * c.allocation.speed;
-      last_release = std::max(last_release, *o.release_time);
-    } else {
-      EXPECT_FALSE(out.failure.empty()) << o.id;
-    }
-  }
-  EXPECT_GE(r.total_distance + 1e-6, total_direct);
-  if (r.completed > 0) {
-    EXPECT_GE(r.makespan, last_release);
-    EXPECT_NEAR(r.throughput_per_hour, static_cast<double>(r.completed) / r.makespan * 3600, 1e-6);
-    EXPECT_GT(r.mean_completion, 0.0);
-  }
-  EXPECT_LT(r.end_time, c.max_time);  // nothing hit the time limit ("waits forever")
-  EXPECT_EQ(r.times.size(), r.min_distance.size());
-}
-
-// The run's own CheckSafety (StreamConfig::check_safety): eps1 between every pair of robots
-// and no crossing movements inside one intersection at a time.
-void ExpectSafe(const StreamResult& r) {
-  ASSERT_TRUE(r.safety.has_value());
-  EXPECT_TRUE(r.safety->ok()) << r.safety->violations.size() << " violations, first: "
-                              << r.safety->violations.front().Describe();
-  // The series measures pairs within distance_cap only (+inf when none was that close).
-  if (std::isfinite(r.overall_min_distance)) {
-    EXPECT_NEAR(r.safety->min_robot_distance, r.overall_min_distance, 1e-9);
-  }
-}
-
-// 18 robots at the Chu2024 floor's stations and `count` random orders (RandomOrders, `seed`).
-struct Stream {
-  std::vector<FleetRobot> robots;
-  std::vector<Order> orders;
-};
-Stream ChuStream(const World& w, std::size_t count, std::uint64_t seed) {
-  auto robots = PlaceRobots(*w.map, 18);
-  if (!robots.ok()) throw std::runtime_error(robots.error().message);
-  RandomOrderOptions ro;
-  ro.count = count;
-  ro.seed = seed;
-  auto orders = RandomOrders(*w.map, ro);
-  if (!orders.ok()) throw std::runtime_error(orders.error().message);
-  return {std::move(robots).value(), std::move(orders).value()};
-}
 
 TEST(OrderStreamTest, StrategiesOnTwoHundredRandomOrdersOnChu2024) {
   const World w = Chu();
@@ -204,15 +108,17 @@ TEST(OrderStreamTest, TaskTableReleaseTimesAreRespected) {
   EXPECT_DOUBLE_EQ(r->orders[2].release_time, 2.0);
 }
 
-TEST(OrderStreamTest, RejectsFormationOrdersAndBadConfig) {
+TEST(OrderStreamTest, RejectsBadConfigAndFormationsWithoutThreeRobots) {
   const World w = Chu();
   auto orders = LoadTaskTableOrders(
       *w.map, std::string(DISPATCH_SHARED_DIR) + "/scenarios/chu2024-table1.csv");
   ASSERT_TRUE(orders.ok());
-  auto robots = PlaceRobots(*w.map, 18);
-  auto r = SimulateOrderStream(w.map, w.routes, *robots, *orders, {});
+  auto two = PlaceRobots(*w.map, 2);
+  auto r = SimulateOrderStream(w.map, w.routes, *two, *orders, {});
   ASSERT_FALSE(r.ok());
-  EXPECT_NE(r.error().message.find("formation"), std::string::npos);
+  EXPECT_NE(r.error().message.find("formation order T1 needs 3 robots"), std::string::npos)
+      << r.error().message;
+  auto robots = PlaceRobots(*w.map, 18);
   StreamConfig bad;
   bad.time_step = 0;
   EXPECT_FALSE(SimulateOrderStream(w.map, w.routes, *robots, {}, bad).ok());
@@ -253,60 +159,10 @@ TEST(OrderStreamTest, Wang2019HeadOnWaitVersusReplan) {
 // lane, picks and drops inside one-cell aisles). Every order completes, or fails with a
 // stated reason; nothing waits until the time limit.
 TEST(OrderStreamTest, LivenessOnSmallDenseGrids) {
-  const std::vector<std::string> maps = {
-      "S...S...SE\n"
-      ".@@.@@.@@.\n"
-      ".@@.@@.@@.\n"
-      "E........E\n"
-      ".@@.@@.@@.\n"
-      ".@@.@@.@@.\n"
-      "S...S...SE\n"
-      "..........\n",
-      "S..S..S..S..\n"
-      "............\n"
-      "..@@..@@..@.\n"
-      "E.@@..@@..@E\n"
-      "............\n"
-      "............\n"
-      "..@@..@@..@.\n"
-      "E.@@..@@..@E\n"
-      "............\n"
-      "S..S..S..S..\n"};
-  std::size_t total = 0, completed = 0;
-  for (const std::string& rows : maps) {
-    const World w = GridWorld(rows);
-    for (std::size_t n : {4u, 6u, 8u}) {
-      for (std::uint64_t seed = 1; seed <= 5; ++seed) {
-        auto robots = PlaceRobots(*w.map, n);
-        ASSERT_TRUE(robots.ok());
-        RandomOrderOptions ro;
-        ro.count = 40;
-        ro.seed = seed;
-        ro.interval = 2.0;
-        auto orders = RandomOrders(*w.map, ro);
-        StreamConfig c;
-        c.max_time = 2000;
-        c.record_series = false;
-        c.check_safety = true;
-        auto r = SimulateOrderStream(w.map, w.routes, *robots, *orders, c);
-        ASSERT_TRUE(r.ok()) << r.error().message;
-        SCOPED_TRACE("robots " + std::to_string(n) + " seed " + std::to_string(seed));
-        ExpectSafe(*r);
-        ExpectSane(w, *orders, *r, c);
-        for (const auto& o : r->orders) {
-          if (!o.completed) {
-            EXPECT_EQ(o.failure.rfind("blocked: ", 0), 0u) << o.failure;
-          }
-        }
-        EXPECT_GE(r->overall_min_distance, 0.6 - 1e-9);  // point clearance (eps1)
-        total += r->orders.size();
-        completed += r->completed;
-      }
-    }
-  }
+  const auto [completed, total] = DenseGridLiveness(0.0);
   std::printf("liveness: %zu/%zu orders completed\n", completed, total);
   EXPECT_GE(static_cast<double>(completed), 0.95 * static_cast<double>(total));
 }
 
 }  // namespace
-}  // namespace dispatch::engine
+}  // namespace dispatch::engine::testing

@@ -91,5 +91,28 @@ TEST_F(SafetyCheckTest, FindsCrossingMovementsInsideOneIntersection) {
   EXPECT_TRUE(CheckSafety(crossing, *map_, config_).ok());
 }
 
+TEST_F(SafetyCheckTest, AgentsEnteringByOneInnerPointMayDivergeButNotMerge) {
+  // R1 and R2 enter one I_w by its south-west point 1 m apart, eastbound. R1 turns
+  // north at the south-east point while R2 goes on east: they diverge, nobody crosses.
+  const Intersection& in = map_->intersections()[8];
+  Eigen::Vector2d lo = map_->point(in.inner[0]).position;
+  for (PointId p : in.inner) lo = lo.cwiseMin(map_->point(p).position);
+  std::vector<SafetyFrame> diverging, merging;
+  for (int k = 0; k <= 30; ++k) {
+    const double f = 0.1 * k;
+    const Eigen::Vector2d r1 = f <= 1.5 ? Eigen::Vector2d(lo.x() + f, lo.y()) : Eigen::Vector2d(lo.x() + 1.5, lo.y() + f - 1.5);
+    diverging.push_back({f, {Single("R1", r1), Single("R2", {lo.x() - 1.0 + f, lo.y()})}});
+    // R2 comes down to the north-west point instead and drives east to the north-east one,
+    // where R1 leaves too: their paths merge.
+    const Eigen::Vector2d r2 = f <= 0.7 ? Eigen::Vector2d(lo.x(), lo.y() + 2.2 - f) : Eigen::Vector2d(lo.x() + f - 0.7, lo.y() + 1.5);
+    merging.push_back({f, {Single("R1", r1), Single("R2", r2)}});
+  }
+  const SafetyReport same_entry = CheckSafety(diverging, *map_, config_);
+  EXPECT_TRUE(same_entry.ok()) << same_entry.violations[0].Describe();
+  const SafetyReport other_entry = CheckSafety(merging, *map_, config_);
+  ASSERT_FALSE(other_entry.ok());
+  EXPECT_EQ(other_entry.violations[0].kind, ViolationKind::kCrossing);
+}
+
 }  // namespace
 }  // namespace dispatch::engine

@@ -155,6 +155,33 @@ TEST(TrafficControllerTest, WorkingRobotIsNeverMovedAndAWaiterWithoutDetourIsBlo
   EXPECT_EQ(ctl.At(w), P(*map, "c2"));
 }
 
+TEST(TrafficControllerTest, AnOwnersWaitClosesACycleThatGetsBroken) {
+  // W stands at c2 with no route and waits, for its owner, on F (a formation's agent waiting
+  // for a member that F holds up); F wants c2. Only with that wait is there a cycle, and F,
+  // the one that can act, backs off.
+  auto map = Grid({"...."});
+  TrafficController ctl = Make(map);
+  const std::size_t w = *ctl.AddRobot("W", P(*map, "c2"));
+  ctl.SetWorking(w, true, 1e9);
+  ctl.SetIdle(w, false);
+  const std::size_t f = *ctl.AddRobot("F", P(*map, "c1"));
+  ASSERT_TRUE(ctl.SetRoute(f, Route(*map, {"c1", "c2", "c3"})).ok());
+  EXPECT_EQ(ctl.Request(f, 0.0), TrafficDecision::kWait);
+  EXPECT_EQ(ctl.HolderOf(P(*map, "c2")), static_cast<int>(w));
+  EXPECT_EQ(ctl.HolderOf(P(*map, "c0")), -1);
+  EXPECT_EQ(ctl.WaitsOn(f), static_cast<int>(w));
+  EXPECT_EQ(ctl.WaitsOn(w), -1);
+  EXPECT_EQ(ctl.ResolveDeadlocks(0.0), 0u);  // a chain that ends at a working robot
+  ctl.WaitOn(w, static_cast<int>(f), 0.0, "waiting for its member");
+  EXPECT_EQ(ctl.WaitsOn(w), static_cast<int>(f));
+  EXPECT_EQ(ctl.ResolveDeadlocks(0.0), 1u);
+  EXPECT_EQ(ctl.Request(f, 0.0), TrafficDecision::kGo);  // backing off to c0
+  EXPECT_EQ(ctl.Next(f), P(*map, "c0"));
+  EXPECT_EQ(ctl.At(w), P(*map, "c2"));
+  ctl.WaitOn(w, -1, 1.0, {});
+  EXPECT_EQ(ctl.WaitsOn(w), -1);
+}
+
 TEST(TrafficControllerTest, IntersectionNeedsAGrantAndReleasesItBehind) {
   MapBuilder b("cross");
   b.SetFloor({-1, -1}, {11, 11});
