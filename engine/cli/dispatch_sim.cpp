@@ -235,13 +235,13 @@ int RunStream(const StreamArgs& a) {
   if (!a.orders_csv.empty()) {
     std::ofstream out(a.orders_csv);
     if (!out) return Fail("cannot write " + a.orders_csv);
-    out << "order,robots,release,completion,completed,failure\n";
+    out << "order,robot,release,completion,completed,failure,team\n";
     for (const StreamOrderOutcome& o : r->orders) {
-      std::string robots = o.robot;  // a formation: its members, leader first
-      for (std::size_t k = 1; k < o.team.size(); ++k) robots += ' ' + o.team[k];
-      out << o.order_id << ',' << robots << ',' << o.release_time << ',';
+      std::string team;  // a formation's members, leader first
+      for (const std::string& id : o.team) team += (team.empty() ? "" : " ") + id;
+      out << o.order_id << ',' << o.robot << ',' << o.release_time << ',';
       if (o.completed) out << o.completion_time;
-      out << ',' << (o.completed ? 1 : 0) << ",\"" << o.failure << "\"\n";
+      out << ',' << (o.completed ? 1 : 0) << ",\"" << o.failure << "\"," << team << '\n';
     }
   }
   if (!a.csv.empty()) {

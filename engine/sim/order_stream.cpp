@@ -132,21 +132,30 @@ void StreamSim::Release(double t) {
   if (config_.strategy == AllocationStrategy::kPreassigned) {
     for (std::size_t k = first_k; k < next_release_; ++k) {
       const Order& o = orders_[k];
-      std::vector<std::size_t> robots;
-      for (const auto& [order, robot] : config_.preassigned) {
-        auto bot = order == o.id ? by_id.find(robot) : by_id.end();
-        if (bot != by_id.end()) robots.push_back(bot->second);
-      }
-      if (robots.size() != static_cast<std::size_t>(o.team_size())) {
-        Fail(outcome_of_[k], "allocation: order not preassigned to " + std::to_string(o.team_size()) +
-                                 " robot(s) on the floor");
+      if (!o.formation) {
+        auto it = std::find_if(config_.preassigned.begin(), config_.preassigned.end(),
+                               [&](const auto& p) { return p.first == o.id; });
+        auto bot = it == config_.preassigned.end() ? by_id.end() : by_id.find(it->second);
+        if (bot == by_id.end()) {
+          Fail(outcome_of_[k], "allocation: order not preassigned to a robot on the floor");
+          continue;
+        }
+        Enqueue(bot->second, k);
         continue;
       }
-      if (o.formation) {
-        EnqueueTeam(robots, k);
-      } else {
-        Enqueue(robots.front(), k);
+      // A formation order: every robot listed for it, leader first, three distinct ones.
+      std::vector<std::size_t> members;
+      for (const auto& [order, robot] : config_.preassigned) {
+        auto bot = order == o.id ? by_id.find(robot) : by_id.end();
+        if (bot != by_id.end() && std::find(members.begin(), members.end(), bot->second) == members.end()) {
+          members.push_back(bot->second);
+        }
       }
+      if (members.size() != static_cast<std::size_t>(kFormationTeamSize)) {
+        Fail(outcome_of_[k], "allocation: formation order not preassigned to 3 distinct robots on the floor");
+        continue;
+      }
+      EnqueueTeam(members, k);
     }
     return;
   }
@@ -296,11 +305,17 @@ void StreamSim::Move(std::size_t r, double t0) {
       PointId target = kNoPoint;
       if (!b.tasks.empty()) {
         target = b.tasks.front().Stop();
-      } else if (config_.return_home && IsServicePoint(map_->point(b.home).kind)) {
+      } else if (config_.return_home && !b.agent && IsServicePoint(map_->point(b.home).kind)) {
         target = b.home;
       }
-      const bool holds = !b.tasks.empty() && b.tasks.front().team >= 0 && HoldsForRendezvous(b, now);
-      ctl_.SetIdle(r, b.tasks.empty() || holds);
+      const bool member = !b.agent && !b.tasks.empty() && b.tasks.front().team >= 0;
+      if (member && teams_[static_cast<std::size_t>(b.tasks.front().team)].phase != Team::Phase::kGathering) {
+        b.tasks.pop_front();  // never: a team that has formed holds all its members
+        SyncGroup(r);
+        continue;
+      }
+      const bool holds = member && HoldsForRendezvous(b, now);
+      if (member) ctl_.SetIdle(r, holds);  // waiting for the rendezvous call: may be nudged
       if (target == kNoPoint || (b.tasks.empty() && at == target) || holds) {
         // Idle away from a station: leave service points and corridors to the others.
         if ((b.tasks.empty() || holds) && config_.idle_step_aside && !b.parked_aside && ctl_.StepAside(r)) {
@@ -323,6 +338,10 @@ void StreamSim::Move(std::size_t r, double t0) {
       if (!path.ok()) {
         if (b.tasks.empty()) break;  // cannot get home: stay
         Fail(b.tasks.front().order, "unreachable: " + path.error().message);
+        if (b.agent) {  // the formation cannot go on: its members leave it here
+          DissolveBlocked(r);
+          break;
+        }
         b.tasks.pop_front();
         SyncGroup(r);
         continue;
@@ -508,7 +527,11 @@ StreamResult StreamSim::Run() {
     rules.epsilon_single_single = clearance_;
     rules.epsilon_single_formation = clearance_ + radius_;
     rules.epsilon_formation_formation = clearance_ + 2.0 * radius_;
-    out_.safety = CheckSafety(frames_, *map_, rules);
+    // The controller grants per movement and may re-plan a robot inside I_w (a detour, a
+    // back-off): one that entered behind another may leave by another point.
+    SafetyCheckOptions options;
+    options.followers_may_diverge = true;
+    out_.safety = CheckSafety(frames_, *map_, rules, options);
   }
   if (config_.record_frames) out_.frames = std::move(frames_);
   return std::move(out_);
@@ -538,7 +561,9 @@ Result<StreamResult> SimulateOrderStream(std::shared_ptr<const WarehouseMap> map
   if (!valid.ok()) return valid.error();
   TrafficControllerConfig tc = config.traffic;
   tc.speed = config.allocation.speed;
-  tc.max_envelope = std::max(tc.max_envelope, FormationRadius());  // a formation's D_f
+  if (std::any_of(orders.begin(), orders.end(), [](const Order& o) { return o.formation; })) {
+    tc.max_envelope = std::max(tc.max_envelope, FormationRadius());  // a formation's D_f
+  }
   auto ctl = TrafficController::Create(map, tc);
   if (!ctl.ok()) return ctl.error();
   stream_sim::StreamSim sim(map, routes, config, std::move(ctl).value());

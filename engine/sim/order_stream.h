@@ -27,8 +27,9 @@
 // the others join from the point before P, each driving into its slot of the triangle (eq. (9)).
 // Then the agent serves the order like one robot, every grant and point held for the whole
 // formation, the members rigidly in their slots (turning in place about the centre before an
-// arc with a new heading), and after the drop the members go back to the controller one at a
-// time. Members count as one agent (distance series, CheckSafety groups) from their approach
+// arc with a new heading), and after the drop the members go back to the controller beside the
+// drop point while the agent still holds it, the last one onto the drop point itself once the
+// others have driven off its slot. Members count as one agent (distance series, CheckSafety groups) from their approach
 // until each is eps1 from its former mates. A formation that cannot form (a member blocked,
 // its order failed) breaks up; a blocked formation's order fails and its members leave it
 // where it stands, as at a drop.
@@ -116,8 +117,8 @@ struct StreamResult {
   bool all_completed() const { return completed == orders.size(); }
 };
 
-// Errors: bad config, null map/routes, no robots, a formation order, robots that cannot be
-// placed (unknown or shared start points).
+// Errors: bad config, null map/routes, no robots, a formation order with fewer than 3 robots
+// on the floor, robots that cannot be placed (unknown or shared start points).
 Result<StreamResult> SimulateOrderStream(std::shared_ptr<const WarehouseMap> map,
                                          std::shared_ptr<const RouteTable> routes,
                                          const std::vector<FleetRobot>& robots,

@@ -85,6 +85,7 @@ struct Team {
   bool called = false;
   std::vector<double> depart;
   PointId leave_at = kNoPoint;  // where members go back to the controller (drop; P if broken)
+  double leave_wait = 0.0;      // s leaving without progress (no member placed or driving out)
   bool apart = false;           // done, and every former member is eps1 from its mates
 };
 
@@ -121,6 +122,7 @@ class StreamSim {
   // The remaining stops of a member's formation task (allocation rounds); false if none.
   bool MemberRemaining(const Bot& b, const Task& task, PlanTask& out) const;
   void SyncGroup(std::size_t r);
+  void KeepFormer(Bot& b, int team);  // b left `team` (or its formation broke up)
   // Approaching member r at the rendezvous: joins (true) or waits for the point (false).
   bool Join(std::size_t r, double t);
   // A member free for its formation that must not leave for P yet (the rendezvous is not
@@ -141,6 +143,7 @@ class StreamSim {
   // Its agent was blocked on the way: the order has failed, the members leave where it stands.
   void DissolveBlocked(std::size_t agent);
   bool StepLeaving(std::size_t team, double t);
+  PointId PlaceOff(std::size_t team, std::size_t member, double t);
   // Sends an idle robot (or a member waiting for its rendezvous call) aside, off keep_clear.
   bool NudgeIdle(std::size_t r, double t, const std::vector<PointId>& keep_clear);
   void CheckApart(std::size_t team);

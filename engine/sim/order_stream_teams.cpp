@@ -9,10 +9,11 @@
 //    robot (work at every pick and the drop) under the controller, with every grant and point
 //    held for the whole formation; the members keep their slots around it (eq. (9)), and the
 //    structure turns in place about its centre before an arc with a new heading.
-//  - Leaving: after the drop's work the members go back into the controller one at a time
-//    while the agent still holds the drop point D: a member is placed at the first point of its
-//    onward route (or a free neighbour of D) and drives there from its slot; the last one takes
-//    D itself from the agent once the others have arrived. Former teammates stay exempt from
+//  - Leaving: after the drop's work the members go back into the controller while the agent
+//    still holds the drop point D: each but the last is placed at the first point of its onward
+//    route (or a free neighbour of D) and drives there from its slot; the last one takes D
+//    itself from the agent once the others have arrived. With no room to leave for
+//    blocked_after, the members still in their slots leave the floor as faulted. Former teammates stay exempt from
 //    one another until each is eps1 from the others.
 // A formation whose order fails before it moves (a member blocked or unreachable, or P kept
 // occupied for blocked_after) breaks up: joined members leave P as at a drop. So does a
@@ -69,6 +70,12 @@ void StreamSim::SyncGroup(std::size_t r) {
   if (b.slot == Slot::kNone) b.team = b.tasks.empty() ? -1 : b.tasks.front().team;
   const auto group = [&](int team) { return team >= 0 ? teams_[static_cast<std::size_t>(team)].group : 0; };
   ctl_.SetGroup(r, group(b.team), group(b.former));
+}
+
+void StreamSim::KeepFormer(Bot& b, int team) {
+  // One former team at a time (the controller has two groups: the current team and this
+  // one). An older one whose members are not apart yet stays: they may still be close.
+  if (b.former < 0 || teams_[static_cast<std::size_t>(b.former)].apart) b.former = team;
 }
 
 void StreamSim::MemberStart(std::size_t r, double t, PointId& start, double& ready) const {
@@ -188,6 +195,7 @@ bool StreamSim::Join(std::size_t r, double t) {
     const std::vector<PointId> route = ctl_.RemainingRoute(r);
     if (route.size() != 2 || route.back() != p) return false;
     (void)ctl_.SetRoute(r, {at});  // withdraws its requests; it keeps its point until clear
+    ctl_.WaitOn(r, -1, t, {});     // and it waits on nobody any more
   }
   b.join_wait = 0;
   b.slot = Slot::kToSlot;
@@ -291,7 +299,7 @@ void StreamSim::MoveMember(std::size_t r, double /*t0*/) {
   // Out of its slot, at the point it was placed at: on its own again.
   b.slot = Slot::kNone;
   ctl_.SetEnvelope(r, 0.0);
-  b.former = b.team;
+  KeepFormer(b, b.team);
   SyncGroup(r);
   ctl_.SetIdle(r, b.tasks.empty());
 }
@@ -358,7 +366,7 @@ void StreamSim::BreakTeam(std::size_t ti, const std::string& why) {
     if (b.slot != Slot::kNone && b.team == static_cast<int>(ti)) {
       joined = true;  // leaves P as it would leave a drop
     } else if (!b.removed) {
-      if (b.team == static_cast<int>(ti)) b.former = b.team;  // it was approaching: near its mates
+      if (b.team == static_cast<int>(ti)) KeepFormer(b, b.team);  // it was approaching: near its mates
       SyncGroup(m);
       ctl_.SetIdle(m, b.tasks.empty());
     }
@@ -382,6 +390,44 @@ void StreamSim::DissolveBlocked(std::size_t a) {
     Bot& b = bots_[m];
     if (!b.tasks.empty() && b.tasks.front().team == static_cast<int>(ti)) b.tasks.pop_front();
   }
+}
+
+// A free point for member m next to the drop point D: the first point of its onward route,
+// else a neighbour of D (sidings first). None free: the robot holding one is asked to move
+// (an idle one is nudged; for one that waits for D itself the agent's wait closes the cycle
+// the controller breaks), and kNoPoint.
+PointId StreamSim::PlaceOff(std::size_t ti, std::size_t m, double t) {
+  Team& team = teams_[ti];
+  const PointId d = team.leave_at;
+  const Bot& b = bots_[m];
+  std::vector<PointId> candidates;
+  if (!b.tasks.empty() && b.tasks.front().Stop() != d) {
+    auto path = routes_->Path(d, b.tasks.front().Stop());
+    if (path.ok() && path->points.size() >= 2) candidates.push_back(path->points[1]);
+  }
+  for (int pass = 0; pass < 2; ++pass) {
+    for (ArcId arc : map_->out_arcs(d)) {
+      const PointId q = map_->arc(arc).to;
+      const bool siding = !IsServicePoint(map_->point(q).kind) && map_->IntersectionOf(q) < 0;
+      if (siding == (pass == 0)) candidates.push_back(q);
+    }
+  }
+  for (PointId q : candidates) {
+    if (ctl_.Place(m, q).ok()) {
+      ctl_.WaitOn(team.agent, -1, t, {});
+      return q;
+    }
+  }
+  for (PointId q : candidates) {
+    const int h = ctl_.HolderOf(q);
+    if (h < 0) continue;  // only points near it are held: those robots drive on
+    if (!NudgeIdle(static_cast<std::size_t>(h), t, {d, q})) {
+      ctl_.WaitOn(team.agent, h, t, "formation " + out_.orders[team.order].order_id + ": a member leaves '" +
+                                        map_->point(d).name + "' for '" + map_->point(q).name + "'");
+    }
+    break;
+  }
+  return kNoPoint;
 }
 
 // True when every member is back on its own (the agent pooled).
@@ -419,63 +465,51 @@ bool StreamSim::StepLeaving(std::size_t ti, double t) {
     ctl_.SetIdle(m, b.tasks.empty());
     out = true;
   };
+  bool placed = false;
   for (std::size_t k = 0; k < pending.size(); ++k) {
     const std::size_t m = pending[k];
-    Bot& b = bots_[m];
     // Until it has driven out of its slot it keeps the formation's envelope (D_f off its point).
     ctl_.SetEnvelope(m, radius_);
     const Eigen::Vector2d from = Position(m);
-    if (k + 1 < pending.size()) {
-      std::vector<PointId> candidates;
-      if (!b.tasks.empty() && b.tasks.front().Stop() != d) {
-        auto path = routes_->Path(d, b.tasks.front().Stop());
-        if (path.ok() && path->points.size() >= 2) candidates.push_back(path->points[1]);
-      }
-      for (int pass = 0; pass < 2; ++pass) {  // sidings first, then any neighbour
-        for (ArcId arc : map_->out_arcs(d)) {
-          const PointId q = map_->arc(arc).to;
-          const bool siding = !IsServicePoint(map_->point(q).kind) && map_->IntersectionOf(q) < 0;
-          if (siding == (pass == 0)) candidates.push_back(q);
-        }
-      }
-      PointId target = kNoPoint;
-      for (PointId q : candidates) {
-        if (ctl_.Place(m, q).ok()) {
-          target = q;
-          break;
-        }
-      }
-      if (target == kNoPoint) {  // retried next step; the robot in the way is asked to move
-        for (PointId q : candidates) {
-          const int h = ctl_.HolderOf(q);
-          if (h < 0) continue;  // near points held: those robots move on
-          if (NudgeIdle(static_cast<std::size_t>(h), t, {d, q})) break;
-          // A robot that waits for D itself would wait forever: the cycle makes it yield.
-          ctl_.WaitOn(team.agent, h, t, "formation " + out_.orders[team.order].order_id +
-                                            ": a member leaves '" + map_->point(d).name + "' for '" +
-                                            map_->point(q).name + "'");
-          break;
-        }
-        return false;
-      }
-      ctl_.WaitOn(team.agent, -1, t, {});
+    if (k + 1 < pending.size()) {  // placed beside D while the agent still holds D
+      const PointId target = PlaceOff(ti, m, t);
+      if (target == kNoPoint) break;  // retried next step
       start_out(m, from, target);
+      placed = true;
       continue;
     }
-    if (out) return false;  // the last one takes D once the others are at their points
+    if (out) break;  // the last one takes D once the others are at their points
     const std::size_t a = team.agent;
-    if (a == kNone) return false;  // never: a member in its slot has its agent
+    if (a == kNone) break;  // never: a member in its slot has its agent
     ctl_.Remove(a);
     if (!ctl_.Place(m, d).ok()) {
       (void)ctl_.Place(a, d);
       ctl_.SetIdle(a, false);
       ctl_.SetWorking(a, true, 1e18);
-      return false;
+      break;
     }
     PoolAgent(team);
     start_out(m, from, d);
+    placed = true;
   }
-  return false;
+  // No member placed and none driving out for blocked_after: those still in their slots leave
+  // the floor as faulted (no room to leave), so no later order of theirs waits forever.
+  team.leave_wait = placed || out ? 0.0 : team.leave_wait + config_.time_step;
+  if (team.leave_wait < config_.traffic.blocked_after) return false;
+  const std::string why = "formation " + out_.orders[team.order].order_id + ": no room to leave '" +
+                          map_->point(d).name + "' for " + std::to_string(config_.traffic.blocked_after) + " s";
+  out_.blocked.push_back(why);
+  for (std::size_t m : pending) {
+    Bot& b = bots_[m];
+    if (b.slot != Slot::kInSlot) continue;
+    FailTasks(m, "blocked: " + b.id + ": " + why);
+    if (!ctl_.removed(m)) ctl_.Remove(m);
+    b.removed = true;
+    b.slot = Slot::kNone;
+    b.team = b.former = -1;
+  }
+  PoolAgent(team);
+  return true;
 }
 
 void StreamSim::CheckApart(std::size_t ti) {

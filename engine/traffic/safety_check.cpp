@@ -111,7 +111,8 @@ SafetyReport CheckSafety(const std::vector<SafetyFrame>& frames, const Warehouse
       auto& e = refs.try_emplace(r.agent, Eigen::Vector2d::Zero(), 0).first->second;
       e.first += r.xy;
       ++e.second;
-      group_of[r.agent] = &r;
+      const RobotSample*& g = group_of[r.agent];
+      if (g == nullptr || (g->group2.empty() && !r.group2.empty())) g = &r;  // a second group if any member has one
     }
     std::map<std::string, std::size_t> next;
     for (auto& [agent, sum] : refs) {
@@ -141,10 +142,14 @@ SafetyReport CheckSafety(const std::vector<SafetyFrame>& frames, const Warehouse
       const Visit& b = visits[j];
       if (a.intersection != b.intersection || SharesGroup(a.group, a.group2, b.group, b.group2)) continue;
       if (a.last < b.first || b.last < a.first) continue;
-      // Agents that entered by the same inner point came one behind the other along one lane
-      // (the spacing rule keeps them apart there); inside they may go on alike or diverge
-      // (the one ahead turns off, or re-plans) without crossing each other's path.
-      if (a.entry == b.entry) continue;
+      if (a.entry == b.entry && a.exit == b.exit) continue;  // same movement: may share
+      // Through the same entry one behind the other (the spacing rule keeps them apart): the
+      // online controller may turn the one ahead off, or back one off the way it came, so their
+      // exits can differ without either crossing the other's path.
+      if (options.followers_may_diverge && a.entry == b.entry &&
+          map.intersections()[static_cast<std::size_t>(a.intersection)].inner.size() > 1) {
+        continue;
+      }
       SafetyViolation v;
       v.kind = ViolationKind::kCrossing;
       v.t = frames[std::max(a.first, b.first)].t;

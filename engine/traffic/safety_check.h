@@ -10,9 +10,12 @@
 //  - kCrossing: two agents inside one intersection's I_w (the bounding box of its inner
 //    points, grown by `box_margin`) at the same time with different movements, a movement
 //    being (nearest inner point when the agent's reference point entered the box, nearest
-//    inner point when it left) (eqs. (13)-(15)); agents of one group are exempt, and so are
-//    agents that entered by the same inner point (one behind the other in one lane: they may
-//    diverge inside, the one ahead turning off, but not cross).
+//    inner point when it left) (eqs. (13)-(15)); agents of one group are exempt. With
+//    followers_may_diverge, so are two that entered an I_w of several points by the same inner
+//    point, one behind the other in one lane (the spacing check still applies to them): the
+//    online controller may turn the one ahead off, re-plan it, or back one off the way it came,
+//    so their exits may differ without either crossing the other's path. Without it (the
+//    default, the plan simulator's rule) every two movements that differ are reported.
 // Also returns the minimum robot distance over all frames (pairs of different groups).
 // Pure function; thread-safe.
 #pragma once
@@ -69,6 +72,7 @@ struct SafetyViolation {
 struct SafetyCheckOptions {
   double tolerance = 1e-6;   // m: distances this much below the clearance still pass
   double box_margin = 0.05;  // m: I_w box growth (robots on its edge lanes count as inside)
+  bool followers_may_diverge = false;  // see kCrossing above
 };
 
 struct SafetyReport {

@@ -157,7 +157,7 @@ class TrafficController {
   // A wait the owner sees and the controller cannot: robot r (standing, no route: e.g. a
   // formation's agent waiting for a member to arrive, or for a point to put a member on) waits
   // on robot `other` since t (-1: no longer). ResolveDeadlocks then breaks cycles through it
-  // by moving the others (r itself has nothing to re-plan).
+  // like any other (a working r is never moved; otherwise r may be backed off too).
   void WaitOn(std::size_t r, int other, double t, const std::string& why);
   const std::string& why(std::size_t r) const;  // reason of the last kWait / kBlocked
   // "R3 at 'c9' -> 'c8' route 'c9' 'c8' ... waiting on R4 (point 'c8' held by R4)".

@@ -122,6 +122,38 @@ TEST(OrderStreamFormationTest, LivenessWithFormationsOnSmallDenseGrids) {
   EXPECT_GE(static_cast<double>(completed), 0.8 * static_cast<double>(total));
 }
 
+TEST(OrderStreamFormationTest, PreassignedFormationsNeedThreeDistinctRobots) {
+  // Table 2's T8 given to R5 (leader), R6 and R17, as the paper's ζ = 100 run does; a second
+  // copy names R5 twice and fails; a third names a robot not on the floor.
+  const World w = Chu();
+  auto table = LoadTaskTableOrders(*w.map, std::string(DISPATCH_SHARED_DIR) + "/scenarios/chu2024-table2.csv");
+  ASSERT_TRUE(table.ok());
+  const Order t8 = table->back();
+  ASSERT_TRUE(t8.formation);
+  std::vector<Order> orders(3, t8);
+  for (std::size_t i = 0; i < orders.size(); ++i) {
+    orders[i].id = "T8-" + std::to_string(i + 1);
+    orders[i].release_time = 0.0;
+  }
+  StreamConfig c;
+  c.strategy = AllocationStrategy::kPreassigned;
+  c.check_safety = true;
+  c.preassigned = {{"T8-1", "R5"}, {"T8-1", "R6"}, {"T8-1", "R17"},
+                   {"T8-2", "R5"}, {"T8-2", "R5"}, {"T8-2", "R6"},
+                   {"T8-3", "R1"}, {"T8-3", "R2"}, {"T8-3", "R99"}};
+  auto robots = PlaceRobots(*w.map, 18);
+  ASSERT_TRUE(robots.ok());
+  auto r = SimulateOrderStream(w.map, w.routes, *robots, orders, c);
+  ASSERT_TRUE(r.ok()) << r.error().message;
+  ExpectSafe(*r);
+  ASSERT_TRUE(r->orders[0].completed) << r->orders[0].failure;
+  EXPECT_EQ(r->orders[0].team, (std::vector<std::string>{"R5", "R6", "R17"}));
+  for (std::size_t i : {1u, 2u}) {
+    EXPECT_FALSE(r->orders[i].completed);
+    EXPECT_NE(r->orders[i].failure.find("3 distinct robots"), std::string::npos) << r->orders[i].failure;
+  }
+}
+
 TEST(OrderStreamFormationTest, IsDeterministic) {
   const World w = Chu();
   const Stream st = ChuStream(w, 60, 4, 0.3);

@@ -91,9 +91,10 @@ TEST_F(SafetyCheckTest, FindsCrossingMovementsInsideOneIntersection) {
   EXPECT_TRUE(CheckSafety(crossing, *map_, config_).ok());
 }
 
-TEST_F(SafetyCheckTest, AgentsEnteringByOneInnerPointMayDivergeButNotMerge) {
+TEST_F(SafetyCheckTest, OnlineFollowersMayDivergeButNotMerge) {
   // R1 and R2 enter one I_w by its south-west point 1 m apart, eastbound. R1 turns
-  // north at the south-east point while R2 goes on east: they diverge, nobody crosses.
+  // north at the south-east point while R2 goes on east: they diverge, nobody crosses
+  // (followers_may_diverge; the strict default calls it two movements).
   const Intersection& in = map_->intersections()[8];
   Eigen::Vector2d lo = map_->point(in.inner[0]).position;
   for (PointId p : in.inner) lo = lo.cwiseMin(map_->point(p).position);
@@ -107,11 +108,18 @@ TEST_F(SafetyCheckTest, AgentsEnteringByOneInnerPointMayDivergeButNotMerge) {
     const Eigen::Vector2d r2 = f <= 0.7 ? Eigen::Vector2d(lo.x(), lo.y() + 2.2 - f) : Eigen::Vector2d(lo.x() + f - 0.7, lo.y() + 1.5);
     merging.push_back({f, {Single("R1", r1), Single("R2", r2)}});
   }
-  const SafetyReport same_entry = CheckSafety(diverging, *map_, config_);
+  EXPECT_FALSE(CheckSafety(diverging, *map_, config_).ok());  // strict by default
+  SafetyCheckOptions online;
+  online.followers_may_diverge = true;
+  const SafetyReport same_entry = CheckSafety(diverging, *map_, config_, online);
   EXPECT_TRUE(same_entry.ok()) << same_entry.violations[0].Describe();
-  const SafetyReport other_entry = CheckSafety(merging, *map_, config_);
+  const SafetyReport other_entry = CheckSafety(merging, *map_, config_, online);
   ASSERT_FALSE(other_entry.ok());
   EXPECT_EQ(other_entry.violations[0].kind, ViolationKind::kCrossing);
+  // Cut off while R2 is still near the entry and R1 has driven on: the same.
+  diverging.resize(13);
+  EXPECT_TRUE(CheckSafety(diverging, *map_, config_, online).ok());
+  EXPECT_FALSE(CheckSafety(diverging, *map_, config_).ok());
 }
 
 }  // namespace
