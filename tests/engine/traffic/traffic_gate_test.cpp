@@ -303,7 +303,8 @@ void TrafficGateTest::RestartWhileMoving(bool one_behind) {
 
 TEST_F(TrafficGateTest, AFormationOrderCompletesWhateverMomentTheServerRestartsAt) {
   // Approaching, assembling, moving, at the drop, leaving it: the restart comes at one of 60
-  // moments until the team has dissolved.
+  // moments until the team has dissolved, then at 20 more until every robot has finished (idle
+  // robots stepping off the drops, seen by the new gate away from their stations).
   auto start = [&] {
     AddFormation({"park-P1", "park-P2", "park-P3"}, "K3-2-3N", "D-B2", "f1");
     AddRobot("R4", "park-P4", {"K3-2-2N"}, "D-B1", "o4");
@@ -319,8 +320,8 @@ TEST_F(TrafficGateTest, AFormationOrderCompletesWhateverMomentTheServerRestartsA
   }));
   ASSERT_GT(dissolved, 0);
   int formed_again = 0, left_alone = 0;  // which way the gate took
-  for (int cut = 1; cut <= 60; ++cut) {
-    const int at = cut * dissolved / 60;
+  for (int cut = 1; cut <= 80; ++cut) {
+    const int at = cut <= 60 ? cut * dissolved / 60 : dissolved + (cut - 60) * (steps - dissolved) / 21;
     SCOPED_TRACE("restart at step " + std::to_string(at) + " of " + std::to_string(steps));
     sims_.clear();
     t_ = 0.0;
