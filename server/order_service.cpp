@@ -243,8 +243,22 @@ grpc::ServerUnaryReactor* OrderServiceImpl::ListOrders(grpc::CallbackServerConte
   return Done(context, grpc::Status::OK);
 }
 
+// A WatchOrders call refused before it starts (it names an order that does not exist).
+class RefusedWatch final : public grpc::ServerWriteReactor<pb::OrderEvent> {
+ public:
+  explicit RefusedWatch(grpc::Status status) { Finish(std::move(status)); }
+  void OnDone() override { delete this; }
+};
+
 grpc::ServerWriteReactor<pb::OrderEvent>* OrderServiceImpl::WatchOrders(
     grpc::CallbackServerContext* /*context*/, const pb::WatchOrdersRequest* request) {
+  // Named orders must exist (a submitted order is in the snapshot before SubmitOrder replies).
+  auto snap = dispatcher_.snapshot();
+  for (const std::string& id : request->order_ids()) {
+    if (!snap->FindOrder(id)) {
+      return new RefusedWatch(Fitted({grpc::StatusCode::NOT_FOUND, "no order with id '" + id + "'"}));
+    }
+  }
   return new WatchReactor(dispatcher_, *request);
 }
 

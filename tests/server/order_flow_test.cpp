@@ -156,6 +156,29 @@ TEST_F(OrderFlowTest, SubmitAssignCompleteWithARobot) {
                                                  pb::ORDER_STATE_IN_PROGRESS, pb::ORDER_STATE_COMPLETED}));
 }
 
+TEST_F(OrderFlowTest, WatchingAnUnknownOrderIsNotFound) {
+  StartServer();
+  pb::SubmitOrderResponse a;
+  ASSERT_TRUE(Submit(OrderRequest("known", {"K1-1-1N"}, "D-B1"), &a).ok());
+  pb::WatchOrdersRequest request;
+  request.add_order_ids(a.order().id());
+  request.add_order_ids("ord-999999");
+  grpc::ClientContext ctx;
+  auto reader = orders_->WatchOrders(WithDeadline(ctx), request);
+  pb::OrderEvent e;
+  EXPECT_FALSE(reader->Read(&e));  // refused at once, not left waiting
+  const grpc::Status s = reader->Finish();
+  EXPECT_EQ(s.error_code(), grpc::StatusCode::NOT_FOUND);
+  EXPECT_NE(s.error_message().find("ord-999999"), std::string::npos) << s.error_message();
+  // The known order alone is watched as before: its journal replays from the start.
+  pb::WatchOrdersRequest known;
+  known.set_from_start(true);
+  known.add_order_ids(a.order().id());
+  OrderWatcher watcher(channel_, known);
+  auto accepted = watcher.WaitForState(a.order().id(), pb::ORDER_STATE_ACCEPTED);
+  ASSERT_TRUE(accepted);
+}
+
 TEST_F(OrderFlowTest, EveryConnectedRobotBidsAndTheLowestBidWins) {
   StartServer();
   OrderWatcher watcher(channel_);
