@@ -57,8 +57,10 @@ RestServer::RestServer(RestHandlers handlers, const std::string& web_root)
   s.Get("/metrics", [&h](const httplib::Request&, httplib::Response& res) { Reply(res, h.Metrics()); });
   s.Get("/api/v1/map", [&h](const httplib::Request&, httplib::Response& res) { Reply(res, h.Map()); });
   s.Get("/api/v1/zones", [&h](const httplib::Request&, httplib::Response& res) { Reply(res, h.Zones()); });
-  s.Get("/api/v1/intersections", [&h](const httplib::Request&, httplib::Response& res) {
-    Reply(res, h.Intersections());
+  s.Get("/api/v1/intersections", [&h](const httplib::Request& req, httplib::Response& res) {
+    std::optional<std::string> active;
+    if (req.has_param("active")) active = req.get_param_value("active");
+    Reply(res, h.Intersections(active));
   });
   s.Get("/healthz", [&h](const httplib::Request&, httplib::Response& res) { Reply(res, h.Health()); });
   s.Get("/readyz", [&h](const httplib::Request&, httplib::Response& res) { Reply(res, h.Ready()); });

@@ -143,7 +143,15 @@ RestReply RestHandlers::Zones() const {
   return {200, {{"time", snap->time}, {"zones", out}}};
 }
 
-RestReply RestHandlers::Intersections() const {
+RestReply RestHandlers::Intersections(const std::optional<std::string>& active) const {
+  bool only_active = false;
+  if (active) {
+    if (*active == "1" || *active == "true") {
+      only_active = true;
+    } else if (*active != "0" && *active != "false") {
+      return Error(400, "active must be 1, true, 0 or false");
+    }
+  }
   auto snap = dispatcher_.snapshot();
   const engine::WarehouseMap& map = dispatcher_.map();
   auto names = [&map](const std::vector<engine::PointId>& points) {
@@ -155,6 +163,7 @@ RestReply RestHandlers::Intersections() const {
   for (std::size_t i = 0; i < map.intersections().size(); ++i) {
     const auto& x = map.intersections()[i];
     const IntersectionView* live = i < snap->intersections.size() ? &snap->intersections[i] : nullptr;
+    if (only_active && (!live || (live->holders.empty() && live->waiting.empty()))) continue;
     out.push_back({{"id", x.name},
                    {"inner", names(x.inner)},
                    {"approach", names(x.approach)},

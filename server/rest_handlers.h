@@ -52,8 +52,9 @@ class RestHandlers {
   RestReply Map() const;
   // GET /api/v1/zones: each zone's polygon, area and live density.
   RestReply Zones() const;
-  // GET /api/v1/intersections: each intersection's regions, grant holders and waiters.
-  RestReply Intersections() const;
+  // GET /api/v1/intersections: each intersection's regions, grant holders and waiters;
+  // ?active=1 (or true) only those with a holder or a waiter (large floors have thousands).
+  RestReply Intersections(const std::optional<std::string>& active = std::nullopt) const;
   // GET /metrics: Prometheus text format.
   RestReply Metrics() const;
   // body: {"client_order_id": "...", "picks": ["P1-1-1" | {"x":..,"y":..}, ...],

@@ -190,7 +190,7 @@
       state.robotsFresh = true;
       scheduleDraw();
     });
-    poll("intersections", () => "intersections", 200, j => {
+    poll("intersections", () => "intersections?active=1", 200, j => {
       state.intersections = Array.isArray(j.intersections) ? j.intersections : [];
       WM.Panels.renderIntersections(state.intersections);
       scheduleDraw();

@@ -161,6 +161,17 @@ TEST_F(OperatorEndpointsTest, IntersectionsShowWhoHoldsTheGrant) {
     holders += static_cast<int>(x["holders"].size());
   }
   EXPECT_EQ(holders, 1);
+  // ?active=1: only the intersection R7 holds (the others are idle), the same entry.
+  const json active = GetJson("/api/v1/intersections?active=1");
+  ASSERT_EQ(active["intersections"].size(), 1u) << active.dump();
+  EXPECT_EQ(active["intersections"][0]["id"], grant->intersection_name());
+  EXPECT_EQ(active["intersections"][0]["holders"], json::array({"R7"}));
+  EXPECT_EQ(GetJson("/api/v1/intersections?active=0")["intersections"].size(),
+            server_->dispatcher().map().intersections().size());
+  auto bad = client_->Get("/api/v1/intersections?active=maybe");
+  ASSERT_TRUE(bad);
+  EXPECT_EQ(bad->status, 400);
+  EXPECT_NE(bad->body.find("active must be"), std::string::npos) << bad->body;
 }
 
 TEST_F(OperatorEndpointsTest, OrderDetailHasEachRobotsRemainingRoute) {
