@@ -1,0 +1,251 @@
+// TrafficController's way out of waits: detours (bounded A*), backing off to a free
+// neighbour, stepping aside to a siding, and breaking wait-for cycles (ResolveDeadlocks).
+// Requests are in traffic_controller_requests.cpp, the public interface in
+// traffic_controller.cpp, the shared state in traffic_controller_impl.h.
+#include <algorithm>
+#include <cstdint>
+#include <functional>
+#include <optional>
+#include <queue>
+#include <utility>
+#include <vector>
+
+#include "engine/traffic/traffic_controller_impl.h"
+
+namespace dispatch::engine {
+
+// Cheapest route from -> to avoiding `ban_point`, corridor `ban_corridor` and intersection
+// `ban_guard` (each -1/kNoPoint for none). Empty points when there is none.
+// A* with the straight-line time as heuristic (admissible: paths are never shorter than
+// the straight distance and no robot is faster than `speed`); searches stop once every
+// open route costs more than `bound` seconds (no route returned then).
+Detour TrafficController::Impl::Route(PointId from, PointId to, PointId ban_point, int ban_corridor,
+                                      int ban_guard, double bound) {
+  Detour out;
+  if (to == ban_point || from == to) {
+    if (from == to) out = {{from}, 0.0};
+    return out;
+  }
+  if (++stamp == 0) {
+    std::fill(seen.begin(), seen.end(), 0);
+    stamp = 1;
+  }
+  using Item = std::pair<double, PointId>;
+  std::priority_queue<Item, std::vector<Item>, std::greater<>> heap;
+  const Eigen::Vector2d goal = M().point(to).position;
+  auto h = [&](PointId v) { return (M().point(v).position - goal).norm() / config.speed; };
+  auto relax = [&](PointId v, double d, ArcId a) {
+    const auto i = static_cast<std::size_t>(v);
+    if (seen[i] == stamp && dist[i] <= d) return;
+    seen[i] = stamp;
+    dist[i] = d;
+    via[i] = a;
+    heap.push({d + h(v), v});
+  };
+  relax(from, 0.0, -1);
+  bool found = false;
+  while (!heap.empty()) {
+    const auto [key, u] = heap.top();
+    heap.pop();
+    const double d = dist[static_cast<std::size_t>(u)];
+    if (key > d + h(u) + 1e-12) continue;  // stale entry
+    if (key > bound) break;
+    if (u == to) {
+      found = true;
+      break;
+    }
+    for (ArcId a : M().out_arcs(u)) {
+      const PointId v = M().arc(a).to;
+      if (v == ban_point) continue;
+      if (ban_corridor >= 0 && CorridorOf(a) == ban_corridor) continue;
+      if (ban_guard >= 0 && M().IntersectionOf(v) == ban_guard && v != to) continue;
+      relax(v, d + ArcTime(a), a);
+    }
+  }
+  const auto ti = static_cast<std::size_t>(to);
+  if (!found) return out;
+  out.cost = dist[ti];
+  for (PointId v = to; v != from; v = M().arc(via[static_cast<std::size_t>(v)]).from) {
+    out.points.push_back(v);
+  }
+  out.points.push_back(from);
+  std::reverse(out.points.begin(), out.points.end());
+  return out;
+}
+
+// A new route must not start against robots holding a corridor the other way (a robot
+// inside a corridor cannot turn back through its followers).
+bool TrafficController::Impl::StartAllowed(std::size_t r,
+                                           const std::vector<PointId>& points) const {
+  for (std::size_t k = 0; k + 1 < points.size() && k < 2; ++k) {
+    auto a = M().FindArc(points[k], points[k + 1]);
+    if (!a) return false;
+    const int c = CorridorOf(*a);
+    if (c >= 0 && CorridorBlocker(c, lanes.Direction(M(), *a), r) >= 0) return false;
+  }
+  return true;
+}
+
+// Re-plans robot r's route to its goal avoiding what it waits for; true when applied.
+bool TrafficController::Impl::TryDetour(std::size_t r, PointId ban_point, int ban_corridor,
+                                        int ban_guard, bool need_free_first_hop) {
+  RobotState& x = robots[r];
+  if (x.pos + 1 >= x.route.size()) return false;
+  // Detours more than blocked_after longer than the current route are not worth taking
+  // (and bounding keeps a failing search from sweeping the whole floor).
+  const double bound = RouteCost(x) + config.blocked_after;
+  Detour d = Route(x.at, x.route.back(), ban_point, ban_corridor, ban_guard, bound);
+  if (d.points.size() < 2 || !StartAllowed(r, d.points)) return false;
+  if (need_free_first_hop && PointBlocker(d.points[1], r) >= 0) return false;
+  if (!Assign(r, std::move(d.points)).ok()) return false;
+  ++stats.replans;
+  ClearWait(x);
+  return true;
+}
+
+// Steps robot r to a free neighbour (not `avoid`, not an intersection point) and re-plans
+// from there to its goal (if it has one), preferring routes that avoid `ban_point`.
+bool TrafficController::Impl::TryBackOff(std::size_t r, PointId avoid, PointId ban_point) {
+  RobotState& x = robots[r];
+  const PointId goal = x.pos + 1 < x.route.size() ? x.route.back() : kNoPoint;
+  for (ArcId a : M().out_arcs(x.at)) {
+    const PointId n = M().arc(a).to;
+    if (n == avoid || n == ban_point || PointBlocker(n, r) >= 0) continue;
+    if (M().IntersectionOf(n) >= 0) continue;
+    const int c = CorridorOf(a);
+    if (c >= 0 && CorridorBlocker(c, lanes.Direction(M(), a), r) >= 0) continue;
+    std::vector<PointId> route{x.at};
+    if (goal != kNoPoint) {
+      const double bound = RouteCost(x) + config.blocked_after;
+      Detour d = Route(n, goal, ban_point, -1, -1, bound);
+      if (d.points.empty()) d = Route(n, goal, kNoPoint, -1, -1, bound);
+      if (d.points.empty()) continue;
+      route.insert(route.end(), d.points.begin(), d.points.end());
+    } else {
+      route.push_back(n);
+    }
+    if (!Assign(r, std::move(route)).ok()) continue;
+    ++stats.replans;
+    ClearWait(x);
+    return true;
+  }
+  return false;
+}
+
+bool TrafficController::Impl::Siding(PointId p) const {
+  return !IsServicePoint(M().point(p).kind) &&
+         lanes.interior_of[static_cast<std::size_t>(p)] < 0 && M().IntersectionOf(p) < 0;
+}
+
+// Breadth-first search for the nearest free siding not on `keep_clear`; routes r there.
+bool TrafficController::Impl::StepAside(std::size_t r, const std::vector<PointId>& keep_clear) {
+  RobotState& x = robots[r];
+  if (x.removed || x.working || x.next != kNoPoint || x.pos + 1 < x.route.size()) return false;
+  // Kept clear: the given points, the service point it leaves (the next robot, or
+  // formation, to serve there must be able to come), and every point within
+  // point_clearance + max_envelope of those.
+  std::vector<PointId> keep = keep_clear;
+  if (IsServicePoint(M().point(x.at).kind)) keep.push_back(x.at);
+  auto clear = [&](PointId p) {
+    for (PointId k : keep) {
+      if (p == k) return false;
+      for (const auto& [n, d] : near[static_cast<std::size_t>(k)]) {
+        if (n == p && d < config.point_clearance + config.max_envelope) return false;
+      }
+    }
+    return true;
+  };
+  if (Siding(x.at) && clear(x.at)) return false;
+  if (++stamp == 0) {
+    std::fill(seen.begin(), seen.end(), 0);
+    stamp = 1;
+  }
+  std::vector<PointId> frontier{x.at};
+  seen[static_cast<std::size_t>(x.at)] = stamp;
+  via[static_cast<std::size_t>(x.at)] = -1;
+  for (std::size_t head = 0; head < frontier.size() && head < 40; ++head) {
+    const PointId u = frontier[head];
+    for (ArcId a : M().out_arcs(u)) {
+      const PointId v = M().arc(a).to;
+      const auto vi = static_cast<std::size_t>(v);
+      if (seen[vi] == stamp || PointBlocker(v, r) >= 0) continue;
+      seen[vi] = stamp;
+      via[vi] = a;
+      frontier.push_back(v);
+      if (!Siding(v) || !clear(v)) continue;
+      std::vector<PointId> route;
+      for (PointId w = v; w != x.at; w = M().arc(via[static_cast<std::size_t>(w)]).from) {
+        route.push_back(w);
+      }
+      route.push_back(x.at);
+      std::reverse(route.begin(), route.end());
+      if (!StartAllowed(r, route) || !Assign(r, std::move(route)).ok()) return false;
+      return true;
+    }
+  }
+  return false;
+}
+
+bool TrafficController::Impl::BreakCycle(const std::vector<std::size_t>& members, double t) {
+  std::vector<std::size_t> order = members;
+  std::sort(order.begin(), order.end(),
+            [&](std::size_t a, std::size_t b) { return Lower(a, b); });
+  for (std::size_t v : order) {
+    RobotState& x = robots[v];
+    if (x.working || x.next != kNoPoint || t < x.next_break_try) continue;
+    const PointId want = x.pos + 1 < x.route.size() ? x.route[x.pos + 1] : kNoPoint;
+    const bool ok =
+        x.wait == WaitKind::kCorridor ? TryDetour(v, kNoPoint, x.wait_corridor, -1, true)
+        : x.wait == WaitKind::kGrant  ? TryDetour(v, kNoPoint, -1, M().IntersectionOf(want), true)
+                                      : TryDetour(v, want, -1, -1, true);
+    if (ok || TryBackOff(v, want, want)) return true;
+    x.next_break_try = t + 1.0;
+  }
+  return false;
+}
+
+std::size_t TrafficController::Impl::ResolveDeadlocks(double t) {
+  const std::size_t n = robots.size();
+  std::vector<std::uint32_t> walk(n, 0);
+  std::uint32_t walk_id = 0;
+  std::size_t broken = 0;
+  for (std::size_t s = 0; s < n; ++s) {
+    if (walk[s] != 0 || robots[s].wait == WaitKind::kNone) continue;
+    ++walk_id;
+    std::vector<std::size_t> path;
+    int v = static_cast<int>(s);
+    while (v >= 0 && walk[static_cast<std::size_t>(v)] == 0) {
+      walk[static_cast<std::size_t>(v)] = walk_id;
+      path.push_back(static_cast<std::size_t>(v));
+      const RobotState& x = robots[static_cast<std::size_t>(v)];
+      v = x.wait != WaitKind::kNone ? x.waits_on : -1;
+    }
+    if (v >= 0 && walk[static_cast<std::size_t>(v)] == walk_id) {
+      auto it = std::find(path.begin(), path.end(), static_cast<std::size_t>(v));
+      std::vector<std::size_t> cycle(it, path.end());
+      if (BreakCycle(cycle, t)) {
+        ++broken;
+        ++stats.deadlocks_resolved;
+      }
+    } else if (v < 0 && path.size() >= 2) {
+      // The chain ends at a robot that does not wait: nudge it aside if it is idle.
+      const std::size_t h = path.back();
+      const RobotState& w = robots[path[path.size() - 2]];
+      RobotState& y = robots[h];
+      if (y.idle && !y.removed && !y.working && y.next == kNoPoint &&
+          y.pos + 1 >= y.route.size()) {
+        std::vector<PointId> keep(w.route.begin() + static_cast<std::ptrdiff_t>(w.pos),
+                                  w.route.end());
+        if (StepAside(h, keep)) {
+          ++stats.nudges;
+        } else {
+          const PointId want = w.pos + 1 < w.route.size() ? w.route[w.pos + 1] : kNoPoint;
+          if (TryBackOff(h, w.at, want)) ++stats.nudges;
+        }
+      }
+    }
+  }
+  return broken;
+}
+
+}  // namespace dispatch::engine

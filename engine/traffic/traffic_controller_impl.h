@@ -1,0 +1,139 @@
+// TrafficController's internal state, shared by traffic_controller.cpp (creation and the
+// public interface), traffic_controller_requests.cpp (points, corridors, grants, waits) and
+// traffic_controller_deadlocks.cpp (detours, back-off, sidings, deadlocks). Internal to the
+// controller; see traffic_controller.h for the model. Include it only from those files.
+#pragma once
+
+#include <algorithm>
+#include <cstddef>
+#include <cstdint>
+#include <limits>
+#include <memory>
+#include <string>
+#include <unordered_map>
+#include <utility>
+#include <vector>
+
+#include "engine/traffic/traffic_controller.h"
+
+namespace dispatch::engine {
+namespace traffic_detail {
+
+inline constexpr double kInf = std::numeric_limits<double>::infinity();
+enum class WaitKind { kNone, kPoint, kCorridor, kGrant };
+
+struct RobotState {
+  std::string id;
+  PointId at = kNoPoint;
+  PointId next = kNoPoint;
+  std::vector<PointId> route;  // route[pos] == at
+  std::vector<ArcId> arcs;     // arcs[k]: route[k] -> route[k + 1]
+  std::size_t pos = 0;
+  bool working = false, loaded = false, removed = false;
+  int group = 0, group2 = 0;  // > 0: robots sharing a group (a formation) may come closer
+  double envelope = 0.0;  // extra clearance (a formation's D_f), <= config.max_envelope
+  double work_end = 0.0;
+  bool idle = true;
+  std::vector<int> corridors;  // held corridor reservations
+  int guard = -1;              // intersection requested or granted
+  bool granted = false;
+  // Wait state (valid while wait != kNone).
+  WaitKind wait = WaitKind::kNone;
+  double wait_start = 0.0;
+  double next_detour_try = 0.0;
+  double next_break_try = 0.0;  // BreakCycle retries a robot that could not act after 1 s
+  int waits_on = -1;
+  PointId wait_point = kNoPoint;
+  int wait_corridor = -1;
+  int head_on_decided = -1;  // corridor whose head-on was decided in this wait
+  std::string why;
+};
+
+struct CorridorState {
+  int dir = 0;
+  std::vector<int> holders;
+  bool exclusive = false;  // a service point inside: one robot at a time
+};
+
+struct Detour {
+  std::vector<PointId> points;
+  double cost = kInf;
+};
+
+}  // namespace traffic_detail
+
+using traffic_detail::CorridorState;
+using traffic_detail::Detour;
+using traffic_detail::kInf;
+using traffic_detail::RobotState;
+using traffic_detail::WaitKind;
+
+struct TrafficController::Impl {
+  std::shared_ptr<const WarehouseMap> map;
+  TrafficControllerConfig config;
+  LaneCorridors lanes;
+  IntersectionGrants grants{0};
+  // Points closer than point_clearance + 2 * max_envelope, with their distance.
+  std::vector<std::vector<std::pair<PointId, double>>> near;
+  std::vector<int> holder;                 // per point
+  std::vector<CorridorState> cstate;
+  std::vector<RobotState> robots;
+  std::unordered_map<std::string, std::size_t> index;
+  TrafficStats stats;
+  // Dijkstra scratch.
+  std::vector<double> dist;
+  std::vector<ArcId> via;
+  std::vector<std::uint32_t> seen;
+  std::uint32_t stamp = 0;
+
+  const WarehouseMap& M() const { return *map; }
+  double ArcTime(ArcId a) const {
+    const Arc& arc = M().arc(a);
+    const double v = arc.max_speed > 0 ? std::min(config.speed, arc.max_speed) : config.speed;
+    return arc.length / v;
+  }
+  int CorridorOf(ArcId a) const { return lanes.CorridorOfArc(M(), a); }
+  int Priority(std::size_t r) const {
+    const RobotState& x = robots[r];
+    return x.working ? 2 : (x.loaded ? 1 : 0);
+  }
+  // True when robot a yields to robot b (a has lower priority).
+  bool Lower(std::size_t a, std::size_t b) const {
+    const int pa = Priority(a), pb = Priority(b);
+    return pa != pb ? pa < pb : a > b;
+  }
+  std::string Name(PointId p) const { return "'" + M().point(p).name + "'"; }
+
+  // Points, corridors, grants and waits (traffic_controller_requests.cpp).
+  int PointBlocker(PointId q, std::size_t r) const;
+  int CorridorBlocker(int c, int d, std::size_t r) const;
+  void HoldCorridor(int c, int d, std::size_t r);
+  void DropCorridor(int c, std::size_t r);
+  void ReconcileCorridors(std::size_t r);
+  void ReleaseGuard(std::size_t r);
+  void ClearWait(RobotState& x);
+  TrafficDecision Wait(std::size_t r, WaitKind kind, int on, double t, std::string why);
+
+  double RouteCost(const RobotState& x) const;
+  double ClearTime(std::size_t h, int c, double now) const;
+  Status Assign(std::size_t r, std::vector<PointId> points);
+  TrafficDecision HeadOn(std::size_t r, int c, int oncoming, double t);
+  TrafficDecision Request(std::size_t r, double t);
+  TrafficDecision Check(std::size_t r, PointId q, double t);
+  void Arrived(std::size_t r);
+  void Remove(std::size_t r);
+
+  // Detours, back-off, sidings and deadlocks (traffic_controller_deadlocks.cpp).
+  Detour Route(PointId from, PointId to, PointId ban_point, int ban_corridor, int ban_guard,
+               double bound = kInf);
+  bool StartAllowed(std::size_t r, const std::vector<PointId>& points) const;
+  bool TryDetour(std::size_t r, PointId ban_point, int ban_corridor, int ban_guard,
+                 bool need_free_first_hop);
+  bool TryBackOff(std::size_t r, PointId avoid, PointId ban_point);
+  bool Siding(PointId p) const;
+  bool StepAside(std::size_t r, const std::vector<PointId>& keep_clear);
+  bool BreakCycle(const std::vector<std::size_t>& members, double t);
+  std::size_t ResolveDeadlocks(double t);
+};
+
+}  // namespace dispatch::engine

@@ -1,0 +1,305 @@
+// TrafficController's requests (what Request() decides): point reservations and clearance
+// (PointBlocker), single-lane corridors and head-on conflicts, intersection grants, waits and
+// their timeouts, route assignment, and arriving at / leaving the floor. Detours, back-off,
+// sidings and deadlocks are in traffic_controller_deadlocks.cpp, the public interface in
+// traffic_controller.cpp, the shared state in traffic_controller_impl.h.
+#include <algorithm>
+#include <cstdio>
+#include <optional>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "engine/traffic/traffic_controller_impl.h"
+
+namespace dispatch::engine {
+
+int TrafficController::Impl::PointBlocker(PointId q, std::size_t r) const {
+  const int h = holder[static_cast<std::size_t>(q)];
+  if (h >= 0 && static_cast<std::size_t>(h) != r) return h;
+  // Chu2024 eqs. (10)-(12): eps1 between singles, eps1 + D_f single-formation, eps1 + 2 D_f
+  // between formations: each agent's envelope adds to the clearance.
+  const RobotState& me = robots[r];
+  auto mates = [&](const RobotState& o) {
+    return (me.group > 0 && (o.group == me.group || o.group2 == me.group)) ||
+           (me.group2 > 0 && (o.group == me.group2 || o.group2 == me.group2));
+  };
+  const double own = config.point_clearance + robots[r].envelope - 1e-9;
+  for (const auto& [n, d] : near[static_cast<std::size_t>(q)]) {
+    const int hn = holder[static_cast<std::size_t>(n)];
+    if (hn < 0 || static_cast<std::size_t>(hn) == r) continue;
+    const RobotState& other = robots[static_cast<std::size_t>(hn)];
+    if (mates(other)) continue;
+    if (d < own + other.envelope) return hn;
+  }
+  return -1;
+}
+
+// The robot holding corridor c the other way (-1: free for direction d).
+int TrafficController::Impl::CorridorBlocker(int c, int d, std::size_t r) const {
+  const CorridorState& s = cstate[static_cast<std::size_t>(c)];
+  if (s.dir == d && !s.exclusive) return -1;
+  for (int h : s.holders) {
+    if (static_cast<std::size_t>(h) != r) return h;
+  }
+  return -1;
+}
+
+void TrafficController::Impl::HoldCorridor(int c, int d, std::size_t r) {
+  CorridorState& s = cstate[static_cast<std::size_t>(c)];
+  s.dir = d;
+  if (std::find(s.holders.begin(), s.holders.end(), static_cast<int>(r)) == s.holders.end()) {
+    s.holders.push_back(static_cast<int>(r));
+    robots[r].corridors.push_back(c);
+  }
+}
+
+void TrafficController::Impl::DropCorridor(int c, std::size_t r) {
+  CorridorState& s = cstate[static_cast<std::size_t>(c)];
+  s.holders.erase(std::remove(s.holders.begin(), s.holders.end(), static_cast<int>(r)),
+                  s.holders.end());
+  if (s.holders.empty()) s.dir = 0;
+  auto& mine = robots[r].corridors;
+  mine.erase(std::remove(mine.begin(), mine.end(), c), mine.end());
+}
+
+// Keeps only the corridors the robot is inside of or drives on / looks ahead into.
+void TrafficController::Impl::ReconcileCorridors(std::size_t r) {
+  RobotState& x = robots[r];
+  const std::vector<int> held = x.corridors;
+  for (int c : held) {
+    bool keep = lanes.interior_of[static_cast<std::size_t>(x.at)] == c;
+    for (std::size_t k = x.pos; k < x.arcs.size() && k < x.pos + 2 && !keep; ++k) {
+      keep = CorridorOf(x.arcs[k]) == c;
+    }
+    if (!keep) DropCorridor(c, r);
+  }
+}
+
+void TrafficController::Impl::ReleaseGuard(std::size_t r) {
+  RobotState& x = robots[r];
+  if (x.guard < 0) return;
+  (void)grants.Release(static_cast<std::size_t>(x.guard), x.id);
+  x.guard = -1;
+  x.granted = false;
+}
+
+void TrafficController::Impl::ClearWait(RobotState& x) {
+  x.wait = WaitKind::kNone;
+  x.waits_on = -1;
+  x.head_on_decided = -1;
+}
+
+TrafficDecision TrafficController::Impl::Wait(std::size_t r, WaitKind kind, int on, double t,
+                                              std::string why) {
+  RobotState& x = robots[r];
+  if (x.wait == WaitKind::kNone) {
+    x.wait_start = t;
+    x.next_detour_try = 0.0;
+  }
+  x.wait = kind;
+  x.waits_on = on;
+  x.why = std::move(why);
+  return TrafficDecision::kWait;
+}
+
+double TrafficController::Impl::RouteCost(const RobotState& x) const {
+  double c = 0;
+  for (std::size_t k = x.pos; k < x.arcs.size(); ++k) c += ArcTime(x.arcs[k]);
+  return c;
+}
+
+// Time until robot h has driven through corridor c (approach included) and one arc beyond.
+double TrafficController::Impl::ClearTime(std::size_t h, int c, double now) const {
+  const RobotState& x = robots[h];
+  double t = x.working ? std::max(0.0, x.work_end - now) : 0.0;
+  bool entered = lanes.interior_of[static_cast<std::size_t>(x.at)] == c;
+  for (std::size_t k = x.pos; k < x.arcs.size(); ++k) {
+    const bool in = CorridorOf(x.arcs[k]) == c;
+    t += ArcTime(x.arcs[k]);
+    if (in) entered = true;
+    if (!in && entered) break;
+  }
+  return t;
+}
+
+Status TrafficController::Impl::Assign(std::size_t r, std::vector<PointId> points) {
+  RobotState& x = robots[r];
+  if (x.removed) return Error{ErrorCode::kFailedPrecondition, "traffic: robot " + x.id + " is off the floor"};
+  if (x.next != kNoPoint) return Error{ErrorCode::kFailedPrecondition, "traffic: robot " + x.id + " is driving"};
+  if (points.empty() || points.front() != x.at) {
+    return InvalidArgument("traffic: route of " + x.id + " must start where it stands");
+  }
+  std::vector<ArcId> arcs;
+  for (std::size_t k = 0; k + 1 < points.size(); ++k) {
+    if (points[k] < 0 || static_cast<std::size_t>(points[k + 1]) >= M().point_count()) {
+      return InvalidArgument("traffic: route of " + x.id + " names an unknown point");
+    }
+    auto a = M().FindArc(points[k], points[k + 1]);
+    if (!a) {
+      return InvalidArgument("traffic: route of " + x.id + " has no arc " + Name(points[k]) +
+                             " -> " + Name(points[k + 1]));
+    }
+    arcs.push_back(*a);
+  }
+  x.route = std::move(points);
+  x.arcs = std::move(arcs);
+  x.pos = 0;
+  x.head_on_decided = -1;
+  if (x.guard >= 0 && M().IntersectionOf(x.at) != x.guard) ReleaseGuard(r);
+  ReconcileCorridors(r);
+  return Ok{};
+}
+
+TrafficDecision TrafficController::Impl::HeadOn(std::size_t r, int c, int oncoming, double t) {
+  RobotState& x = robots[r];
+  if (x.head_on_decided != c) {
+    x.head_on_decided = c;
+    ++stats.head_on_conflicts;
+    HeadOnRecord rec;
+    rec.t = t;
+    rec.robot = x.id;
+    rec.oncoming = robots[static_cast<std::size_t>(oncoming)].id;
+    for (int h : cstate[static_cast<std::size_t>(c)].holders) {
+      if (static_cast<std::size_t>(h) == r) continue;
+      rec.wait_estimate = std::max(rec.wait_estimate, ClearTime(static_cast<std::size_t>(h), c, t));
+    }
+    // kChooseFaster only needs detours faster than waiting: bound the search there.
+    const double old_cost = RouteCost(x);
+    const double bound = config.head_on == HeadOnPolicy::kChooseFaster
+                             ? old_cost + rec.wait_estimate
+                             : kInf;
+    Detour d = Route(x.at, x.route.back(), kNoPoint, c, -1, bound);
+    if (!d.points.empty() && !StartAllowed(r, d.points)) d = Detour{};
+    rec.replan_extra = d.points.empty() ? kInf : d.cost - old_cost;
+    const bool replan =
+        !d.points.empty() && (config.head_on == HeadOnPolicy::kAlwaysReplan ||
+                              (config.head_on == HeadOnPolicy::kChooseFaster &&
+                               rec.replan_extra < rec.wait_estimate));
+    rec.replanned = replan;
+    if (stats.head_on.size() < 1000) stats.head_on.push_back(rec);
+    if (replan && Assign(r, std::move(d.points)).ok()) {
+      ++stats.replans;
+      ClearWait(x);
+      return TrafficDecision::kReplanned;
+    }
+  }
+  return Wait(r, WaitKind::kCorridor, oncoming, t,
+              "head-on: corridor held by " + robots[static_cast<std::size_t>(oncoming)].id);
+}
+
+TrafficDecision TrafficController::Impl::Request(std::size_t r, double t) {
+  RobotState& x = robots[r];
+  if (x.removed || x.next != kNoPoint || x.pos + 1 >= x.route.size()) {
+    x.why = "nothing to request";
+    return TrafficDecision::kWait;
+  }
+  const PointId q = x.route[x.pos + 1];
+  const TrafficDecision d = Check(r, q, t);
+  if (d != TrafficDecision::kWait) return d;
+  // Timeouts (Wang2019 §3.2 steps 3-4): re-plan, else blocked after blocked_after.
+  const double waited = t - x.wait_start;
+  const double limit = x.wait == WaitKind::kCorridor ? config.t_w1 : config.t_w2;
+  if (waited >= limit && t >= x.next_detour_try) {
+    x.next_detour_try = t + limit;
+    const bool ok = x.wait == WaitKind::kCorridor
+                        ? TryDetour(r, kNoPoint, x.wait_corridor, -1, false)
+                        : x.wait == WaitKind::kGrant
+                              ? TryDetour(r, kNoPoint, -1, M().IntersectionOf(q), false)
+                              : TryDetour(r, q, -1, -1, false);
+    if (ok) return TrafficDecision::kReplanned;
+  }
+  if (waited >= config.blocked_after) {
+    char buf[96];
+    std::snprintf(buf, sizeof buf, "blocked after waiting %.0f s at %s with no alternative: ",
+                  waited, M().point(x.at).name.c_str());
+    x.why = buf + x.why;
+    return TrafficDecision::kBlocked;
+  }
+  return TrafficDecision::kWait;
+}
+
+TrafficDecision TrafficController::Impl::Check(std::size_t r, PointId q, double t) {
+  RobotState& x = robots[r];
+  const int blocker = PointBlocker(q, r);
+  if (blocker >= 0) {
+    x.wait_point = q;
+    return Wait(r, WaitKind::kPoint, blocker, t,
+                "point " + Name(q) + " held by " + robots[static_cast<std::size_t>(blocker)].id);
+  }
+  for (std::size_t k = x.pos; k < x.arcs.size() && k < x.pos + 2; ++k) {
+    const int c = CorridorOf(x.arcs[k]);
+    if (c < 0) continue;
+    const int on = CorridorBlocker(c, lanes.Direction(M(), x.arcs[k]), r);
+    if (on < 0) continue;
+    x.wait_corridor = c;
+    return HeadOn(r, c, on, t);
+  }
+  const int g = config.intersection_grants ? M().IntersectionOf(q) : -1;
+  if (g >= 0 && M().IntersectionOf(x.at) != g) {
+    if (x.guard != g) {
+      ReleaseGuard(r);
+      std::size_t k = x.pos + 1;
+      while (k + 1 < x.route.size() && M().IntersectionOf(x.route[k + 1]) == g) ++k;
+      const PointId exit = k + 1 < x.route.size() ? x.route[k + 1] : kNoPoint;
+      (void)grants.Request(static_cast<std::size_t>(g),
+                           {x.id, {x.at, exit}, t, Priority(r)});
+      x.guard = g;
+      x.granted = false;
+    }
+    if (!grants.Granted(static_cast<std::size_t>(g), x.id)) {
+      const auto holders = grants.Holders(static_cast<std::size_t>(g));
+      int on = -1;
+      if (!holders.empty()) on = static_cast<int>(index.at(holders.front()));
+      return Wait(r, WaitKind::kGrant, on, t,
+                  "waiting for a grant at " + M().intersections()[static_cast<std::size_t>(g)].name);
+    }
+    if (!x.granted) {
+      x.granted = true;
+      ++stats.grants;
+    }
+  }
+  // Take the reservations.
+  holder[static_cast<std::size_t>(q)] = static_cast<int>(r);
+  x.next = q;
+  for (std::size_t k = x.pos; k < x.arcs.size() && k < x.pos + 2; ++k) {
+    const int c = CorridorOf(x.arcs[k]);
+    if (c >= 0) HoldCorridor(c, lanes.Direction(M(), x.arcs[k]), r);
+  }
+  ClearWait(x);
+  return TrafficDecision::kGo;
+}
+
+void TrafficController::Impl::Arrived(std::size_t r) {
+  RobotState& x = robots[r];
+  if (x.next == kNoPoint) return;
+  const PointId prev = x.at;
+  x.at = x.next;
+  x.next = kNoPoint;
+  ++x.pos;
+  if (holder[static_cast<std::size_t>(prev)] == static_cast<int>(r)) {
+    holder[static_cast<std::size_t>(prev)] = -1;
+  }
+  ReconcileCorridors(r);
+  if (x.guard >= 0 && x.granted && M().IntersectionOf(x.at) != x.guard) ReleaseGuard(r);
+}
+
+void TrafficController::Impl::Remove(std::size_t r) {
+  RobotState& x = robots[r];
+  for (PointId p : {x.at, x.next}) {
+    if (p != kNoPoint && holder[static_cast<std::size_t>(p)] == static_cast<int>(r)) {
+      holder[static_cast<std::size_t>(p)] = -1;
+    }
+  }
+  const std::vector<int> held = x.corridors;
+  for (int c : held) DropCorridor(c, r);
+  ReleaseGuard(r);
+  x.removed = true;
+  x.route.clear();
+  x.arcs.clear();
+  x.pos = 0;
+  x.next = kNoPoint;
+  ClearWait(x);
+}
+
+}  // namespace dispatch::engine
