@@ -6,6 +6,8 @@
 //                   table, all lanes bidirectional), auction (zeta = 100) allocating every
 //                   10 s (one FleetState rebuild per batch), a steady stream of random orders (one every 110 / R s: about one
 //                   order per robot per task duration), 300 simulated seconds, dt = 0.1 s.
+//   BM_SimulateFormations/R   the same with 10% of the orders formation orders (3 robots each,
+//                   Chu2024 §3.2: gathering, one agent with the formation's envelope, leaving).
 // Counter `speedup` = simulated seconds per wall second (target: R = 500 at >= 100x).
 // The map, the route table (warmed on every pick and drop) and the orders are built once,
 // outside the timing. Run from a Release build:
@@ -52,7 +54,7 @@ const Floor& LargeFloor() {
   return floor;
 }
 
-void BM_Simulate(benchmark::State& state) {
+void Simulate(benchmark::State& state, double formation_share) {
   const Floor& f = LargeFloor();
   const auto robots_count = static_cast<std::size_t>(state.range(0));
   auto robots = PlaceRobots(*f.map, robots_count);
@@ -61,6 +63,7 @@ void BM_Simulate(benchmark::State& state) {
   ro.interval = 110.0 / static_cast<double>(robots_count);
   ro.count = static_cast<std::size_t>(kHorizon / ro.interval);
   ro.seed = 42;
+  ro.formation_share = formation_share;
   auto orders = RandomOrders(*f.map, ro);
   if (!orders.ok()) throw std::runtime_error(orders.error().message);
   StreamConfig config;
@@ -68,7 +71,7 @@ void BM_Simulate(benchmark::State& state) {
   config.allocation_period = 10.0;
   config.record_series = false;
   double simulated = 0;
-  std::size_t completed = 0, total = 0, deadlocks = 0, replans = 0;
+  std::size_t completed = 0, total = 0, deadlocks = 0, replans = 0, blocked = 0;
   for (auto _ : state) {
     auto r = SimulateOrderStream(f.map, f.routes, *robots, *orders, config);
     if (!r.ok()) throw std::runtime_error(r.error().message);
@@ -77,14 +80,21 @@ void BM_Simulate(benchmark::State& state) {
     total += r->orders.size();
     deadlocks += r->traffic.deadlocks_resolved;
     replans += r->traffic.replans;
+    blocked += r->blocked.size();
   }
   state.counters["speedup"] = benchmark::Counter(simulated, benchmark::Counter::kIsRate);
   state.counters["completed"] = static_cast<double>(completed) / static_cast<double>(state.iterations());
   state.counters["orders"] = static_cast<double>(total) / static_cast<double>(state.iterations());
   state.counters["deadlocks"] = static_cast<double>(deadlocks) / static_cast<double>(state.iterations());
   state.counters["replans"] = static_cast<double>(replans) / static_cast<double>(state.iterations());
+  state.counters["blocked"] = static_cast<double>(blocked) / static_cast<double>(state.iterations());
 }
+
+void BM_Simulate(benchmark::State& state) { Simulate(state, 0.0); }
+void BM_SimulateFormations(benchmark::State& state) { Simulate(state, 0.1); }
 BENCHMARK(BM_Simulate)->Arg(18)->Arg(100)->Arg(500)->Unit(benchmark::kMillisecond)
+    ->UseRealTime()->Iterations(2);
+BENCHMARK(BM_SimulateFormations)->Arg(100)->Arg(500)->Unit(benchmark::kMillisecond)
     ->UseRealTime()->Iterations(2);
 
 }  // namespace
