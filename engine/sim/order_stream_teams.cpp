@@ -1,10 +1,12 @@
 // Order-stream simulation: formation orders (Chu2024 §3.2; issue 4 §3), the same model as
 // TrafficGate's teams (engine/traffic/traffic_gate.h) on the simulator's own motion.
 //
-//  - Gathering: each member drives alone to the first pick P. The first to stand on P hands it
-//    to the team's agent (one controller agent with the formation's envelope D_f, "working"
-//    so never asked to yield) and drives into its slot; the others join from the point before
-//    P. A joined member leaves the controller once clear of its point: the agent stands for it.
+//  - Gathering: once all three have the order first in their queues (the rendezvous is
+//    called), each member drives alone to the first pick P, leaving so as to arrive with the
+//    slowest; until then it waits like an idle robot. The first to stand on P hands it to the
+//    team's agent (one controller agent with the formation's envelope D_f, "working" so never
+//    asked to yield) and drives into its slot; the others join from the point before P. A
+//    joined member leaves the controller once clear of its point: the agent stands for it.
 //  - Moving: when all three are in their slots the agent serves the order's stops like a single
 //    robot (work at every pick and the drop) under the controller, with every grant and point
 //    held for the whole formation; the members keep their slots around it (eq. (9)), and the
@@ -13,8 +15,8 @@
 //    still holds the drop point D: each but the last is placed at the first point of its onward
 //    route (or a free neighbour of D) and drives there from its slot; the last one takes D
 //    itself from the agent once the others have arrived. With no room to leave for
-//    blocked_after, the members still in their slots leave the floor as faulted. Former teammates stay exempt from
-//    one another until each is eps1 from the others.
+//    blocked_after, the members still in their slots leave the floor as faulted. Former
+//    teammates stay exempt from one another until each is eps1 from the others.
 // A formation whose order fails before it moves (a member blocked or unreachable, or P kept
 // occupied for blocked_after) breaks up: joined members leave P as at a drop. So does a
 // formation whose agent is blocked on its way (the order fails): its members leave it where it
