@@ -176,7 +176,7 @@ void StreamSim::Release(double t) {
       const Task& task = b.tasks[k];
       PlanTask pt;
       const bool left = k == 0 && task.team >= 0 && b.slot != Slot::kNone
-                            ? MemberRemaining(b, task, pt)
+                            ? MemberRemaining(task, pt)
                             : Remaining(task, task.next_stop + (k == 0 && b.dwell > 0 ? 1 : 0), pt);
       if (left) (void)state.AssignSingle(i, out_.orders[task.order].order_id, pt);
     }
@@ -242,16 +242,11 @@ void StreamSim::FinishStop(std::size_t r, double t) {
   SyncGroup(r);
 }
 
-void StreamSim::Drive(Bot& b, double d, double weight) {
-  b.s += d * b.speed;
-  out_.total_distance += weight * d * b.speed;
-}
-
 void StreamSim::Move(std::size_t r, double t0) {
   Bot& b = bots_[r];
   if (b.removed) return;
   if (b.slot != Slot::kNone) {  // a formation member: the team moves it
-    MoveMember(r, t0);
+    MoveMember(r);
     return;
   }
   if (b.agent && teams_[static_cast<std::size_t>(b.team)].phase != Team::Phase::kMoving) return;
@@ -292,7 +287,8 @@ void StreamSim::Move(std::size_t r, double t0) {
         ctl_.Arrived(r, t0 + (dt - budget));
         continue;
       }
-      Drive(b, budget, weight);
+      b.s += budget * b.speed;
+      out_.total_distance += weight * budget * b.speed;
       budget = 0;
       if (!b.left_start && b.s >= leave_after) {
         ctl_.LeftPoint(r);
@@ -309,11 +305,6 @@ void StreamSim::Move(std::size_t r, double t0) {
         target = b.home;
       }
       const bool member = !b.agent && !b.tasks.empty() && b.tasks.front().team >= 0;
-      if (member && teams_[static_cast<std::size_t>(b.tasks.front().team)].phase != Team::Phase::kGathering) {
-        b.tasks.pop_front();  // never: a team that has formed holds all its members
-        SyncGroup(r);
-        continue;
-      }
       const bool holds = member && HoldsForRendezvous(b, now);
       if (member) ctl_.SetIdle(r, holds);  // waiting for the rendezvous call: may be nudged
       if (target == kNoPoint || (b.tasks.empty() && at == target) || holds) {

@@ -60,7 +60,6 @@ struct Bot {
   int former = -1;     // the team it left, until it is point_clearance from its mates
   int member = -1;     // its slot (0 = the front vertex, the leader)
   Slot slot = Slot::kNone;
-  bool off_floor = false;  // a member in its slot: the team agent stands for it
   double join_wait = 0.0;  // s waited at the rendezvous point for the agent to be placed
   // kToSlot: from the point before P along its arc to `via` (D_f short of P), then into the
   // slot; via_s = that first leg's length (0: straight from `from` to `to`).
@@ -109,7 +108,6 @@ class StreamSim {
   static bool Remaining(const Task& task, std::size_t first, PlanTask& out);
   void Complete(std::size_t outcome, double t);
   void Fail(std::size_t outcome, const std::string& why);  // once per order
-  void Drive(Bot& b, double budget, double weight);  // distance bookkeeping
   Eigen::Vector2d Position(std::size_t r) const;
   bool SameAgent(const Bot& a, const Bot& b) const;
   void Sample(double t);
@@ -120,7 +118,7 @@ class StreamSim {
   // Where a member's queue continues and when (allocation rounds).
   void MemberStart(std::size_t r, double t, PointId& start, double& ready) const;
   // The remaining stops of a member's formation task (allocation rounds); false if none.
-  bool MemberRemaining(const Bot& b, const Task& task, PlanTask& out) const;
+  bool MemberRemaining(const Task& task, PlanTask& out) const;
   void SyncGroup(std::size_t r);
   void KeepFormer(Bot& b, int team);  // b left `team` (or its formation broke up)
   // Approaching member r at the rendezvous: joins (true) or waits for the point (false).
@@ -136,7 +134,7 @@ class StreamSim {
   void WaitToJoin(std::size_t r, double budget);
   bool PlaceAgent(std::size_t team, PointId p, double t);
   void PoolAgent(Team& team);
-  void MoveMember(std::size_t r, double t);
+  void MoveMember(std::size_t r);
   void TeamDropDone(std::size_t agent, double t);  // the agent finished the drop's work
   void StepTeams(double t);
   void BreakTeam(std::size_t team, const std::string& why);

@@ -99,7 +99,7 @@ void StreamSim::MemberStart(std::size_t r, double t, PointId& start, double& rea
   }
 }
 
-bool StreamSim::MemberRemaining(const Bot& /*b*/, const Task& task, PlanTask& out) const {
+bool StreamSim::MemberRemaining(const Task& task, PlanTask& out) const {
   const Team& team = teams_[static_cast<std::size_t>(task.team)];
   if (team.phase == Team::Phase::kGathering) return Remaining(task, 0, out);
   if (team.phase != Team::Phase::kMoving || team.agent == kNone) return false;
@@ -189,10 +189,8 @@ bool StreamSim::Join(std::size_t r, double t) {
       ctl_.SetIdle(r, false);
       return false;
     }
-    b.off_floor = true;
   } else if (at == p) {
     ctl_.Remove(r);
-    b.off_floor = true;
   } else {
     const std::vector<PointId> route = ctl_.RemainingRoute(r);
     if (route.size() != 2 || route.back() != p) return false;
@@ -282,7 +280,7 @@ void StreamSim::WaitToJoin(std::size_t r, double budget) {
   b.join_wait = 0;
 }
 
-void StreamSim::MoveMember(std::size_t r, double /*t0*/) {
+void StreamSim::MoveMember(std::size_t r) {
   Bot& b = bots_[r];
   if (b.slot == Slot::kInSlot) return;
   const double d = std::min(config_.time_step * b.speed, b.len - b.s);
@@ -290,10 +288,8 @@ void StreamSim::MoveMember(std::size_t r, double /*t0*/) {
   out_.total_distance += std::max(0.0, d);
   const bool arrived = b.s >= b.len - kTiny;
   if (b.slot == Slot::kToSlot) {
-    if (!b.off_floor && (arrived || b.s >= clearance_)) {
-      ctl_.Remove(r);
-      b.off_floor = true;
-    }
+    // It keeps the point it joined from until clear of it; then the agent stands for it.
+    if (!ctl_.removed(r) && (arrived || b.s >= clearance_)) ctl_.Remove(r);
     if (arrived) b.slot = Slot::kInSlot;
     return;
   }
@@ -457,7 +453,6 @@ bool StreamSim::StepLeaving(std::size_t ti, double t) {
   auto start_out = [&](std::size_t m, const Eigen::Vector2d& from, PointId target) {
     Bot& b = bots_[m];
     b.slot = Slot::kOut;
-    b.off_floor = false;
     b.from = from;
     b.to = map_->point(target).position;
     b.via_s = 0;
