@@ -250,6 +250,7 @@ std::vector<GateEffect> TrafficGate::Step(double t) {
     b.held = true;  // sent as a Resume
     s.SendRelease(b, -1, out);
   }
+  s.PlaceStrays();
   s.StepTeams(t, out);
   for (auto& [id, b] : s.bots) s.StepSolo(b, t, out);
   // Deadlock breaking and nudges re-route standing robots: their legs follow.

@@ -121,6 +121,9 @@ struct GateImpl {
   bool OnFloor(const GateBot& b) const;
   bool PlaceBot(GateBot& b, PointId at);
   bool PlaceNear(GateBot& b);
+  // Former members of a formation that is gone, off the floor because the point at their slot
+  // was a teammate's: placed as soon as it is free, before anyone else requests it.
+  void PlaceStrays();
   void StepSolo(GateBot& b, double t, std::vector<GateEffect>& out);
   void RequestSolo(GateBot& b, double t, std::vector<GateEffect>& out);
   void AdoptRoute(GateBot& b, double t, std::vector<GateEffect>& out);

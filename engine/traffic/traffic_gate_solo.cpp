@@ -31,12 +31,21 @@ bool GateImpl::PlaceBot(GateBot& b, PointId at) {
   return true;
 }
 
-// Re-places a bot that is not on the floor at the free point nearest to where it is.
+// Re-places a bot that is not on the floor at the free point nearest to where it is: its
+// plan's current waypoint (or the next) while that is the waypoint it last reached, else the
+// point nearest its last reported pose. A plan cut back to its anchor (its orders taken away
+// after kBlocked or a cancel) leaves idx at the anchor, where the plan started - e.g. its home
+// - while the robot stands elsewhere (issue 15 §3b: never place a robot where it is not). A
+// former member of a formation that is gone may stand in its slot, D_f off the point: it keeps
+// the formation's envelope until its next arrival.
 bool GateImpl::PlaceNear(GateBot& b) {
   std::vector<PointId> candidates;
   const long n = static_cast<long>(b.plan.waypoints.size());
-  if (b.idx >= 0 && b.idx < n) candidates.push_back(b.plan.waypoints[static_cast<std::size_t>(b.idx)].point);
-  if (b.idx + 1 < n) candidates.push_back(b.plan.waypoints[static_cast<std::size_t>(b.idx + 1)].point);
+  const bool current = !b.has_xy || b.idx < 0 ||
+                       (b.idx < n && static_cast<std::uint64_t>(b.plan.waypoints[static_cast<std::size_t>(b.idx)].seq) ==
+                                         b.reached_seq);
+  if (current && b.idx >= 0 && b.idx < n) candidates.push_back(b.plan.waypoints[static_cast<std::size_t>(b.idx)].point);
+  if (current && b.idx + 1 < n) candidates.push_back(b.plan.waypoints[static_cast<std::size_t>(b.idx + 1)].point);
   if (b.has_xy) candidates.push_back(map->NearestPoint(b.xy));
   if (b.ctl >= 0) {  // teammates (a formation it is in or just left) do not keep it off
     const auto keys = TeamKeys(b);
@@ -44,9 +53,19 @@ bool GateImpl::PlaceNear(GateBot& b) {
                  keys.second.empty() ? 0 : GroupOf(keys.second));
   }
   for (PointId p : candidates) {
-    if (PlaceBot(b, p)) return true;
+    if (!PlaceBot(b, p)) continue;
+    if (!b.former_team.empty() && !teams.count(b.former_team)) {
+      ctl.SetEnvelope(static_cast<std::size_t>(b.ctl), FormationRadius());
+    }
+    return true;
   }
   return false;
+}
+
+void GateImpl::PlaceStrays() {
+  for (auto& [id, o] : bots) {
+    if (o.team.empty() && !o.former_team.empty() && !teams.count(o.former_team) && !OnFloor(o)) PlaceNear(o);
+  }
 }
 
 // Rewrites b's waypoints after index `cut` (-1: a new anchor too) with moves along `route`
@@ -145,6 +164,7 @@ void GateImpl::StepSolo(GateBot& b, double t, std::vector<GateEffect>& out) {
         (b.xy - map->point(ctl.At(r)).position).norm() >= config.point_clearance + FormationRadius()) {
       ctl.LeftPoint(r);
       b.left = true;
+      if (!b.former_team.empty()) PlaceStrays();  // a teammate's slot may be at the point it left
     }
     Release(b, RunEnd(b, b.idx + 1, next, n), map->IntersectionOf(next), out);
     return;

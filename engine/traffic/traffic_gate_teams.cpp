@@ -69,13 +69,24 @@ void GateImpl::BreakTeam(GateTeam& team) {
   }
   if (team.ctl >= 0) team_pool.push_back(static_cast<std::size_t>(team.ctl));
   team.ctl = -1;
-  for (const std::string& id : team.members) {
+  const int group = GroupOf(team.order);
+  for (const std::string& id : team.members) {  // leader first
     auto it = bots.find(id);
     if (it == bots.end() || it->second.team != team.order) continue;
-    it->second.team.clear();  // StepSolo puts it back on the floor where it stands
-    it->second.former_team = team.order;
-    it->second.former_at = kNoPoint;  // broken up on the way: until its next point
-    it->second.leg_stale = true;
+    GateBot& b = it->second;
+    b.team.clear();
+    b.former_team = team.order;
+    b.former_at = kNoPoint;  // broken up on the way: until its next point
+    b.leg_stale = true;
+    // It stands in its slot (D_f off the team's point) until it reports elsewhere: back on the
+    // floor there at once, by its pose, before anyone is given the points the team agent held
+    // (issue 15 §3b). If that point is a teammate's, the teammate's D_f envelope covers this
+    // slot, and PlaceStrays places it once the point is free.
+    if (!OnFloor(b) && b.has_xy && b.ctl >= 0) {
+      const auto r = static_cast<std::size_t>(b.ctl);
+      ctl.SetGroup(r, 0, group);
+      if (PlaceBot(b, map->NearestPoint(b.xy))) ctl.SetEnvelope(r, FormationRadius());
+    }
   }
 }
 

@@ -13,6 +13,7 @@
 
 #include "engine/allocation/auction_allocator.h"
 #include "engine/allocation/fleet_state.h"
+#include "engine/fleet/formation.h"
 #include "engine/map/chu2024_floor.h"
 
 namespace dispatch::engine {
@@ -340,6 +341,59 @@ TEST_F(TrafficGateTest, AFormationOrderCompletesWhateverMomentTheServerRestartsA
   EXPECT_GT(formed_again, 0);
   EXPECT_GT(left_alone, 0);
   std::cout << formed_again << " restarts formed the team again, " << left_alone << " found it leaving its drop\n";
+}
+
+TEST_F(TrafficGateTest, RegressionABlockedFormationMemberIsNeverPlacedAtItsHome) {
+  // Issue 15 §3b: a moving formation is blocked; the dispatcher takes the order away, which cuts
+  // each member's plan back to its anchor (its parking point). The members still stand in their
+  // slots and must stay obstacles there: the gate used to put them back at home, and a robot
+  // then came D_f = 0.231 m (later 0 m) from one of them.
+  AddFormation({"park-P1", "park-P2", "park-P3"}, "K3-2-3N", "D-B2", "f1");
+  auto past_pick = [&](const std::string& id) {
+    const Sim& s = sims_[id];
+    std::size_t pick = 0;
+    while (pick < s.plan.size() && s.plan[pick].action != WaypointAction::kPick) ++pick;
+    return static_cast<long>(s.at) - static_cast<long>(pick);
+  };
+  ASSERT_TRUE(Run(40000, {}, [&] {
+    for (const auto& id : team_) {
+      if (gate_->RobotState(id).formation != "f1" || past_pick(id) < 3) return false;
+    }
+    return true;
+  })) << DescribeAll();
+  std::map<std::string, Eigen::Vector2d> stands;
+  std::map<std::string, PointId> home;
+  for (const auto& id : team_) {
+    Sim& s = sims_[id];
+    ASSERT_LT(s.at + 1, s.plan.size()) << id << " is done already";
+    stands[id] = s.plan[s.at].xy;
+    home[id] = s.plan.front().point;
+    gate_->Report(id, stands[id], static_cast<std::uint64_t>(s.plan[s.at].seq), t_);
+  }
+  for (const auto& id : team_) {  // the dispatcher's kBlocked -> ReleaseOrders -> SyncGate
+    Sim& s = sims_[id];
+    s.plan.resize(1);  // the anchor only: the simulated robot stays in its slot
+    s.at = 0;
+    GatePlan cut;
+    cut.waypoints = s.plan;
+    cut.order_of = {""};
+    gate_->SetPlan(id, cut);
+  }
+  Run(1);
+  int on_floor = 0;
+  for (const auto& id : team_) {
+    EXPECT_EQ(gate_->RobotState(id).formation, "") << id;
+    const PointId at = gate_->StartPoint(id);
+    if (at == kNoPoint) continue;  // the point at its slot is a teammate's
+    ++on_floor;
+    EXPECT_NE(at, home[id]) << gate_->Describe(id);
+    EXPECT_LE((map_->point(at).position - stands[id]).norm(), 0.6 + FormationRadius()) << gate_->Describe(id);
+  }
+  EXPECT_GE(on_floor, 1) << DescribeAll();
+  // A robot sent the formation's way keeps eps1 from the members standing in their slots.
+  AddRobot("R4", "park-P4", {"K3-2-3N"}, "D-B2", "o4");
+  Run(600, {}, [&] { return sims_["R4"].at + 1 >= sims_["R4"].plan.size(); });
+  ExpectEps1Kept();
 }
 
 }  // namespace
