@@ -7,17 +7,13 @@
 #include <algorithm>
 #include <cmath>
 
-#include "engine/allocation/auction_allocator.h"
-#include "engine/allocation/greedy_allocator.h"
+#include "engine/dispatch/order_intake.h"
+#include "engine/dispatch/strategy.h"
 #include "server/json_convert.h"
 
 namespace dispatch::server {
 namespace {
 
-// Picks per order. Seed tasks have 1-3; the cap keeps one order (and so every ListOrders
-// page and Assignment carrying it) far below gRPC's 4 MiB message limit: an order of
-// 100 000 picks fits in one SubmitOrder but makes every default-sized page unreadable.
-constexpr std::size_t kMaxPicksPerOrder = 100;
 constexpr int kWorkerNice = 5;  // the workers' CPU priority below the loop's (WorkerThread)
 
 }  // namespace
@@ -43,16 +39,15 @@ engine::Result<std::unique_ptr<Dispatcher>> Dispatcher::Create(
   if (auto valid = engine::ValidateAllocationConfig(options.allocation); !valid.ok()) {
     return valid.error();
   }
-  std::unique_ptr<engine::Allocator> allocator;
-  if (options.strategy == "auction") {
-    allocator = std::make_unique<engine::AuctionAllocator>();
-  } else if (options.strategy == "greedy") {
-    allocator = std::make_unique<engine::GreedyAllocator>();
-  } else {
-    return engine::InvalidArgument("unknown strategy '" + options.strategy + "' (auction | greedy)");
-  }
+  auto allocator = engine::MakeAllocator(options.strategy);
+  if (!allocator.ok()) return allocator.error();
+  auto stopwatch = [] {
+    return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
+  };
+  auto rounds = std::make_unique<engine::RoundRunner>(map, routes, options.allocation,
+                                                      std::move(allocator).value(), stopwatch);
   std::unique_ptr<Dispatcher> d(new Dispatcher(std::move(map), std::move(routes), store,
-                                               std::move(options), std::move(allocator)));
+                                               std::move(options), std::move(rounds)));
   if (d->options_.traffic_control) {
     if (auto valid = d->options_.traffic.Validate(); !valid.ok()) return valid.error();
     auto gate = engine::TrafficGate::Create(d->map_, d->routes_, d->options_.traffic);
@@ -66,12 +61,12 @@ engine::Result<std::unique_ptr<Dispatcher>> Dispatcher::Create(
 
 Dispatcher::Dispatcher(std::shared_ptr<const engine::WarehouseMap> map,
                        std::shared_ptr<const engine::RouteTable> routes, storage::Store& store,
-                       DispatcherOptions options, std::unique_ptr<engine::Allocator> allocator)
+                       DispatcherOptions options, std::unique_ptr<engine::RoundRunner> rounds)
     : map_(std::move(map)),
       routes_(std::move(routes)),
       store_(store),
       options_(std::move(options)),
-      allocator_(std::move(allocator)),
+      rounds_(std::move(rounds)),
       wall_start_(Clock::now()),
       // Below the loop's priority: traffic control first when the cores are busy.
       route_worker_(std::make_unique<WorkerThread>(kWorkerNice)),
@@ -302,6 +297,7 @@ void Dispatcher::Publish() {
     snap->robots.emplace(id, std::move(view));
   }
   snap->zones = ZoneViews(snap->robots);
+  snap->traffic.implausible_reports = traffic_counts_.implausible;
   if (gate_) {
     for (auto& g : gate_->Intersections()) {
       snap->intersections.push_back({std::move(g.holders), std::move(g.waiting)});
@@ -396,7 +392,7 @@ void Dispatcher::SubmitOrder(engine::OrderRequest request, std::function<void(Su
   auto shared = std::make_shared<const engine::OrderRequest>(std::move(request));
   route_worker_->Run([this, shared, done = std::move(done)](bool cancelled) {
     if (!cancelled) {
-      for (const engine::PointId p : StopsOf(*shared)) routes_->Prepare(p);
+      for (const engine::PointId p : engine::StopsOf(*map_, *shared, options_.snap)) routes_->Prepare(p);
     }
     Post([this, shared, done] {
       DoSubmit(*shared, [this, done](SubmitReply reply) {
@@ -404,15 +400,6 @@ void Dispatcher::SubmitOrder(engine::OrderRequest request, std::function<void(Su
       });
     });
   });
-}
-
-std::vector<engine::PointId> Dispatcher::StopsOf(const engine::OrderRequest& request) const {
-  if (request.picks.size() > kMaxPicksPerOrder) return {};
-  auto resolved = engine::ResolveOrder(*map_, request, options_.snap);
-  if (!resolved.ok()) return {};
-  std::vector<engine::PointId> stops = resolved->picks;
-  stops.push_back(resolved->drop);
-  return stops;
 }
 
 void Dispatcher::CancelOrder(std::string order_id, std::string reason,
@@ -424,54 +411,17 @@ void Dispatcher::CancelOrder(std::string order_id, std::string reason,
   });
 }
 
-ServiceStatus Dispatcher::CheckReachable(const engine::Order& order) const {
-  std::vector<engine::PointId> stops = order.picks;
-  stops.push_back(order.drop);
-  for (std::size_t i = 0; i + 1 < stops.size(); ++i) {
-    if (!std::isfinite(routes_->Cost(stops[i], stops[i + 1]))) {
-      const auto& a = map_->point(stops[i]);
-      const auto& b = map_->point(stops[i + 1]);
-      return MakeStatus(StatusCode::kInvalidArgument,
-                        "order '" + order.client_id + "': no route from " +
-                            engine::PointKindName(a.kind) + " point '" + a.name + "' to " +
-                            engine::PointKindName(b.kind) + " point '" + b.name + "'");
-    }
-  }
-  return OkStatus();
-}
-
 void Dispatcher::DoSubmit(const engine::OrderRequest& request,
                           const std::function<void(SubmitReply)>& done) {
   SubmitReply reply;
-  if (request.client_id.empty()) {
-    reply.status = MakeStatus(StatusCode::kInvalidArgument, "client_order_id is required");
-    return done(std::move(reply));
-  }
-  if (request.client_id.size() > 128) {
-    reply.status = MakeStatus(StatusCode::kInvalidArgument,
-                              "client_order_id is longer than 128 bytes");
-    return done(std::move(reply));
-  }
-  if (request.picks.size() > kMaxPicksPerOrder) {
-    reply.status = MakeStatus(StatusCode::kInvalidArgument,
-                              "order '" + request.client_id + "' has " + std::to_string(request.picks.size()) +
-                                  " picks; at most " + std::to_string(kMaxPicksPerOrder) + " are allowed");
-    return done(std::move(reply));
-  }
   engine::OrderRequest req = request;
-  req.id = req.client_id;  // errors name the order by the client's id
   req.created_time = Now();
-  auto resolved = engine::ResolveOrder(*map_, req, options_.snap);
-  if (!resolved.ok()) {
-    reply.status = FromEngineError(resolved.error());
+  auto admitted = engine::AdmitOrder(*map_, *routes_, req, options_.snap, NextOrderId());
+  if (!admitted.ok()) {
+    reply.status = FromEngineError(admitted.error());
     return done(std::move(reply));
   }
-  engine::Order order = std::move(resolved).value();
-  order.id = NextOrderId();
-  if (auto reach = CheckReachable(order); !reach.ok()) {
-    reply.status = reach;
-    return done(std::move(reply));
-  }
+  engine::Order order = std::move(admitted).value();
   if (auto it = by_client_id_.find(order.client_id); it != by_client_id_.end()) {
     const auto& existing = orders_[it->second];
     if (storage::OrderContentHash(order) == existing->record.content_hash) {

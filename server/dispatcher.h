@@ -68,7 +68,7 @@
 #include <unordered_map>
 #include <vector>
 
-#include "engine/allocation/allocator.h"
+#include "engine/dispatch/allocation_round.h"
 #include "engine/fleet/order.h"
 #include "engine/routing/route_table.h"
 #include "engine/traffic/traffic_controller.h"
@@ -185,11 +185,15 @@ class Dispatcher {
     std::uint64_t last_reached = 0;  // highest waypoint sequence reported reached
     std::optional<Eigen::Vector2d> last_xy;  // where it reached its last waypoint
     std::optional<double> held_since;  // dispatcher seconds of the Hold in force
+    // Picks and drops it reported before reaching them (CheckTaskEvent's `later`): tried again
+    // when it reports progress, at most kMaxWaitingEvents.
+    std::vector<RobotInbound> waiting_events;
   };
+  static constexpr std::size_t kMaxWaitingEvents = 8;
 
   Dispatcher(std::shared_ptr<const engine::WarehouseMap> map,
              std::shared_ptr<const engine::RouteTable> routes, storage::Store& store,
-             DispatcherOptions options, std::unique_ptr<engine::Allocator> allocator);
+             DispatcherOptions options, std::unique_ptr<engine::RoundRunner> rounds);
   engine::Status Recover();
   void Loop();
   double Now() const;
@@ -198,10 +202,6 @@ class Dispatcher {
   void DoSubmit(const engine::OrderRequest& request, const std::function<void(SubmitReply)>& done);
   void DoCancel(const std::string& order_id, const std::string& reason,
                 const std::function<void(OrderReply)>& done);
-  ServiceStatus CheckReachable(const engine::Order& order) const;
-  // The stops (picks, drop) the request resolves to; empty when it does not resolve (DoSubmit
-  // then says why). Any thread.
-  std::vector<engine::PointId> StopsOf(const engine::OrderRequest& request) const;
   std::shared_ptr<const OrderView> Find(const std::string& order_id) const;
   void Put(std::shared_ptr<OrderView> view);  // replaces (or adds) an order in the book
   // Publishes a committed journal event to the watchers (deferred, see Defer).
@@ -214,15 +214,8 @@ class Dispatcher {
   void CloseLink(const std::shared_ptr<RobotLink>& link, ServiceStatus status);
   std::string NextOrderId();
 
-  // Allocation rounds (dispatcher_allocation.cpp). A round's view of one robot, copied on the
-  // loop thread: the worker reads nothing else of the dispatcher's state.
-  struct RoundRobot {
-    std::string id;
-    engine::PointId start = engine::kNoPoint;
-    storage::AssignmentRecord assignment;  // empty order_ids: no queue
-    std::uint64_t last_reached = 0;
-    std::vector<std::shared_ptr<const OrderView>> queue;  // the views of assignment.order_ids
-  };
+  // Allocation rounds (dispatcher_allocation.cpp): the core's RoundRunner on the allocation
+  // worker, from a copy of its inputs made on the loop thread.
   // What must not have changed for an award computed on the copy to be committed.
   struct RoundKey {
     std::uint64_t plan_id = 0;
@@ -232,20 +225,10 @@ class Dispatcher {
       return plan_id == o.plan_id && last_order == o.last_order && start == o.start;
     }
   };
-  struct RoundInput {
-    double now = 0.0;
-    std::vector<RoundRobot> robots;  // natural id order
-    std::vector<std::shared_ptr<const OrderView>> pending;  // (priority, created) order
-  };
   struct RoundAward {
-    std::string order_id;
+    engine::RoundAward plan;  // segments per winner (its award moved into record)
     AllocationRecord record;  // the award and the weights it was made with
-    // Per winner (award.winners order): the fleet plan's new waypoints (from its start for a
-    // robot with no queue), and the departure the first of them follows (queued robots).
-    std::vector<std::vector<engine::Waypoint>> segments;
-    std::vector<double> after_departure;
-    double seconds = 0.0;  // the strategy's time for this order
-    std::string detail;    // the explanation as stored (AllocationDetail), made on the worker
+    std::string detail;       // the explanation as stored (AllocationDetail), made on the worker
   };
   // A round's awards on their way into the store, kCommitChunk per loop turn.
   struct RoundCommit {
@@ -261,11 +244,7 @@ class Dispatcher {
   engine::PointId StartOf(const RobotRuntime& robot) const;
   RoundKey KeyOf(const RobotRuntime& robot) const;
   // Worker: the round's awards.
-  std::vector<RoundAward> RunRound(const RoundInput& input);
-  // Appends the robot's remaining orders (each as its member's own task; the first one from
-  // the picks it has not reached yet) to its queue in `fleet`, so that bids count the whole
-  // queue (Chu2024 eq. 3) and traffic prediction sees the robot's work (worker).
-  void ReplayQueue(engine::FleetState& fleet, std::size_t index, const RoundRobot& robot) const;
+  std::vector<RoundAward> RunRound(const engine::RoundInput& input);
   // Loop: commits the round's next kCommitChunk awards, in one store transaction: those whose
   // orders are still accepted and whose robots are still eligible with the keys the round saw;
   // marks another round due when some were not. False if the store failed (nothing of this
@@ -274,13 +253,6 @@ class Dispatcher {
   // Loop: CommitRound, then the rest of the round in a later loop turn (robots are served in
   // between), then the end of the round.
   void CommitNext(std::shared_ptr<RoundCommit> commit);
-  // Removes `order_id` and every later order from the plan; returns the later ones.
-  static std::vector<std::string> CutPlan(storage::AssignmentRecord& plan, const std::string& order_id);
-  // Drops the finished first order (up to its drop waypoint) from the plan; false if
-  // `order_id` is not the plan's first order.
-  static bool TrimDone(storage::AssignmentRecord& plan, const std::string& order_id);
-  // Index of the first waypoint of the plan's k-th order segment.
-  static std::size_t SegmentStart(const storage::AssignmentRecord& plan, std::size_t k);
   // Takes `order_ids` away from their robots and moves each to target(order) (cancelled,
   // failed, or accepted for re-allocation) with `reason`; orders queued after them on the
   // same robots go back to accepted. One store transaction; false (and *status) on failure,
@@ -292,9 +264,6 @@ class Dispatcher {
   RobotOutbound PlanMessage(const RobotRuntime& robot, bool full, std::uint64_t from_sequence) const;
   // Stamps the robot's next message sequence and the time, and sends if connected.
   void SendTo(RobotRuntime& robot, RobotOutbound message);
-  static std::string OrderOfWaypoint(const storage::AssignmentRecord& plan, std::size_t index);
-  // OrderOfWaypoint of every waypoint, in one pass.
-  static std::vector<std::string> OrdersOfWaypoints(const storage::AssignmentRecord& plan);
   RobotRuntime* RobotOf(const std::string& id);
 
   // Robots (dispatcher_robots.cpp).
@@ -302,6 +271,10 @@ class Dispatcher {
   void DoHello(const std::shared_ptr<RobotLink>& link, const RobotInbound& hello);
   void DoWaypointReached(RobotRuntime& robot, const RobotInbound& message);
   void DoTaskEvent(RobotRuntime& robot, const RobotInbound& message);
+  // Runs the robot's waiting picks and drops again (it reported progress).
+  void RetryTaskEvents(RobotRuntime& robot);
+  // A report that was not plausible (engine/dispatch/report_check.h): logged and counted.
+  void Implausible(RobotRuntime& robot, const std::string& what, const std::string& why);
   void DoRobotGone(const std::shared_ptr<RobotLink>& link);
   void MarkOffline(RobotRuntime& robot, const std::string& why);
   // Places a robot that is not connected in the gate at its stored point (an obstacle).
@@ -328,9 +301,6 @@ class Dispatcher {
 
   const std::shared_ptr<const engine::WarehouseMap> map_;
   const std::shared_ptr<const engine::RouteTable> routes_;
-  // The traffic predictor's zone lookup, built by the first allocation round and shared by
-  // the later ones (allocation worker only).
-  std::shared_ptr<const engine::ZoneIndex> zone_index_;
   storage::Store& store_;
   const DispatcherOptions options_;
   WatchHub hub_;
@@ -346,7 +316,7 @@ class Dispatcher {
   std::shared_ptr<const Snapshot> snapshot_;  // atomic_load / atomic_store only
 
   // Allocation worker state (only rounds on allocation_worker_ touch it).
-  std::unique_ptr<engine::Allocator> allocator_;
+  std::unique_ptr<engine::RoundRunner> rounds_;
   // Loop-thread state (no lock: only the loop touches it after Start).
   std::unique_ptr<engine::TrafficGate> gate_;  // null when traffic control is off
   Clock::time_point wall_start_;
@@ -377,6 +347,7 @@ class Dispatcher {
   Clock::time_point awaiting_until_{};
   struct {
     std::uint64_t grants = 0, holds = 0, replans = 0;
+    std::uint64_t implausible = 0;  // robot reports not taken (Implausible)
   } traffic_counts_;
   // Route searches of new orders (SubmitOrder) and allocation rounds: off the loop thread.
   // Stopped first (Stop, destructor): what they still hold reaches the loop's queue.

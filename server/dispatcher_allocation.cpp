@@ -4,7 +4,6 @@
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
-#include <cctype>
 #include <map>
 
 #include "server/dispatcher.h"
@@ -13,28 +12,6 @@
 
 namespace dispatch::server {
 namespace {
-
-// "R2" < "R10": letters compare as text, digit runs as numbers.
-bool NaturalLess(const std::string& a, const std::string& b) {
-  std::size_t i = 0, j = 0;
-  while (i < a.size() && j < b.size()) {
-    if (std::isdigit(static_cast<unsigned char>(a[i])) && std::isdigit(static_cast<unsigned char>(b[j]))) {
-      std::size_t ie = i, je = j;
-      while (ie < a.size() && std::isdigit(static_cast<unsigned char>(a[ie]))) ++ie;
-      while (je < b.size() && std::isdigit(static_cast<unsigned char>(b[je]))) ++je;
-      const std::string na = a.substr(i, ie - i), nb = b.substr(j, je - j);
-      if (na.size() != nb.size()) return na.size() < nb.size();
-      if (na != nb) return na < nb;
-      i = ie;
-      j = je;
-    } else {
-      if (a[i] != b[j]) return a[i] < b[j];
-      ++i;
-      ++j;
-    }
-  }
-  return a.size() - i < b.size() - j;
-}
 
 bool HasOrders(const storage::AssignmentRecord& a, bool has) { return has && !a.order_ids.empty(); }
 
@@ -73,9 +50,13 @@ void Dispatcher::AllocatePending() {
     return;
   }
   retry_allocation_ = false;
-  auto input = std::make_shared<RoundInput>();
+  auto input = std::make_shared<engine::RoundInput>();
+  // The round reads the orders through their views (kept alive by the copy, never copied).
+  auto order_of = [](const std::shared_ptr<const OrderView>& view) {
+    return std::shared_ptr<const engine::Order>(view, &view->record.order);
+  };
   for (const auto& view : orders_) {
-    if (view->record.order.state == engine::OrderState::kAccepted) input->pending.push_back(view);
+    if (view->record.order.state == engine::OrderState::kAccepted) input->pending.push_back(order_of(view));
   }
   if (input->pending.empty()) return;
   std::vector<std::string> ids;
@@ -83,24 +64,22 @@ void Dispatcher::AllocatePending() {
     if (Eligible(r)) ids.push_back(id);
   }
   if (ids.empty()) return;
-  std::sort(ids.begin(), ids.end(), NaturalLess);
-  std::sort(input->pending.begin(), input->pending.end(), [](const auto& a, const auto& b) {
-    const auto& x = a->record.order;
-    const auto& y = b->record.order;
-    if (x.priority != y.priority) return x.priority > y.priority;
-    if (x.created_time != y.created_time) return x.created_time < y.created_time;
-    return a->position < b->position;
-  });
+  std::sort(ids.begin(), ids.end(), engine::NaturalLess);
+  std::sort(input->pending.begin(), input->pending.end(),
+            [](const auto& a, const auto& b) { return engine::AllocationOrderLess(*a, *b); });
   input->now = Now();
   auto keys = std::make_shared<std::map<std::string, RoundKey>>();  // moved into the commit
   for (const auto& id : ids) {
     const RobotRuntime& r = robots_.at(id);
-    RoundRobot robot;
+    engine::RoundRobot robot;
     robot.id = id;
     robot.start = StartOf(r);
     if (HasOrders(r.assignment, r.has_assignment)) {
       robot.assignment = r.assignment;
-      for (const auto& order_id : r.assignment.order_ids) robot.queue.push_back(Find(order_id));
+      for (const auto& order_id : r.assignment.order_ids) {
+        auto view = Find(order_id);
+        robot.queue.push_back(view ? order_of(view) : nullptr);
+      }
     }
     robot.last_reached = r.last_reached;
     input->robots.push_back(std::move(robot));
@@ -129,103 +108,20 @@ void Dispatcher::CommitNext(std::shared_ptr<RoundCommit> commit) {
   }
 }
 
-std::vector<Dispatcher::RoundAward> Dispatcher::RunRound(const RoundInput& input) {
+std::vector<Dispatcher::RoundAward> Dispatcher::RunRound(const engine::RoundInput& input) {
+  engine::RoundResult round = rounds_->Run(input);
+  for (const std::string& note : round.notes) spdlog::warn("{}", note);
   std::vector<RoundAward> out;
-  std::vector<engine::FleetRobot> fleet_robots;
-  for (const RoundRobot& r : input.robots) {
-    engine::FleetRobot f;
-    f.id = r.id;
-    f.start = r.start;
-    f.ready_time = input.now;
-    fleet_robots.push_back(f);
-  }
-  auto fleet = engine::FleetState::Create(map_, routes_, fleet_robots, options_.allocation, zone_index_);
-  if (!fleet.ok()) {
-    spdlog::error("allocation: {}", fleet.error().message);
-    return out;
-  }
-  engine::FleetState state = std::move(fleet).value();
-  zone_index_ = state.zone_index();  // one floor, one index: the next round skips the grid
-  for (std::size_t i = 0; i < input.robots.size(); ++i) ReplayQueue(state, i, input.robots[i]);
-  std::vector<bool> queued(input.robots.size());  // has orders (before or from this round)
-  for (std::size_t i = 0; i < input.robots.size(); ++i) queued[i] = !input.robots[i].assignment.order_ids.empty();
-  for (const auto& view : input.pending) {
-    const engine::Order& order = view->record.order;
-    if (static_cast<std::size_t>(order.team_size()) > input.robots.size()) continue;
-    std::vector<std::size_t> old_sizes;
-    for (std::size_t i = 0; i < state.robot_count(); ++i) old_sizes.push_back(state.plan(i).waypoints.size());
-    const auto start = Clock::now();
-    auto award = allocator_->Allocate(order, state);
-    const double seconds = std::chrono::duration<double>(Clock::now() - start).count();
-    if (!award.ok()) {
-      spdlog::warn("order {} not allocated (stays accepted): {}", order.id, award.error().message);
-      continue;
-    }
+  for (engine::RoundAward& plan : round.awards) {
     RoundAward a;
-    a.order_id = order.id;
-    a.seconds = seconds;
-    for (const auto& w : award->winners) {
-      const std::size_t i = *state.FindRobot(w);
-      const auto& fp = state.plan(i).waypoints;
-      // A robot without a queue gets the whole plan (its start waypoint included).
-      const std::size_t from = queued[i] ? old_sizes[i] : 0;
-      queued[i] = true;
-      a.segments.emplace_back(fp.begin() + static_cast<std::ptrdiff_t>(std::min(from, fp.size())), fp.end());
-      a.after_departure.push_back(from > 0 && from <= fp.size() ? fp[from - 1].departure() : 0.0);
-    }
-    a.record = {std::move(award).value(), options_.allocation.alpha, options_.allocation.beta,
+    a.record = {std::move(plan.award), options_.allocation.alpha, options_.allocation.beta,
                 options_.allocation.zeta, input.now};
+    a.plan = std::move(plan);
     KeepBestBids(a.record);
     a.detail = AllocationDetail(a.record);
     out.push_back(std::move(a));
   }
   return out;
-}
-
-void Dispatcher::ReplayQueue(engine::FleetState& fleet, std::size_t index, const RoundRobot& r) const {
-  const auto& plan = r.assignment;
-  for (std::size_t k = 0; k < plan.order_ids.size(); ++k) {
-    const auto& view = r.queue[k];
-    if (!view) return;
-    const engine::Order& order = view->record.order;
-    std::vector<engine::PointId> picks = order.picks;
-    if (k == 0) {  // only the picks still ahead of the robot
-      picks.clear();
-      for (std::size_t w = 1; w < SegmentStart(plan, 1) && w < plan.plan.waypoints.size(); ++w) {
-        const auto& wp = plan.plan.waypoints[w];
-        if (wp.action == engine::WaypointAction::kPick && static_cast<std::uint64_t>(wp.seq) > r.last_reached) {
-          picks.push_back(wp.point);
-        }
-      }
-      if (picks.empty()) picks.push_back(order.drop);  // picked: only the drop is left
-    }
-    // The stored waypoints of this order (the first: those not reached yet), re-timed from
-    // the queue's end: no routing (on a large floor every random pick is a new destination
-    // of the lazy route table, and re-routing every queue each round thrashed its cache).
-    const std::size_t begin = k == 0 ? 1 : SegmentStart(plan, k), end = SegmentStart(plan, k + 1);
-    std::vector<engine::Waypoint> segment;
-    const engine::PointId from = fleet.summary(index).end_point;
-    segment.push_back({0, from, map_->point(from).position, 0.0, engine::WaypointAction::kMove, 0.0});
-    for (std::size_t w = begin; w < end && w < plan.plan.waypoints.size(); ++w) {
-      engine::Waypoint wp = plan.plan.waypoints[w];
-      if (k == 0 && static_cast<std::uint64_t>(wp.seq) <= r.last_reached) continue;
-      if (segment.size() == 1) {
-        // Reach the first one from the queue's end at cruise speed, then keep the plan's pace.
-        const double lead = (wp.xy - segment.front().xy).norm() / options_.allocation.speed;
-        segment.front().eta = wp.eta - lead;
-      }
-      segment.push_back(wp);
-    }
-    const engine::PlanTask task = fleet.TaskOf(picks, order.drop, order.work_time);
-    engine::Status assigned = engine::InvalidArgument("no stored waypoints");
-    if (segment.size() >= 2) assigned = fleet.AssignPlanned(index, order.id, task, std::move(segment));
-    if (!assigned.ok()) assigned = fleet.AssignSingle(index, order.id, task);
-    if (!assigned.ok()) {
-      spdlog::warn("allocation: queue of {} replayed up to {} only: {}", r.id, order.id,
-                   assigned.error().message);
-      return;
-    }
-  }
 }
 
 bool Dispatcher::CommitRound(RoundCommit& commit) {
@@ -245,7 +141,7 @@ bool Dispatcher::CommitRound(RoundCommit& commit) {
   const std::size_t end = std::min(commit.awards.size(), commit.next + kCommitChunk);
   for (; commit.next < end; ++commit.next) {
     const RoundAward& a = commit.awards[commit.next];
-    auto view = Find(a.order_id);
+    auto view = Find(a.plan.order_id);
     if (!view || view->record.order.state != engine::OrderState::kAccepted) continue;  // cancelled meanwhile
     bool valid = true;
     for (const auto& w : a.record.award.winners) {
@@ -274,29 +170,10 @@ bool Dispatcher::CommitRound(RoundCommit& commit) {
         wk.record.next_sequence += 1;  // the one Assignment / PlanUpdate it gets
       }
       auto& plan = wk.assignment;
-      std::int64_t next_seq = plan.released_up_to + 1;
-      if (!plan.plan.waypoints.empty()) next_seq = std::max<std::int64_t>(next_seq, plan.plan.waypoints.back().seq + 1);
-      const bool empty = plan.order_ids.empty() || (first && wk.fresh);
-      if (empty) {
-        plan.robot_id = w;
-        plan.plan_id += 1;
-        plan.plan.robot_id = w;
-        plan.plan.waypoints.clear();
-        plan.order_ids.clear();
-      }
-      if (first) wk.first_new = static_cast<std::uint64_t>(next_seq);
-      // The replayed queue (see ReplayQueue) re-timed the robot's remaining work from the
-      // round's start; the new segment never starts before the robot's actual plan ends.
-      const auto& segment = a.segments[k];
-      const double shift = empty || segment.empty() ? 0.0 : std::max(0.0, plan.plan.end_time() - a.after_departure[k]);
-      for (engine::Waypoint wp : segment) {
-        wp.seq = static_cast<int>(next_seq++);
-        wp.eta += shift;
-        plan.plan.waypoints.push_back(wp);
-      }
-      plan.order_ids.push_back(a.order_id);
-      plan.released_up_to = next_seq - 1;
-      plan.updated_time = now;
+      plan.robot_id = w;
+      const std::uint64_t first_new = engine::AppendOrder(plan, a.plan.order_id, a.plan.segments[k],
+                                                          a.plan.after_departure[k], first && wk.fresh, now);
+      if (first) wk.first_new = first_new;
       wk.record.robot.task_queue = plan.order_ids;
     }
     accepted.push_back(&a);
@@ -308,7 +185,7 @@ bool Dispatcher::CommitRound(RoundCommit& commit) {
     for (std::size_t i = 0; i < accepted.size(); ++i) {
       const RoundAward& a = *accepted[i];
       storage::OrderTransition t;
-      t.order_id = a.order_id;
+      t.order_id = a.plan.order_id;
       t.to = engine::OrderState::kAssigned;
       t.time = now;
       t.robots = a.record.award.winners;
@@ -316,7 +193,7 @@ bool Dispatcher::CommitRound(RoundCommit& commit) {
       auto e1 = s.TransitionOrder(t);
       if (!e1.ok()) return e1.error();
       events.push_back(*e1);
-      auto e2 = s.AppendProgress(a.order_id, now, a.detail);
+      auto e2 = s.AppendProgress(a.plan.order_id, now, a.detail);
       if (!e2.ok()) return e2.error();
       events.push_back(*e2);
     }
@@ -333,14 +210,14 @@ bool Dispatcher::CommitRound(RoundCommit& commit) {
   }
   for (std::size_t i = 0; i < accepted.size(); ++i) {
     const RoundAward& a = *accepted[i];
-    auto view = std::make_shared<OrderView>(*Find(a.order_id));
+    auto view = std::make_shared<OrderView>(*Find(a.plan.order_id));
     view->record.order.state = engine::OrderState::kAssigned;
     view->record.robots = a.record.award.winners;
     view->record.updated_time = now;
     view->explanation = a.record;
     Put(view);
-    if (options_.metrics) options_.metrics->ObserveAllocation(a.seconds);
-    spdlog::info("order {} assigned: {}", a.order_id, a.record.award.reason);
+    if (options_.metrics) options_.metrics->ObserveAllocation(a.plan.seconds);
+    spdlog::info("order {} assigned: {}", a.plan.order_id, a.record.award.reason);
   }
   for (const auto& e : events) Journal(e);
   for (auto& [id, wk] : work) {

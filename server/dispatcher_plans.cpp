@@ -4,6 +4,7 @@
 
 #include <algorithm>
 
+#include "engine/dispatch/order_release.h"
 #include "server/dispatcher.h"
 
 namespace dispatch::server {
@@ -11,36 +12,6 @@ namespace dispatch::server {
 Dispatcher::RobotRuntime* Dispatcher::RobotOf(const std::string& id) {
   auto it = robots_.find(id);
   return it == robots_.end() ? nullptr : &it->second;
-}
-
-std::size_t Dispatcher::SegmentStart(const storage::AssignmentRecord& plan, std::size_t k) {
-  if (k == 0) return 1;
-  std::size_t drops = 0;
-  for (std::size_t i = 1; i < plan.plan.waypoints.size(); ++i) {
-    if (plan.plan.waypoints[i].action == engine::WaypointAction::kDrop && ++drops == k) return i + 1;
-  }
-  return plan.plan.waypoints.size();
-}
-
-std::vector<std::string> Dispatcher::OrdersOfWaypoints(const storage::AssignmentRecord& plan) {
-  // Waypoint 0 anchors; then segment k (up to and including its drop) serves order_ids[k].
-  const auto& w = plan.plan.waypoints;
-  std::vector<std::string> out(w.size());
-  std::size_t drops = 0;
-  for (std::size_t i = 1; i < w.size() && drops < plan.order_ids.size(); ++i) {
-    out[i] = plan.order_ids[drops];
-    if (w[i].action == engine::WaypointAction::kDrop) ++drops;
-  }
-  return out;
-}
-
-std::string Dispatcher::OrderOfWaypoint(const storage::AssignmentRecord& plan, std::size_t index) {
-  if (index == 0) return {};
-  std::size_t drops = 0;
-  for (std::size_t i = 1; i < index && i < plan.plan.waypoints.size(); ++i) {
-    if (plan.plan.waypoints[i].action == engine::WaypointAction::kDrop) ++drops;
-  }
-  return drops < plan.order_ids.size() ? plan.order_ids[drops] : std::string();
 }
 
 OrderRoutes Dispatcher::RoutesOf(const std::string& order_id) const {
@@ -54,7 +25,7 @@ OrderRoutes Dispatcher::RoutesOf(const std::string& order_id) const {
     const auto& a = r.assignment;
     const std::uint64_t released = ReleasedUpTo(r);
     auto& route = out[robot_id];
-    const std::vector<std::string> order_of = OrdersOfWaypoints(a);
+    const std::vector<std::string> order_of = engine::OrdersOfWaypoints(a);
     for (std::size_t i = 0; i < a.plan.waypoints.size(); ++i) {
       const auto& w = a.plan.waypoints[i];
       const auto seq = static_cast<std::uint64_t>(w.seq);
@@ -62,26 +33,6 @@ OrderRoutes Dispatcher::RoutesOf(const std::string& order_id) const {
     }
   }
   return out;
-}
-
-std::vector<std::string> Dispatcher::CutPlan(storage::AssignmentRecord& plan,
-                                             const std::string& order_id) {
-  auto it = std::find(plan.order_ids.begin(), plan.order_ids.end(), order_id);
-  if (it == plan.order_ids.end()) return {};
-  const auto k = static_cast<std::size_t>(it - plan.order_ids.begin());
-  plan.plan.waypoints.resize(std::max<std::size_t>(1, SegmentStart(plan, k)));
-  std::vector<std::string> later(it + 1, plan.order_ids.end());
-  plan.order_ids.resize(k);
-  return later;
-}
-
-bool Dispatcher::TrimDone(storage::AssignmentRecord& plan, const std::string& order_id) {
-  if (plan.order_ids.empty() || plan.order_ids.front() != order_id) return false;
-  const std::size_t drop = SegmentStart(plan, 1) - 1;  // the first order's drop waypoint
-  auto& w = plan.plan.waypoints;
-  w.erase(w.begin(), w.begin() + static_cast<std::ptrdiff_t>(std::min(drop, w.size() - 1)));
-  plan.order_ids.erase(plan.order_ids.begin());
-  return true;
 }
 
 RobotOutbound Dispatcher::PlanMessage(const RobotRuntime& robot, bool full,
@@ -94,7 +45,7 @@ RobotOutbound Dispatcher::PlanMessage(const RobotRuntime& robot, bool full,
   m.order_ids = a.order_ids;
   // Released: what the traffic gate has released so far (everything without traffic control).
   const std::uint64_t released = ReleasedUpTo(robot);
-  const std::vector<std::string> order_of = OrdersOfWaypoints(a);
+  const std::vector<std::string> order_of = engine::OrdersOfWaypoints(a);
   for (std::size_t i = 0; i < a.plan.waypoints.size(); ++i) {
     const auto& w = a.plan.waypoints[i];
     if (!full && static_cast<std::uint64_t>(w.seq) < from_sequence) continue;
@@ -126,38 +77,24 @@ bool Dispatcher::ReleaseOrders(const std::vector<std::string>& order_ids,
                                const std::function<engine::OrderState(const OrderView&)>& target,
                                const std::string& reason, ServiceStatus* status) {
   const double now = Now();
-  std::map<std::string, engine::OrderState> to;             // order -> new state
-  std::map<std::string, storage::AssignmentRecord> plans;   // robot -> new plan
-  std::map<std::string, std::vector<std::string>> removed;  // robot -> orders taken away
-  std::vector<std::string> work = order_ids;
-  for (const auto& id : order_ids) {
-    if (auto v = Find(id)) to[id] = target(*v);
-  }
-  while (!work.empty()) {
-    const std::string id = work.back();
-    work.pop_back();
+  engine::ReleaseLookups book;
+  book.state = [this](const std::string& id) -> std::optional<engine::OrderState> {
     auto view = Find(id);
-    if (!view) continue;
-    for (const auto& robot_id : view->record.robots) {
-      RobotRuntime* r = RobotOf(robot_id);
-      if (!r || !r->has_assignment) continue;
-      auto [it, inserted] = plans.try_emplace(robot_id, r->assignment);
-      auto& plan = it->second;
-      if (std::find(plan.order_ids.begin(), plan.order_ids.end(), id) == plan.order_ids.end()) continue;
-      auto later = CutPlan(plan, id);
-      removed[robot_id].push_back(id);
-      for (const auto& l : later) {
-        removed[robot_id].push_back(l);
-        if (to.count(l)) continue;
-        auto lv = Find(l);
-        // A later order cannot have started; if it somehow has, it fails rather than vanish.
-        to[l] = lv && lv->record.order.state == engine::OrderState::kInProgress
-                    ? engine::OrderState::kFailed
-                    : engine::OrderState::kAccepted;
-        work.push_back(l);
-      }
-    }
-  }
+    return view ? std::optional<engine::OrderState>(view->record.order.state) : std::nullopt;
+  };
+  book.robots = [this](const std::string& id) {
+    auto view = Find(id);
+    return view ? view->record.robots : std::vector<std::string>{};
+  };
+  book.assignment = [this](const std::string& robot_id) -> const storage::AssignmentRecord* {
+    RobotRuntime* r = RobotOf(robot_id);
+    return r && r->has_assignment ? &r->assignment : nullptr;
+  };
+  engine::OrderRelease release = engine::PlanRelease(
+      order_ids, [&](const std::string& id) { return target(*Find(id)); }, book);
+  auto& to = release.to;
+  auto& plans = release.plans;
+  auto& removed = release.removed;
   std::vector<storage::OrderEvent> events;
   auto committed = store_.RunInTransaction([&](storage::Store& s) -> engine::Status {
     events.clear();
@@ -201,6 +138,7 @@ bool Dispatcher::ReleaseOrders(const std::vector<std::string>& order_ids,
       view->finished_time = now;
     }
     Put(view);
+    if (state != engine::OrderState::kAccepted) order_distance_.erase(id);  // finished: nothing more driven
   }
   for (const auto& e : events) Journal(e);
   for (auto& [robot_id, plan] : plans) {

@@ -2,10 +2,13 @@
 // grace that re-allocates a lost robot's orders.
 #include <spdlog/spdlog.h>
 
+#include <algorithm>
 #include <cmath>
 #include <optional>
 #include <sstream>
 
+#include "engine/dispatch/report_check.h"
+#include "engine/dispatch/order_release.h"
 #include "server/dispatcher.h"
 
 namespace dispatch::server {
@@ -86,15 +89,14 @@ void Dispatcher::DoRobotMessage(const std::shared_ptr<RobotLink>& link, const Ro
       // A waypoint beyond the highest ever numbered for this robot was never sent, so it
       // cannot have been passed: such a claim is ignored (the gate would otherwise take the
       // robot to be at its plan's end and disregard its real progress from then on).
-      std::int64_t numbered = r->assignment.released_up_to;
-      if (!r->assignment.plan.waypoints.empty()) {
-        numbered = std::max<std::int64_t>(numbered, r->assignment.plan.waypoints.back().seq);
-      }
+      const std::int64_t numbered = engine::HighestNumbered(r->assignment);
       const std::uint64_t passed =
           numbered >= 0 && m.sequence <= static_cast<std::uint64_t>(numbered) ? m.sequence : 0;
+      const bool progressed = passed > r->last_reached;
       r->last_reached = std::max(r->last_reached, passed);
       if (gate_) gate_->Report(r->record.robot.id, m.pose.position, passed, Now());
       if (!awaiting_reconnect_.empty()) Reported(r->record.robot.id);
+      if (progressed) RetryTaskEvents(*r);
       break;
     }
     case RobotInbound::Kind::kWaypointReached: DoWaypointReached(*r, m); break;
@@ -228,36 +230,48 @@ void Dispatcher::StartOrder(const std::string& order_id, const std::string& deta
 
 void Dispatcher::DoWaypointReached(RobotRuntime& r, const RobotInbound& m) {
   const auto& w = r.assignment.plan.waypoints;
-  for (std::size_t i = 0; i < w.size(); ++i) {
-    if (static_cast<std::uint64_t>(w[i].seq) != m.sequence) continue;
-    r.record.robot.current_point = w[i].point;
-    const bool fresh = m.sequence > r.last_reached;  // not a repeat of an older arrival
-    if (fresh) {  // distance driven, for the order it serves
-      if (r.last_xy) {
-        const std::string order = OrderOfWaypoint(r.assignment, i);
-        if (!order.empty()) order_distance_[order] += (w[i].xy - *r.last_xy).norm();
-      }
-      r.last_xy = w[i].xy;
+  const std::optional<Eigen::Vector2d> pose =
+      m.has_pose ? std::optional<Eigen::Vector2d>(m.pose.position) : std::nullopt;
+  const engine::ReportVerdict verdict =
+      engine::CheckReached(r.assignment, m.sequence, ReleasedUpTo(r), pose, options_.robot_snap_tolerance);
+  if (!verdict.taken) return Implausible(r, "reached waypoint " + std::to_string(m.sequence), verdict.why);
+  const std::size_t i = verdict.index;
+  r.record.robot.current_point = w[i].point;
+  const bool fresh = m.sequence > r.last_reached;  // not a repeat of an older arrival
+  if (fresh) {  // distance driven, for the order it serves
+    if (r.last_xy) {
+      const std::string order = engine::OrderOfWaypoint(r.assignment, i);
+      if (!order.empty()) order_distance_[order] += (w[i].xy - *r.last_xy).norm();
     }
-    r.last_reached = std::max(r.last_reached, m.sequence);
-    // Where it is now: a new arrival is fresher than the last state report (robots report at
-    // a few Hz). Its pose, if it is near the waypoint (a missing pose reads as (0, 0)), else
-    // the waypoint's own position.
-    std::optional<Eigen::Vector2d> xy;
-    if (fresh) {
-      const bool near = m.pose.position.allFinite() &&
-                        (m.pose.position - w[i].xy).norm() <= options_.robot_snap_tolerance;
-      xy = near ? m.pose.position : w[i].xy;
-      r.record.robot.pose.position = *xy;
-      if (near && std::isfinite(m.pose.heading)) r.record.robot.pose.heading = m.pose.heading;
-    }
-    if (gate_) gate_->Reached(r.record.robot.id, m.sequence, Now(), xy);
-    if (w[i].action == engine::WaypointAction::kPick) {
-      const std::string order = OrderOfWaypoint(r.assignment, i);
-      StartOrder(order, r.record.robot.id + " reached pick '" + map_->point(w[i].point).name + "'");
-    }
-    return;
+    r.last_xy = w[i].xy;
   }
+  r.last_reached = std::max(r.last_reached, m.sequence);
+  // Where it is now: a new arrival is fresher than the last state report (robots report at a
+  // few Hz): the pose it sent (near the waypoint, checked above), else the waypoint's own.
+  std::optional<Eigen::Vector2d> xy;
+  if (fresh) {
+    xy = pose ? *pose : w[i].xy;
+    r.record.robot.pose.position = *xy;
+    if (pose && std::isfinite(m.pose.heading)) r.record.robot.pose.heading = m.pose.heading;
+  }
+  if (gate_) gate_->Reached(r.record.robot.id, m.sequence, Now(), xy);
+  if (w[i].action == engine::WaypointAction::kPick) {
+    const std::string order = engine::OrderOfWaypoint(r.assignment, i);
+    StartOrder(order, r.record.robot.id + " reached pick '" + map_->point(w[i].point).name + "'");
+  }
+  if (fresh) RetryTaskEvents(r);
+}
+
+void Dispatcher::RetryTaskEvents(RobotRuntime& r) {
+  std::vector<RobotInbound> waiting;
+  waiting.swap(r.waiting_events);
+  for (const RobotInbound& m : waiting) DoTaskEvent(r, m);
+}
+
+void Dispatcher::Implausible(RobotRuntime& r, const std::string& what, const std::string& why) {
+  ++traffic_counts_.implausible;
+  dirty_ = true;
+  spdlog::warn("robot {}: '{}' not taken: {}", r.record.robot.id, what, why);
 }
 
 void Dispatcher::DoTaskEvent(RobotRuntime& r, const RobotInbound& m) {
@@ -266,9 +280,26 @@ void Dispatcher::DoTaskEvent(RobotRuntime& r, const RobotInbound& m) {
   if (!view || engine::IsTerminal(view->record.order.state)) return;  // late or repeated
   const auto& team = view->record.robots;
   if (std::find(team.begin(), team.end(), robot) == team.end()) return;
-  std::string where = m.point_id >= 0 && static_cast<std::size_t>(m.point_id) < map_->point_count()
-                          ? "'" + map_->point(m.point_id).name + "'"
-                          : "?";
+  if (m.dropped && view->dropped_by.count(robot)) return;  // repeated
+  const engine::ReportVerdict verdict = engine::CheckTaskEvent(
+      r.assignment, m.order_id, m.dropped, r.last_reached, r.record.robot.pose.position, options_.robot_snap_tolerance);
+  const std::string what = std::string(m.dropped ? "dropped" : "picked") + " for order " + m.order_id;
+  if (verdict.later) {  // e.g. a drop repeated after a restart before the robot's first report
+    auto same = [&](const RobotInbound& e) { return e.order_id == m.order_id && e.dropped == m.dropped; };
+    if (std::none_of(r.waiting_events.begin(), r.waiting_events.end(), same)) {
+      if (r.waiting_events.size() >= kMaxWaitingEvents) {
+        Implausible(r, "task event waiting too long", "more than " + std::to_string(kMaxWaitingEvents) +
+                                                         " picks and drops wait for progress");
+        r.waiting_events.erase(r.waiting_events.begin());
+      }
+      r.waiting_events.push_back(m);
+      spdlog::debug("robot {}: '{}' waits for its progress: {}", robot, what, verdict.why);
+    }
+    return;
+  }
+  if (!verdict.taken) return Implausible(r, what, verdict.why);
+  // Where it did it: the stop of its plan (the point id it sent is not needed).
+  const std::string where = "'" + map_->point(r.assignment.plan.waypoints[verdict.index].point).name + "'";
   if (!m.dropped) {
     if (view->record.order.state == engine::OrderState::kAssigned) {
       StartOrder(m.order_id, robot + " picked at " + where);
@@ -277,11 +308,10 @@ void Dispatcher::DoTaskEvent(RobotRuntime& r, const RobotInbound& m) {
     }
     return;
   }
-  if (view->dropped_by.count(robot)) return;  // repeated
   StartOrder(m.order_id, robot + " dropped at " + where);
   view = Find(m.order_id);
   storage::AssignmentRecord plan = r.assignment;
-  const bool trimmed = TrimDone(plan, m.order_id);
+  const bool trimmed = engine::TrimDone(plan, m.order_id);
   std::set<std::string> dropped = view->dropped_by;
   dropped.insert(robot);
   const bool complete = dropped.size() >= team.size();
@@ -375,10 +405,7 @@ void Dispatcher::Tick() {
     if (offline.count() < options_.offline_grace) continue;
     ServiceStatus status;
     const std::string why = "robot " + id + " offline for more than " + Fixed(options_.offline_grace) + " s";
-    auto target = [](const OrderView& v) {
-      return v.record.order.state == engine::OrderState::kInProgress ? engine::OrderState::kFailed
-                                                                     : engine::OrderState::kAccepted;
-    };
+    auto target = [](const OrderView& v) { return engine::StateAfterRobotLoss(v.record.order.state); };
     if (ReleaseOrders(r.assignment.order_ids, target, why, &status)) {
       r.offline_since.reset();
       retry_allocation_ = true;

@@ -5,22 +5,18 @@
 
 #include <algorithm>
 
+#include "engine/dispatch/order_release.h"
 #include "server/dispatcher.h"
 
 namespace dispatch::server {
 
 engine::GatePlan Dispatcher::GatePlanOf(const RobotRuntime& r) const {
-  engine::GatePlan g;
-  const auto& w = r.assignment.plan.waypoints;
-  g.waypoints = w;
-  g.order_of = OrdersOfWaypoints(r.assignment);
+  std::map<std::string, std::vector<std::string>> teams;
   for (const auto& id : r.assignment.order_ids) {
     auto view = Find(id);
-    if (view && view->record.order.formation) g.teams[id] = view->record.robots;
+    if (view && view->record.order.formation) teams[id] = view->record.robots;
   }
-  g.next_sequence = static_cast<std::uint64_t>(r.assignment.released_up_to) + 1;
-  if (!w.empty()) g.next_sequence = std::max<std::uint64_t>(g.next_sequence, w.back().seq + 1);
-  return g;
+  return engine::ToGatePlan(r.assignment, std::move(teams));
 }
 
 void Dispatcher::SyncGate(const RobotRuntime& r) {
@@ -178,10 +174,7 @@ void Dispatcher::ApplyGateEffect(engine::GateEffect& e) {
       dirty_ = true;
       if (!r->has_assignment || r->assignment.order_ids.empty()) break;
       ServiceStatus status;
-      auto target = [](const OrderView& v) {
-        return v.record.order.state == engine::OrderState::kInProgress ? engine::OrderState::kFailed
-                                                                       : engine::OrderState::kAccepted;
-      };
+      auto target = [](const OrderView& v) { return engine::StateAfterRobotLoss(v.record.order.state); };
       if (ReleaseOrders(r->assignment.order_ids, target, "robot " + e.robot + " blocked: " + e.reason, &status)) {
         retry_allocation_ = true;
       }

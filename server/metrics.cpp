@@ -70,6 +70,8 @@ ServiceMetrics::ServiceMetrics() : registry_(std::make_shared<prometheus::Regist
   deadlocks_ = counter("dispatch_deadlocks_resolved_total", "Wait-for cycles broken");
   head_on_ = counter("dispatch_head_on_conflicts_total", "Head-on conflicts on single lanes");
   nudges_ = counter("dispatch_nudges_total", "Idle robots sent aside for others");
+  implausible_ = counter("dispatch_implausible_reports_total",
+                         "Robot reports not taken: arrivals at unreleased or far waypoints, picks and drops away from the stop");
 }
 
 ServiceMetrics::~ServiceMetrics() = default;
@@ -115,6 +117,7 @@ std::string ServiceMetrics::Render(const Snapshot& snap) {
   RaiseTo(*deadlocks_, static_cast<double>(snap.traffic.deadlocks_resolved));
   RaiseTo(*head_on_, static_cast<double>(snap.traffic.head_on_conflicts));
   RaiseTo(*nudges_, static_cast<double>(snap.traffic.nudges));
+  RaiseTo(*implausible_, static_cast<double>(snap.traffic.implausible_reports));
   return prometheus::TextSerializer().Serialize(registry_->Collect());
 }
 

@@ -10,7 +10,8 @@
 //   dispatch_robots{state}              robots by state (offline when not connected)
 //   dispatch_robot_streams              connected robot streams
 //   dispatch_grants_total, dispatch_holds_total, dispatch_replans_total,
-//   dispatch_deadlocks_resolved_total, dispatch_head_on_conflicts_total, dispatch_nudges_total
+//   dispatch_deadlocks_resolved_total, dispatch_head_on_conflicts_total, dispatch_nudges_total,
+//   dispatch_implausible_reports_total
 //   dispatch_min_robot_distance_meters  closest two robots of different agents so far
 #pragma once
 
@@ -61,6 +62,7 @@ class ServiceMetrics {
   prometheus::Counter* deadlocks_;
   prometheus::Counter* head_on_;
   prometheus::Counter* nudges_;
+  prometheus::Counter* implausible_;
   std::mutex render_mu_;  // one scrape at a time brings the snapshot values up to date
   std::mutex db_mu_;      // db_write_ label lookups
 };

@@ -193,6 +193,7 @@ engine::Result<RobotInbound> RobotInboundFromProto(const pb::RobotMessage& m) {
       in.kind = RobotInbound::Kind::kWaypointReached;
       in.sequence = m.waypoint_reached().sequence();
       in.pose = PoseFromProto(m.waypoint_reached().pose());
+      in.has_pose = m.waypoint_reached().has_pose();
       return in;
     case pb::RobotMessage::kTaskEvent: {
       const auto& e = m.task_event();

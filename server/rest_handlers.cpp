@@ -203,6 +203,7 @@ RestReply RestHandlers::Status() const {
                   {"deadlocks_resolved", t.deadlocks_resolved},
                   {"head_on_conflicts", t.head_on_conflicts},
                   {"nudges", t.nudges},
+                  {"implausible_reports", t.implausible_reports},
                   {"awaiting_reconnect", t.awaiting_reconnect},
                   {"min_robot_distance", nullptr}};
   if (t.min_distance >= 0) {

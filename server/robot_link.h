@@ -28,6 +28,7 @@ struct RobotInbound {
   double max_speed = 0.0;  // 0 = default
   // kHello, kState, kWaypointReached
   engine::Pose pose;
+  bool has_pose = true;  // kWaypointReached: the robot sent its pose with the arrival
   // kState
   std::optional<int> arc_id;
   double arc_offset = 0.0;

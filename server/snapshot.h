@@ -72,6 +72,7 @@ struct TrafficView {
   std::size_t deadlocks_resolved = 0;
   std::size_t head_on_conflicts = 0;
   std::size_t nudges = 0;
+  std::uint64_t implausible_reports = 0;  // robot reports not taken (engine/dispatch/report_check.h)
   double min_distance = -1.0;  // m between robot centres of different agents; < 0: none yet
   std::string min_pair_a, min_pair_b;
   double min_time = 0.0;

@@ -28,6 +28,7 @@
 #include <vector>
 
 #include "engine/common/result.h"
+#include "engine/dispatch/assignment.h"
 #include "engine/fleet/order.h"
 #include "engine/fleet/plan.h"
 #include "engine/fleet/robot.h"
@@ -111,15 +112,9 @@ struct RobotRecord {
   std::uint64_t next_sequence = 1;        // next server message sequence to use
 };
 
-// A robot's current plan and what it serves (one per robot; saving replaces it).
-struct AssignmentRecord {
-  std::string robot_id;
-  std::uint64_t plan_id = 0;            // increasing per robot
-  std::vector<std::string> order_ids;   // in execution order
-  engine::Plan plan;                    // plan.robot_id == robot_id
-  std::int64_t released_up_to = -1;     // highest released waypoint seq; -1 = none
-  double updated_time = 0.0;
-};
+// A robot's current plan and what it serves (one per robot; saving replaces it): the dispatch
+// core's Assignment (engine/dispatch/assignment.h).
+using AssignmentRecord = engine::Assignment;
 
 struct MapVersion {
   std::int64_t version = 0;  // increasing, assigned by the store

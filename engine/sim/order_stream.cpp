@@ -26,6 +26,11 @@ StreamSim::StreamSim(std::shared_ptr<const WarehouseMap> map, std::shared_ptr<co
 
 Status StreamSim::Init(const std::vector<FleetRobot>& robots, std::vector<Order> orders) {
   if (robots.empty()) return InvalidArgument("order stream: no robots");
+  if (config_.strategy != AllocationStrategy::kPreassigned) {  // the service's registry
+    auto made = MakeAllocator(AllocationStrategyName(config_.strategy));
+    if (!made.ok()) return made.error();
+    allocator_ = std::move(made).value();
+  }
   // Formation agents are bots too (at most one per joined robot); references stay valid.
   bots_.reserve(2 * robots.size());
   for (const FleetRobot& fr : robots) {
@@ -181,9 +186,7 @@ void StreamSim::Release(double t) {
       if (left) (void)state.AssignSingle(i, out_.orders[task.order].order_id, pt);
     }
   }
-  Allocator& allocator = config_.strategy == AllocationStrategy::kAuction
-                             ? static_cast<Allocator&>(auction_)
-                             : static_cast<Allocator&>(greedy_);
+  Allocator& allocator = *allocator_;
   std::unordered_map<std::string, std::size_t> order_index;
   for (std::size_t k = first_k; k < next_release_; ++k) order_index.emplace(orders_[k].id, k);
   for (const OrderAllocation& a : AllocateAll(allocator, batch, state)) {

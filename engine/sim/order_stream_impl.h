@@ -12,8 +12,7 @@
 #include <string>
 #include <vector>
 
-#include "engine/allocation/auction_allocator.h"
-#include "engine/allocation/greedy_allocator.h"
+#include "engine/dispatch/strategy.h"
 #include "engine/sim/order_stream.h"
 
 namespace dispatch::engine::stream_sim {
@@ -163,8 +162,7 @@ class StreamSim {
   std::size_t next_release_ = 0;
   double next_allocation_ = 0.0;
   std::size_t terminal_ = 0;
-  AuctionAllocator auction_;
-  GreedyAllocator greedy_;
+  std::unique_ptr<Allocator> allocator_;  // MakeAllocator (null: preassigned)
   StreamResult out_;
   double clearance_ = 0.6;  // TrafficControllerConfig::point_clearance
   double radius_ = 0.0;     // the formation's D_f

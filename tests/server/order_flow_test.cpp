@@ -156,6 +156,56 @@ TEST_F(OrderFlowTest, SubmitAssignCompleteWithARobot) {
                                                  pb::ORDER_STATE_IN_PROGRESS, pb::ORDER_STATE_COMPLETED}));
 }
 
+TEST_F(OrderFlowTest, RegressionAPickOrDropIsTakenOnlyWhereTheRobotStands) {
+  // Issue 15 §3b: a client that said Hello as an unknown robot id received an order and
+  // reported it completed without driving (distance 0.0). Now a drop counts only once the robot
+  // has reached that order's drop waypoint (released to it, the pose near it) and stands there.
+  StartServer();
+  OrderWatcher watcher(channel_);
+  FakeRobot robot(channel_, "Liar1");
+  robot.Connect(kP1x, kP1y);
+  ASSERT_TRUE(robot.WaitFor(pb::ServerMessage::kWelcome));
+  pb::SubmitOrderResponse submitted;
+  ASSERT_TRUE(Submit(OrderRequest("wms-liar", {"K3-2-3N"}, "D-B2"), &submitted).ok());
+  const std::string id = submitted.order().id();
+  auto assignment = robot.WaitFor(pb::ServerMessage::kAssignment);
+  ASSERT_TRUE(assignment);
+  const auto& plan = assignment->assignment();
+  const auto& drop = plan.waypoints(plan.waypoints_size() - 1);
+  ASSERT_EQ(drop.action(), pb::WAYPOINT_ACTION_DROP);
+  ASSERT_GT(drop.sequence(), plan.released_up_to_sequence());
+  // Straight to the drop: an arrival at a waypoint not released, then picked and dropped events
+  // while it stands at its station (they wait until it has reached the stops: a drop repeated
+  // after a restart comes before the robot's first progress report).
+  pb::RobotMessage reached;
+  reached.mutable_waypoint_reached()->set_sequence(drop.sequence());
+  reached.mutable_waypoint_reached()->mutable_pose()->set_x(drop.x());
+  reached.mutable_waypoint_reached()->mutable_pose()->set_y(drop.y());
+  ASSERT_TRUE(robot.Write(reached));
+  for (const auto type : {pb::TASK_EVENT_TYPE_PICKED, pb::TASK_EVENT_TYPE_DROPPED}) {
+    pb::RobotMessage event;
+    event.mutable_task_event()->set_order_id(id);
+    event.mutable_task_event()->set_type(type);
+    event.mutable_task_event()->set_point_id(drop.point_id());
+    event.mutable_task_event()->set_waypoint_sequence(drop.sequence());
+    ASSERT_TRUE(robot.Write(event));
+  }
+  // An arrival far from its waypoint is not taken either.
+  pb::RobotMessage far;
+  far.mutable_waypoint_reached()->set_sequence(plan.waypoints(0).sequence());
+  far.mutable_waypoint_reached()->mutable_pose()->set_x(drop.x());
+  far.mutable_waypoint_reached()->mutable_pose()->set_y(drop.y());
+  ASSERT_TRUE(robot.Write(far));
+  // Then it drives the plan for real: the order completes, with the distance driven.
+  ASSERT_GT(robot.Follow(plan.waypoints(), plan.released_up_to_sequence()), 0);
+  ASSERT_TRUE(watcher.WaitForState(id, pb::ORDER_STATE_COMPLETED));
+  const pb::Order order = Get(id);
+  EXPECT_GT(order.distance(), 5.0);
+  // The forged arrivals were processed before the real reports (one stream, in order) and
+  // flagged; the early picked / dropped events counted only once it had reached the stops.
+  EXPECT_EQ(server_->dispatcher().snapshot()->traffic.implausible_reports, 2u);
+}
+
 TEST_F(OrderFlowTest, WatchingAnUnknownOrderIsNotFound) {
   StartServer();
   pb::SubmitOrderResponse a;

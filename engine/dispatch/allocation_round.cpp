@@ -1,0 +1,139 @@
+#include "engine/dispatch/allocation_round.h"
+
+#include <algorithm>
+#include <cctype>
+
+namespace dispatch::engine {
+
+bool NaturalLess(const std::string& a, const std::string& b) {
+  std::size_t i = 0, j = 0;
+  while (i < a.size() && j < b.size()) {
+    if (std::isdigit(static_cast<unsigned char>(a[i])) && std::isdigit(static_cast<unsigned char>(b[j]))) {
+      std::size_t ie = i, je = j;
+      while (ie < a.size() && std::isdigit(static_cast<unsigned char>(a[ie]))) ++ie;
+      while (je < b.size() && std::isdigit(static_cast<unsigned char>(b[je]))) ++je;
+      const std::string na = a.substr(i, ie - i), nb = b.substr(j, je - j);
+      if (na.size() != nb.size()) return na.size() < nb.size();
+      if (na != nb) return na < nb;
+      i = ie;
+      j = je;
+    } else {
+      if (a[i] != b[j]) return a[i] < b[j];
+      ++i;
+      ++j;
+    }
+  }
+  return a.size() - i < b.size() - j;
+}
+
+bool AllocationOrderLess(const Order& a, const Order& b) {
+  if (a.priority != b.priority) return a.priority > b.priority;
+  if (a.created_time != b.created_time) return a.created_time < b.created_time;
+  return NaturalLess(a.id, b.id);
+}
+
+RoundRunner::RoundRunner(std::shared_ptr<const WarehouseMap> map, std::shared_ptr<const RouteTable> routes,
+                         AllocationConfig config, std::unique_ptr<Allocator> allocator,
+                         std::function<double()> stopwatch)
+    : map_(std::move(map)),
+      routes_(std::move(routes)),
+      config_(config),
+      allocator_(std::move(allocator)),
+      stopwatch_(std::move(stopwatch)) {}
+
+RoundResult RoundRunner::Run(const RoundInput& input) {
+  RoundResult out;
+  std::vector<FleetRobot> fleet_robots;
+  for (const RoundRobot& r : input.robots) fleet_robots.push_back({r.id, r.start, input.now});
+  auto fleet = FleetState::Create(map_, routes_, fleet_robots, config_, zone_index_);
+  if (!fleet.ok()) {
+    out.notes.push_back("allocation: " + fleet.error().message);
+    return out;
+  }
+  FleetState state = std::move(fleet).value();
+  zone_index_ = state.zone_index();  // one floor, one index: the next round skips the grid
+  for (std::size_t i = 0; i < input.robots.size(); ++i) ReplayQueue(state, i, input.robots[i], out.notes);
+  std::vector<bool> queued(input.robots.size());  // has orders (before or from this round)
+  for (std::size_t i = 0; i < input.robots.size(); ++i) queued[i] = !input.robots[i].assignment.order_ids.empty();
+  for (const auto& pending : input.pending) {
+    const Order& order = *pending;
+    if (static_cast<std::size_t>(order.team_size()) > input.robots.size()) continue;
+    std::vector<std::size_t> old_sizes;
+    for (std::size_t i = 0; i < state.robot_count(); ++i) old_sizes.push_back(state.plan(i).waypoints.size());
+    const double start = stopwatch_ ? stopwatch_() : 0.0;
+    auto award = allocator_->Allocate(order, state);
+    const double seconds = stopwatch_ ? stopwatch_() - start : 0.0;
+    if (!award.ok()) {
+      out.notes.push_back("order " + order.id + " not allocated (stays accepted): " + award.error().message);
+      continue;
+    }
+    RoundAward a;
+    a.order_id = order.id;
+    a.seconds = seconds;
+    for (const auto& w : award->winners) {
+      const std::size_t i = *state.FindRobot(w);
+      const auto& fp = state.plan(i).waypoints;
+      // A robot without a queue gets the whole plan (its start waypoint included).
+      const std::size_t from = queued[i] ? old_sizes[i] : 0;
+      queued[i] = true;
+      a.segments.emplace_back(fp.begin() + static_cast<std::ptrdiff_t>(std::min(from, fp.size())), fp.end());
+      a.after_departure.push_back(from > 0 && from <= fp.size() ? fp[from - 1].departure() : 0.0);
+    }
+    a.award = std::move(award).value();
+    out.awards.push_back(std::move(a));
+  }
+  return out;
+}
+
+bool RoundRunner::ReplayQueue(FleetState& fleet, std::size_t index, const RoundRobot& r,
+                              std::vector<std::string>& notes) const {
+  const Assignment& plan = r.assignment;
+  const auto& stored = plan.plan.waypoints;
+  for (std::size_t k = 0; k < plan.order_ids.size(); ++k) {
+    if (k >= r.queue.size() || !r.queue[k]) {
+      notes.push_back("allocation: queue of " + r.id + " replayed up to " + plan.order_ids[k] +
+                      " only: the order is not known");
+      return false;
+    }
+    const Order& order = *r.queue[k];
+    std::vector<PointId> picks = order.picks;
+    if (k == 0) {  // only the picks still ahead of the robot
+      picks.clear();
+      for (std::size_t w = 1; w < SegmentStart(plan, 1) && w < stored.size(); ++w) {
+        if (stored[w].action == WaypointAction::kPick && static_cast<std::uint64_t>(stored[w].seq) > r.last_reached) {
+          picks.push_back(stored[w].point);
+        }
+      }
+      if (picks.empty()) picks.push_back(order.drop);  // picked: only the drop is left
+    }
+    // The stored waypoints of this order (the first: those not reached yet), re-timed from
+    // the queue's end: no routing (on a large floor every random pick is a new destination
+    // of the lazy route table, and re-routing every queue each round thrashed its cache).
+    const std::size_t begin = k == 0 ? 1 : SegmentStart(plan, k), end = SegmentStart(plan, k + 1);
+    std::vector<Waypoint> segment;
+    const PointId from = fleet.summary(index).end_point;
+    segment.push_back({0, from, map_->point(from).position, 0.0, WaypointAction::kMove, 0.0});
+    for (std::size_t w = begin; w < end && w < stored.size(); ++w) {
+      Waypoint wp = stored[w];
+      if (k == 0 && static_cast<std::uint64_t>(wp.seq) <= r.last_reached) continue;
+      if (segment.size() == 1) {
+        // Reach the first one from the queue's end at cruise speed, then keep the plan's pace.
+        const double lead = (wp.xy - segment.front().xy).norm() / config_.speed;
+        segment.front().eta = wp.eta - lead;
+      }
+      segment.push_back(wp);
+    }
+    const PlanTask task = fleet.TaskOf(picks, order.drop, order.work_time);
+    Status assigned = InvalidArgument("no stored waypoints");
+    if (segment.size() >= 2) assigned = fleet.AssignPlanned(index, order.id, task, std::move(segment));
+    if (!assigned.ok()) assigned = fleet.AssignSingle(index, order.id, task);
+    if (!assigned.ok()) {
+      notes.push_back("allocation: queue of " + r.id + " replayed up to " + order.id + " only: " +
+                      assigned.error().message);
+      return false;
+    }
+  }
+  return true;
+}
+
+}  // namespace dispatch::engine

@@ -1,0 +1,88 @@
+// Allocation rounds (Chu2024 §2, issue 15 §1): one round of the chosen strategy over the
+// robots' current state, the same for the service (on its allocation worker) and the
+// simulator.
+//
+// A round builds a fresh FleetState with every robot at its start point now, replays each
+// robot's remaining orders into its queue from its stored plan (ReplayQueue: the stored
+// waypoints, re-timed from the queue's end, no routing), so that bids count the whole queue
+// (eq. (3)) and the traffic prediction sees every robot's work, then auctions the pending
+// orders one at a time in their allocation order (AllocationOrderLess). Each award carries
+// the winners' new plan segments, to be spliced into their assignments (AppendOrder).
+//
+// RoundRunner is not thread-safe: one round at a time (it keeps the predictor's zone index
+// between rounds). Inputs are values; nothing else is read.
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "engine/allocation/allocator.h"
+#include "engine/allocation/fleet_state.h"
+#include "engine/dispatch/assignment.h"
+
+namespace dispatch::engine {
+
+// "R2" < "R10": letters compare as text, digit runs as numbers (robot bidding order, and the
+// tie-break of orders created at the same time: "ord-999999" < "ord-1000000").
+bool NaturalLess(const std::string& a, const std::string& b);
+// Allocation order: priority descending, then creation time, then id (NaturalLess).
+bool AllocationOrderLess(const Order& a, const Order& b);
+
+// A round's view of one robot.
+struct RoundRobot {
+  std::string id;
+  PointId start = kNoPoint;  // where a new plan of it starts (standing or arriving there)
+  Assignment assignment;     // empty order_ids: no queue
+  std::uint64_t last_reached = 0;
+  std::vector<std::shared_ptr<const Order>> queue;  // the orders of assignment.order_ids
+};
+
+struct RoundInput {
+  double now = 0.0;
+  std::vector<RoundRobot> robots;                     // bidding order (NaturalLess of ids)
+  std::vector<std::shared_ptr<const Order>> pending;  // allocation order
+};
+
+struct RoundAward {
+  std::string order_id;
+  AwardExplanation award;
+  // Per winner (award.winners order): the new waypoints (from its start for a robot with no
+  // queue), and the departure the first of them follows (robots with a queue).
+  std::vector<std::vector<Waypoint>> segments;
+  std::vector<double> after_departure;
+  double seconds = 0.0;  // the strategy's time for this order (RoundRunner's stopwatch)
+};
+
+struct RoundResult {
+  std::vector<RoundAward> awards;
+  std::vector<std::string> notes;  // orders not allocated and queues not replayed, with why
+};
+
+class RoundRunner {
+ public:
+  // `stopwatch` (optional) reads a clock in seconds, for RoundAward::seconds.
+  RoundRunner(std::shared_ptr<const WarehouseMap> map, std::shared_ptr<const RouteTable> routes,
+              AllocationConfig config, std::unique_ptr<Allocator> allocator,
+              std::function<double()> stopwatch = {});
+
+  RoundResult Run(const RoundInput& input);
+  const Allocator& allocator() const { return *allocator_; }
+
+ private:
+  // Appends the robot's remaining orders (the first from the picks it has not reached yet)
+  // to its queue in `fleet`. False (with a note) when a part of the queue could not be replayed.
+  bool ReplayQueue(FleetState& fleet, std::size_t index, const RoundRobot& robot,
+                   std::vector<std::string>& notes) const;
+
+  std::shared_ptr<const WarehouseMap> map_;
+  std::shared_ptr<const RouteTable> routes_;
+  AllocationConfig config_;
+  std::unique_ptr<Allocator> allocator_;
+  std::function<double()> stopwatch_;
+  std::shared_ptr<const ZoneIndex> zone_index_;  // built by the first round, kept
+};
+
+}  // namespace dispatch::engine

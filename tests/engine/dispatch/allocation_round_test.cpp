@@ -1,0 +1,139 @@
+// Allocation rounds: a round over the robots' current state and queues, awards spliced into
+// assignments, queues replayed from stored plans.
+#include "engine/dispatch/allocation_round.h"
+
+#include <gtest/gtest.h>
+
+#include "engine/dispatch/strategy.h"
+#include "tests/engine/dispatch/dispatch_test_support.h"
+
+namespace dispatch::engine {
+namespace {
+
+using testing_util::Chu2024;
+using testing_util::Chu2024Routes;
+using testing_util::PointsOfKind;
+
+std::shared_ptr<const Order> MakeOrder(const std::string& id, PointId pick, PointId drop, double created,
+                                       int priority = 0) {
+  auto o = std::make_shared<Order>();
+  o->id = id;
+  o->client_id = id;
+  o->picks = {pick};
+  o->drop = drop;
+  o->created_time = created;
+  o->priority = priority;
+  return o;
+}
+
+RoundRunner Runner(const std::string& strategy = "auction") {
+  return RoundRunner(Chu2024(), Chu2024Routes(), AllocationConfig{}, std::move(MakeAllocator(strategy)).value());
+}
+
+TEST(AllocationRound, NaturalAndAllocationOrder) {
+  EXPECT_TRUE(NaturalLess("R2", "R10"));
+  EXPECT_FALSE(NaturalLess("R10", "R2"));
+  EXPECT_TRUE(NaturalLess("ord-999999", "ord-1000000"));
+  EXPECT_TRUE(NaturalLess("R1", "R1a"));
+  EXPECT_FALSE(NaturalLess("R1", "R1"));
+  Order a, b;
+  a.id = "ord-10";
+  b.id = "ord-9";
+  EXPECT_TRUE(AllocationOrderLess(b, a));  // same time: by id, naturally
+  a.priority = 1;
+  EXPECT_TRUE(AllocationOrderLess(a, b));  // priority first
+  a.priority = b.priority = 0;
+  a.created_time = 1.0;
+  b.created_time = 2.0;
+  EXPECT_TRUE(AllocationOrderLess(a, b));
+}
+
+TEST(AllocationRound, AwardsEveryOrderWithWholePlansForRobotsWithoutQueues) {
+  const auto& map = *Chu2024();
+  const auto parks = PointsOfKind(map, PointKind::kPark);
+  const auto picks = PointsOfKind(map, PointKind::kPick);
+  const auto drops = PointsOfKind(map, PointKind::kDrop);
+  RoundInput input;
+  input.now = 100.0;
+  for (int i = 0; i < 3; ++i) input.robots.push_back({"R" + std::to_string(i + 1), parks.at(static_cast<std::size_t>(i) * 6), {}, 0, {}});
+  input.pending = {MakeOrder("o1", picks.at(3), drops.at(0), 1.0), MakeOrder("o2", picks.at(90), drops.at(9), 2.0)};
+  RoundRunner runner = Runner();
+  const RoundResult result = runner.Run(input);
+  EXPECT_TRUE(result.notes.empty());
+  ASSERT_EQ(result.awards.size(), 2u);
+  for (const RoundAward& a : result.awards) {
+    ASSERT_EQ(a.award.winners.size(), 1u);
+    ASSERT_EQ(a.segments.size(), 1u);
+    const auto& seg = a.segments[0];
+    ASSERT_GE(seg.size(), 3u);
+    const auto robot = std::find_if(input.robots.begin(), input.robots.end(),
+                                    [&](const RoundRobot& r) { return r.id == a.award.winners[0]; });
+    ASSERT_NE(robot, input.robots.end());
+    EXPECT_EQ(seg.front().point, robot->start);  // a whole plan from where the robot is
+    EXPECT_GE(seg.front().eta, input.now);
+    EXPECT_EQ(seg.back().action, WaypointAction::kDrop);
+    // Spliced into an empty assignment: a plan numbered from 0, anchored at the start.
+    Assignment book;
+    book.robot_id = robot->id;
+    AppendOrder(book, a.order_id, seg, a.after_departure[0], true, input.now);
+    EXPECT_EQ(book.order_ids, std::vector<std::string>{a.order_id});
+    EXPECT_EQ(OrderOfWaypoint(book, book.plan.waypoints.size() - 1), a.order_id);
+  }
+}
+
+TEST(AllocationRound, QueuesAreReplayedFromStoredPlansAndNewWorkFollowsThem) {
+  const auto& map = *Chu2024();
+  const auto parks = PointsOfKind(map, PointKind::kPark);
+  const auto picks = PointsOfKind(map, PointKind::kPick);
+  const auto drops = PointsOfKind(map, PointKind::kDrop);
+  RoundRunner runner = Runner();
+  // Round 1: one robot gets o1.
+  RoundInput first;
+  first.robots = {{"R1", parks.at(0), {}, 0, {}}};
+  auto o1 = MakeOrder("o1", picks.at(3), drops.at(0), 0.0);
+  first.pending = {o1};
+  RoundResult r1 = runner.Run(first);
+  ASSERT_EQ(r1.awards.size(), 1u);
+  Assignment book;
+  book.robot_id = "R1";
+  AppendOrder(book, "o1", r1.awards[0].segments[0], 0.0, true, 0.0);
+  // Round 2, a few seconds later, with the robot past its first waypoints: o2 goes behind o1.
+  RoundInput second;
+  second.now = 5.0;
+  RoundRobot robot{"R1", book.plan.waypoints.at(2).point, book, 2, {o1}};
+  second.robots = {robot};
+  second.pending = {MakeOrder("o2", picks.at(40), drops.at(5), 4.0)};
+  RoundResult r2 = runner.Run(second);
+  EXPECT_TRUE(r2.notes.empty()) << r2.notes.front();
+  ASSERT_EQ(r2.awards.size(), 1u);
+  const RoundAward& a = r2.awards[0];
+  ASSERT_EQ(a.segments.size(), 1u);
+  ASSERT_FALSE(a.segments[0].empty());
+  EXPECT_GT(a.after_departure[0], 0.0);  // after the replayed queue
+  EXPECT_GE(a.segments[0].front().eta, a.after_departure[0]);
+  // The bid counted the queue: the award starts where o1 ends (its drop), not at the robot.
+  const std::uint64_t first_new = AppendOrder(book, "o2", a.segments[0], a.after_departure[0], false, 5.0);
+  EXPECT_EQ(first_new, static_cast<std::uint64_t>(book.plan.waypoints.at(SegmentStart(book, 1)).seq));
+  EXPECT_EQ(book.order_ids, (std::vector<std::string>{"o1", "o2"}));
+  EXPECT_GE(book.plan.waypoints.at(SegmentStart(book, 1)).eta, book.plan.waypoints.at(SegmentStart(book, 1) - 1).departure());
+}
+
+TEST(AllocationRound, AQueueThatCannotBeReplayedIsNamed) {
+  const auto& map = *Chu2024();
+  const auto parks = PointsOfKind(map, PointKind::kPark);
+  RoundRunner runner = Runner("greedy");
+  Assignment book;
+  book.robot_id = "R1";
+  book.order_ids = {"gone"};
+  RoundInput input;
+  input.robots = {{"R1", parks.at(0), book, 0, {nullptr}}};  // its order's view is missing
+  input.pending = {MakeOrder("o1", PointsOfKind(map, PointKind::kPick).at(0), PointsOfKind(map, PointKind::kDrop).at(0), 0.0)};
+  const RoundResult r = runner.Run(input);
+  ASSERT_EQ(r.notes.size(), 1u);
+  EXPECT_EQ(r.notes[0], "allocation: queue of R1 replayed up to gone only: the order is not known");
+  ASSERT_EQ(r.awards.size(), 1u);  // still bids (as if idle after what could be replayed)
+  EXPECT_EQ(r.awards[0].award.winners, std::vector<std::string>{"R1"});
+}
+
+}  // namespace
+}  // namespace dispatch::engine
