@@ -10,7 +10,7 @@
 #include <cstring>
 #include <fstream>
 
-#include "engine/cli/map_source.h"
+#include "engine/io/map_source.h"
 #include "engine/io/map_json.h"
 #include "engine/routing/route_table.h"
 #include "server/dispatcher.h"

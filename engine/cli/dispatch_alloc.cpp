@@ -13,7 +13,7 @@
 
 #include "engine/allocation/auction_allocator.h"
 #include "engine/allocation/greedy_allocator.h"
-#include "engine/cli/map_source.h"
+#include "engine/io/map_source.h"
 #include "engine/cli/scenario.h"
 #include "engine/routing/route_table.h"
 

@@ -14,7 +14,7 @@
 #include <optional>
 #include <string>
 
-#include "engine/cli/map_source.h"
+#include "engine/io/map_source.h"
 #include "engine/io/map_json.h"
 #include "engine/io/map_svg.h"
 #include "engine/routing/route_table.h"

@@ -25,7 +25,7 @@
 #include <vector>
 
 #include "engine/allocation/auction_allocator.h"
-#include "engine/cli/map_source.h"
+#include "engine/io/map_source.h"
 #include "engine/cli/scenario.h"
 #include "engine/routing/route_table.h"
 #include "engine/sim/fleet_placement.h"

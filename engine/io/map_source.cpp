@@ -1,4 +1,4 @@
-#include "engine/cli/map_source.h"
+#include "engine/io/map_source.h"
 
 #include "engine/io/map_json.h"
 #include "engine/io/movingai_map.h"

@@ -1,4 +1,4 @@
-#include "engine/cli/map_source.h"
+#include "engine/io/map_source.h"
 
 #include <gtest/gtest.h>
 
