@@ -10,6 +10,7 @@
 #include <cstring>
 #include <fstream>
 
+#include "engine/common/fnv1a.h"
 #include "engine/io/map_source.h"
 #include "engine/io/map_json.h"
 #include "engine/routing/route_table.h"
@@ -61,15 +62,10 @@ engine::Status WritePortsFile(const std::string& path, const ServerPorts& ports)
 
 }  // namespace
 
-std::string MapContentHash(const std::string& text) {
-  std::uint64_t h = 1469598103934665603ull;
-  for (unsigned char c : text) {
-    h ^= c;
-    h *= 1099511628211ull;
-  }
-  char buf[17];
-  std::snprintf(buf, sizeof buf, "%016llx", static_cast<unsigned long long>(h));
-  return buf;
+std::string MapContentHash(const std::string& text) { return engine::Hex64(engine::Fnv1a64(text)); }
+
+std::string LegacyMapContentHash(const std::string& text) {
+  return engine::Hex64(engine::Fnv1a64(text, kLegacyMapHashBasis));
 }
 
 engine::Result<std::unique_ptr<DispatchServer>> DispatchServer::Start(const ServerConfig& config,
@@ -105,7 +101,9 @@ engine::Result<std::unique_ptr<DispatchServer>> DispatchServer::Start(const Serv
   s->store_ = s->metered_store_.get();
   storage::MapVersion version;
   version.name = map->name();
-  version.content_hash = MapContentHash(engine::WriteMapJson(*map));
+  const std::string map_json = engine::WriteMapJson(*map);
+  version.content_hash = MapContentHash(map_json);
+  version.also_known_as = {LegacyMapContentHash(map_json)};  // stored by older servers
   version.source = config.map == "chu2024" ? "builtin:chu2024" : config.map;
   auto recorded = s->store_->RecordMapVersion(version);
   if (!recorded.ok()) return recorded.error();

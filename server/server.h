@@ -70,5 +70,10 @@ class DispatchServer {
 
 // FNV-1a 64 of the map's JSON encoding, 16 hex digits: the map version tag.
 std::string MapContentHash(const std::string& map_json);
+// The tag servers before 2026-12 stored: FNV-1a with an offset basis a digit short of the
+// standard one. A latest map version stored under it is the same map (RecordMapVersion
+// re-tags it), so an upgrade records no new map version.
+inline constexpr std::uint64_t kLegacyMapHashBasis = 1469598103934665603ull;
+std::string LegacyMapContentHash(const std::string& map_json);
 
 }  // namespace dispatch::server

@@ -6,6 +6,8 @@
 #include <cstdint>
 #include <cstdio>
 
+#include "engine/common/fnv1a.h"
+
 namespace dispatch::storage {
 namespace {
 
@@ -65,14 +67,7 @@ std::string OrderContentHash(const engine::Order& order) {
   content.push_back(order.release_time ? json(*order.release_time) : json(nullptr));
   const std::string text =
       std::to_string(order.client_id.size()) + ":" + order.client_id + content.dump();
-  std::uint64_t h = 14695981039346656037ull;  // FNV-1a 64
-  for (unsigned char c : text) {
-    h ^= c;
-    h *= 1099511628211ull;
-  }
-  char hex[17];
-  std::snprintf(hex, sizeof hex, "%016llx", static_cast<unsigned long long>(h));
-  return hex;
+  return engine::Hex64(engine::Fnv1a64(text));
 }
 
 Result<std::string> EncodeOrderBody(const engine::Order& order) {

@@ -1,5 +1,6 @@
 // SqliteStore: robots, their assignments and the map versions (opening, orders, events and
 // transactions are in sqlite_store.cpp).
+#include <algorithm>
 #include <string>
 #include <vector>
 
@@ -223,6 +224,17 @@ Result<MapVersion> SqliteStore::RecordMapVersion(const MapVersion& map) {
     Result<MapVersion> latest = LatestMapVersion();
     if (latest.ok() && latest->name == map.name && latest->content_hash == map.content_hash) {
       out = latest.value();
+      return engine::Ok{};
+    }
+    if (latest.ok() && latest->name == map.name &&
+        std::find(map.also_known_as.begin(), map.also_known_as.end(), latest->content_hash) !=
+            map.also_known_as.end()) {  // the same map under an older hash: re-tagged
+      Result<Statement> update = Prepare("UPDATE map_versions SET content_hash = ? WHERE version = ?");
+      if (!update.ok()) return update.error();
+      Status run = update.value().Text(1, map.content_hash).Int(2, latest->version).Run();
+      if (!run.ok()) return run;
+      out = latest.value();
+      out->content_hash = map.content_hash;
       return engine::Ok{};
     }
     if (!latest.ok() && latest.error().code != engine::ErrorCode::kNotFound) {

@@ -122,6 +122,9 @@ struct MapVersion {
   std::string content_hash;  // identifies the content; equal hash = same map
   std::string source;        // where it came from, e.g. "builtin:chu2024" or a file path
   double recorded_time = 0.0;
+  // RecordMapVersion only (not stored): other hashes of the same content (an older hash
+  // function's). A latest version stored under one of them is re-tagged with content_hash.
+  std::vector<std::string> also_known_as;
 };
 
 class Store {

@@ -65,7 +65,7 @@ TEST_F(FaultInjectionStoreTest, EveryKindOfWriteCanFail) {
   assignment.robot_id = "R1";
   EXPECT_FALSE(store_->SaveAssignment(assignment).ok());
   EXPECT_FALSE(store_->DeleteAssignment("R1").ok());
-  EXPECT_FALSE(store_->RecordMapVersion({0, "m", "h", "s", 0}).ok());
+  EXPECT_FALSE(store_->RecordMapVersion({0, "m", "h", "s", 0, {}}).ok());
   EXPECT_EQ(store_->failures(), 6u);
   // Nothing reached the database.
   EXPECT_EQ(sqlite_->GetOrder("o1")->order.state, OrderState::kAccepted);

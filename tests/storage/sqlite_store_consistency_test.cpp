@@ -196,12 +196,24 @@ TEST_F(SqliteStoreTest, RobotsAssignmentsAndMapVersions) {
   EXPECT_TRUE(store->ListAssignments().value().empty());
 
   EXPECT_EQ(store->LatestMapVersion().error().code, ErrorCode::kNotFound);
-  auto v1 = store->RecordMapVersion({0, "chu2024", "h1", "builtin", 0.0}).value();
-  auto same = store->RecordMapVersion({0, "chu2024", "h1", "builtin", 5.0}).value();
+  auto v1 = store->RecordMapVersion({0, "chu2024", "h1", "builtin", 0.0, {}}).value();
+  auto same = store->RecordMapVersion({0, "chu2024", "h1", "builtin", 5.0, {}}).value();
   EXPECT_EQ(same.version, v1.version);
-  auto v2 = store->RecordMapVersion({0, "chu2024", "h2", "file.json", 6.0}).value();
+  auto v2 = store->RecordMapVersion({0, "chu2024", "h2", "file.json", 6.0, {}}).value();
   EXPECT_GT(v2.version, v1.version);
   EXPECT_EQ(store->LatestMapVersion()->content_hash, "h2");
+  // The same map under a new hash function: re-tagged, no new version; an older version's
+  // hash, or another map's, is not the same map.
+  MapVersion renamed{0, "chu2024", "h2-new", "builtin", 7.0, {"h0", "h2"}};
+  auto retagged = store->RecordMapVersion(renamed).value();
+  EXPECT_EQ(retagged.version, v2.version);
+  EXPECT_EQ(retagged.content_hash, "h2-new");
+  EXPECT_EQ(store->LatestMapVersion()->content_hash, "h2-new");
+  EXPECT_EQ(store->LatestMapVersion()->version, v2.version);
+  auto other = store->RecordMapVersion({0, "chu2024", "h3", "builtin", 8.0, {"h1"}}).value();
+  EXPECT_GT(other.version, v2.version);
+  auto another_map = store->RecordMapVersion({0, "grid", "g-new", "grid.map", 9.0, {"h3"}}).value();
+  EXPECT_GT(another_map.version, other.version);
 }
 
 // Random operations against SqliteStore and an in-memory model of its contract.

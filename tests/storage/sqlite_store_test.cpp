@@ -119,7 +119,7 @@ TEST_F(SqliteStoreTest, EverythingSurvivesCloseAndReopen) {
     ASSERT_TRUE(store->AppendProgress("o2", 4.0, "R7 re-planned").ok());
     ASSERT_TRUE(store->UpsertRobot({robot, "differential", 4.5, 17, 18}).ok());
     ASSERT_TRUE(store->SaveAssignment({"R7", 3, {"o2"}, plan, 1, 4.0}).ok());
-    ASSERT_TRUE(store->RecordMapVersion({0, "chu2024", "abc123", "builtin:chu2024", 0.0}).ok());
+    ASSERT_TRUE(store->RecordMapVersion({0, "chu2024", "abc123", "builtin:chu2024", 0.0, {}}).ok());
   }
   auto store = OpenOrDie(db_path());
   ASSERT_NE(store, nullptr);
