@@ -69,6 +69,7 @@
 #include <vector>
 
 #include "engine/dispatch/allocation_round.h"
+#include "engine/dispatch/robot_progress.h"
 #include "engine/fleet/order.h"
 #include "engine/routing/route_table.h"
 #include "engine/traffic/traffic_controller.h"
@@ -182,14 +183,10 @@ class Dispatcher {
     std::optional<Clock::time_point> offline_since;  // set while offline with orders to watch
     storage::AssignmentRecord assignment;  // plan.waypoints[0] anchors; then one segment per order
     bool has_assignment = false;
-    std::uint64_t last_reached = 0;  // highest waypoint sequence reported reached
-    std::optional<Eigen::Vector2d> last_xy;  // where it reached its last waypoint
+    // What it reported reaching, where, and its picks and drops waiting for its progress.
+    engine::RobotProgress progress;
     std::optional<double> held_since;  // dispatcher seconds of the Hold in force
-    // Picks and drops it reported before reaching them (CheckTaskEvent's `later`): tried again
-    // when it reports progress, at most kMaxWaitingEvents.
-    std::vector<RobotInbound> waiting_events;
   };
-  static constexpr std::size_t kMaxWaitingEvents = 8;
 
   Dispatcher(std::shared_ptr<const engine::WarehouseMap> map,
              std::shared_ptr<const engine::RouteTable> routes, storage::Store& store,
@@ -270,9 +267,9 @@ class Dispatcher {
   void DoRobotMessage(const std::shared_ptr<RobotLink>& link, const RobotInbound& message);
   void DoHello(const std::shared_ptr<RobotLink>& link, const RobotInbound& hello);
   void DoWaypointReached(RobotRuntime& robot, const RobotInbound& message);
-  void DoTaskEvent(RobotRuntime& robot, const RobotInbound& message);
+  void DoTaskEvent(RobotRuntime& robot, const engine::TaskReport& report);
   // Runs the robot's waiting picks and drops again (it reported progress).
-  void RetryTaskEvents(RobotRuntime& robot);
+  void RetryTaskEvents(RobotRuntime& robot, std::vector<engine::TaskReport> waiting);
   // A report that was not plausible (engine/dispatch/report_check.h): logged and counted.
   void Implausible(RobotRuntime& robot, const std::string& what, const std::string& why);
   void DoRobotGone(const std::shared_ptr<RobotLink>& link);

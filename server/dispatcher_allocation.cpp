@@ -81,7 +81,7 @@ void Dispatcher::AllocatePending() {
         robot.queue.push_back(view ? order_of(view) : nullptr);
       }
     }
-    robot.last_reached = r.last_reached;
+    robot.last_reached = r.progress.last_reached;
     input->robots.push_back(std::move(robot));
     (*keys)[id] = KeyOf(r);
   }

@@ -29,7 +29,7 @@ OrderRoutes Dispatcher::RoutesOf(const std::string& order_id) const {
     for (std::size_t i = 0; i < a.plan.waypoints.size(); ++i) {
       const auto& w = a.plan.waypoints[i];
       const auto seq = static_cast<std::uint64_t>(w.seq);
-      if (order_of[i] == order_id && seq > r.last_reached) route.push_back({seq, w.xy, w.action, seq <= released});
+      if (order_of[i] == order_id && seq > r.progress.last_reached) route.push_back({seq, w.xy, w.action, seq <= released});
     }
   }
   return out;

@@ -89,18 +89,15 @@ void Dispatcher::DoRobotMessage(const std::shared_ptr<RobotLink>& link, const Ro
       // A waypoint beyond the highest ever numbered for this robot was never sent, so it
       // cannot have been passed: such a claim is ignored (the gate would otherwise take the
       // robot to be at its plan's end and disregard its real progress from then on).
-      const std::int64_t numbered = engine::HighestNumbered(r->assignment);
-      const std::uint64_t passed =
-          numbered >= 0 && m.sequence <= static_cast<std::uint64_t>(numbered) ? m.sequence : 0;
-      const bool progressed = passed > r->last_reached;
-      r->last_reached = std::max(r->last_reached, passed);
+      std::uint64_t passed = 0;
+      std::vector<engine::TaskReport> retry = engine::TakeStateProgress(r->progress, r->assignment, m.sequence, &passed);
       if (gate_) gate_->Report(r->record.robot.id, m.pose.position, passed, Now());
       if (!awaiting_reconnect_.empty()) Reported(r->record.robot.id);
-      if (progressed) RetryTaskEvents(*r);
+      RetryTaskEvents(*r, std::move(retry));
       break;
     }
     case RobotInbound::Kind::kWaypointReached: DoWaypointReached(*r, m); break;
-    case RobotInbound::Kind::kTaskEvent: DoTaskEvent(*r, m); break;
+    case RobotInbound::Kind::kTaskEvent: DoTaskEvent(*r, {m.order_id, m.dropped}); break;
     case RobotInbound::Kind::kAck:
       // An ack of a sequence never sent is ignored: believed, it would skip what is sent
       // next and (beyond 2^63) make the robot's record unstorable.
@@ -232,40 +229,28 @@ void Dispatcher::DoWaypointReached(RobotRuntime& r, const RobotInbound& m) {
   const auto& w = r.assignment.plan.waypoints;
   const std::optional<Eigen::Vector2d> pose =
       m.has_pose ? std::optional<Eigen::Vector2d>(m.pose.position) : std::nullopt;
-  const engine::ReportVerdict verdict =
-      engine::CheckReached(r.assignment, m.sequence, ReleasedUpTo(r), pose, options_.robot_snap_tolerance);
-  if (!verdict.taken) return Implausible(r, "reached waypoint " + std::to_string(m.sequence), verdict.why);
-  const std::size_t i = verdict.index;
-  r.record.robot.current_point = w[i].point;
-  const bool fresh = m.sequence > r.last_reached;  // not a repeat of an older arrival
-  if (fresh) {  // distance driven, for the order it serves
-    if (r.last_xy) {
-      const std::string order = engine::OrderOfWaypoint(r.assignment, i);
-      if (!order.empty()) order_distance_[order] += (w[i].xy - *r.last_xy).norm();
-    }
-    r.last_xy = w[i].xy;
+  engine::Arrival arrival =
+      engine::TakeArrival(r.progress, r.assignment, m.sequence, ReleasedUpTo(r), pose, options_.robot_snap_tolerance);
+  if (!arrival.verdict.taken) {
+    return Implausible(r, "reached waypoint " + std::to_string(m.sequence), arrival.verdict.why);
   }
-  r.last_reached = std::max(r.last_reached, m.sequence);
-  // Where it is now: a new arrival is fresher than the last state report (robots report at a
-  // few Hz): the pose it sent (near the waypoint, checked above), else the waypoint's own.
-  std::optional<Eigen::Vector2d> xy;
-  if (fresh) {
-    xy = pose ? *pose : w[i].xy;
-    r.record.robot.pose.position = *xy;
+  const std::size_t i = arrival.verdict.index;
+  r.record.robot.current_point = w[i].point;
+  if (!arrival.order.empty()) order_distance_[arrival.order] += arrival.driven;
+  if (arrival.xy) {
+    r.record.robot.pose.position = *arrival.xy;
     if (pose && std::isfinite(m.pose.heading)) r.record.robot.pose.heading = m.pose.heading;
   }
-  if (gate_) gate_->Reached(r.record.robot.id, m.sequence, Now(), xy);
+  if (gate_) gate_->Reached(r.record.robot.id, m.sequence, Now(), arrival.xy);
   if (w[i].action == engine::WaypointAction::kPick) {
     const std::string order = engine::OrderOfWaypoint(r.assignment, i);
     StartOrder(order, r.record.robot.id + " reached pick '" + map_->point(w[i].point).name + "'");
   }
-  if (fresh) RetryTaskEvents(r);
+  RetryTaskEvents(r, std::move(arrival.retry));
 }
 
-void Dispatcher::RetryTaskEvents(RobotRuntime& r) {
-  std::vector<RobotInbound> waiting;
-  waiting.swap(r.waiting_events);
-  for (const RobotInbound& m : waiting) DoTaskEvent(r, m);
+void Dispatcher::RetryTaskEvents(RobotRuntime& r, std::vector<engine::TaskReport> waiting) {
+  for (const engine::TaskReport& report : waiting) DoTaskEvent(r, report);
 }
 
 void Dispatcher::Implausible(RobotRuntime& r, const std::string& what, const std::string& why) {
@@ -274,30 +259,23 @@ void Dispatcher::Implausible(RobotRuntime& r, const std::string& what, const std
   spdlog::warn("robot {}: '{}' not taken: {}", r.record.robot.id, what, why);
 }
 
-void Dispatcher::DoTaskEvent(RobotRuntime& r, const RobotInbound& m) {
+void Dispatcher::DoTaskEvent(RobotRuntime& r, const engine::TaskReport& m) {
   auto view = Find(m.order_id);
   const std::string& robot = r.record.robot.id;
   if (!view || engine::IsTerminal(view->record.order.state)) return;  // late or repeated
-  const auto& team = view->record.robots;
+  const std::vector<std::string> team = view->record.robots;  // a copy: `view` is replaced below
   if (std::find(team.begin(), team.end(), robot) == team.end()) return;
   if (m.dropped && view->dropped_by.count(robot)) return;  // repeated
-  const engine::ReportVerdict verdict = engine::CheckTaskEvent(
-      r.assignment, m.order_id, m.dropped, r.last_reached, r.record.robot.pose.position, options_.robot_snap_tolerance);
   const std::string what = std::string(m.dropped ? "dropped" : "picked") + " for order " + m.order_id;
-  if (verdict.later) {  // e.g. a drop repeated after a restart before the robot's first report
-    auto same = [&](const RobotInbound& e) { return e.order_id == m.order_id && e.dropped == m.dropped; };
-    if (std::none_of(r.waiting_events.begin(), r.waiting_events.end(), same)) {
-      if (r.waiting_events.size() >= kMaxWaitingEvents) {
-        Implausible(r, "task event waiting too long", "more than " + std::to_string(kMaxWaitingEvents) +
-                                                         " picks and drops wait for progress");
-        r.waiting_events.erase(r.waiting_events.begin());
-      }
-      r.waiting_events.push_back(m);
-      spdlog::debug("robot {}: '{}' waits for its progress: {}", robot, what, verdict.why);
-    }
+  const engine::TaskVerdict verdict =
+      engine::TakeTaskReport(r.progress, r.assignment, m, r.record.robot.pose.position, options_.robot_snap_tolerance);
+  if (verdict.decision == engine::TaskDecision::kWaiting) {
+    // E.g. a drop repeated after a restart before the robot's first progress report.
+    if (verdict.overflowed) Implausible(r, "an older pick or drop", "too many wait for the robot's progress");
+    spdlog::debug("robot {}: '{}' waits for its progress: {}", robot, what, verdict.why);
     return;
   }
-  if (!verdict.taken) return Implausible(r, what, verdict.why);
+  if (verdict.decision == engine::TaskDecision::kRejected) return Implausible(r, what, verdict.why);
   // Where it did it: the stop of its plan (the point id it sent is not needed).
   const std::string where = "'" + map_->point(r.assignment.plan.waypoints[verdict.index].point).name + "'";
   if (!m.dropped) {
@@ -310,11 +288,10 @@ void Dispatcher::DoTaskEvent(RobotRuntime& r, const RobotInbound& m) {
   }
   StartOrder(m.order_id, robot + " dropped at " + where);
   view = Find(m.order_id);
-  storage::AssignmentRecord plan = r.assignment;
-  const bool trimmed = engine::TrimDone(plan, m.order_id);
-  std::set<std::string> dropped = view->dropped_by;
-  dropped.insert(robot);
-  const bool complete = dropped.size() >= team.size();
+  engine::DropOutcome drop = engine::PlanDrop(r.assignment, m.order_id, robot, team, view->dropped_by);
+  storage::AssignmentRecord& plan = drop.plan;
+  const bool trimmed = drop.trimmed;
+  const bool complete = drop.complete;
   const double now = Now();
   std::optional<storage::OrderEvent> event;
   auto committed = store_.RunInTransaction([&](storage::Store& s) -> engine::Status {
@@ -348,7 +325,7 @@ void Dispatcher::DoTaskEvent(RobotRuntime& r, const RobotInbound& m) {
     SyncGate(r);
   }
   auto copy = std::make_shared<OrderView>(*view);
-  copy->dropped_by = std::move(dropped);
+  copy->dropped_by = std::move(drop.dropped_by);
   if (complete) {
     copy->record.order.state = engine::OrderState::kCompleted;
     copy->record.updated_time = now;
