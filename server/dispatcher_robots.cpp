@@ -5,40 +5,13 @@
 #include <algorithm>
 #include <cmath>
 #include <optional>
-#include <sstream>
 
-#include "engine/dispatch/report_check.h"
 #include "engine/dispatch/order_release.h"
+#include "engine/dispatch/report_check.h"
+#include "engine/dispatch/robot_intake.h"
 #include "server/dispatcher.h"
 
 namespace dispatch::server {
-namespace {
-
-bool ValidRobotId(const std::string& id) {
-  if (id.empty() || id.size() > 64) return false;
-  for (char c : id) {
-    if (!(std::isalnum(static_cast<unsigned char>(c)) || c == '_' || c == '-' || c == '.')) return false;
-  }
-  return true;
-}
-
-std::string Fixed(double v) {
-  std::ostringstream out;
-  if (std::abs(v) < 1e9) {
-    out.precision(2);
-    out << std::fixed;
-  }
-  out << v;  // 1e+300, not 300 digits
-  return out.str();
-}
-
-// Finite and on the floor rectangle, give or take `margin` metres.
-bool OnFloor(const engine::WarehouseMap& map, const Eigen::Vector2d& xy, double margin) {
-  return xy.allFinite() && xy.x() >= map.floor_min().x() - margin && xy.x() <= map.floor_max().x() + margin &&
-         xy.y() >= map.floor_min().y() - margin && xy.y() <= map.floor_max().y() + margin;
-}
-
-}  // namespace
 
 void Dispatcher::OnRobotMessage(std::shared_ptr<RobotLink> link, RobotInbound message) {
   Post([this, link = std::move(link), message = std::move(message)] { DoRobotMessage(link, message); });
@@ -72,7 +45,7 @@ void Dispatcher::DoRobotMessage(const std::shared_ptr<RobotLink>& link, const Ro
       // A pose off the floor (NaN, 1e300, a wrong frame) is not news about the robot: it
       // would leave it at no map point and out of every auction. Ignored, like a bad
       // battery value, which would otherwise fail the robot's next Hello (ValidateRobot).
-      if (!OnFloor(*map_, m.pose.position, options_.robot_snap_tolerance) || !std::isfinite(m.pose.heading)) {
+      if (!engine::OnFloor(*map_, m.pose.position, options_.robot_snap_tolerance) || !std::isfinite(m.pose.heading)) {
         return;
       }
       r->record.robot.pose = m.pose;
@@ -115,32 +88,10 @@ void Dispatcher::DoHello(const std::shared_ptr<RobotLink>& link, const RobotInbo
     spdlog::warn("robot hello rejected: {}", message);
     CloseLink(link, MakeStatus(code, std::move(message)));
   };
-  if (!ValidRobotId(hello.robot_id)) {
-    return reject(StatusCode::kInvalidArgument,
-                  "robot id '" + hello.robot_id + "' is invalid: use 1-64 letters, digits, '_', '-' or '.'");
-  }
+  auto located = engine::LocateRobot(*map_, hello.robot_id, hello.pose, options_.robot_snap_tolerance);
+  if (!located.ok()) return reject(StatusCode::kInvalidArgument, located.error().message);
   const Eigen::Vector2d xy = hello.pose.position;
-  if (!std::isfinite(xy.x()) || !std::isfinite(xy.y()) || !std::isfinite(hello.pose.heading)) {
-    return reject(StatusCode::kInvalidArgument, "robot " + hello.robot_id + ": pose is not finite");
-  }
-  // On the map: within the tolerance of a point, or of a lane (a robot that stopped between
-  // two points, e.g. when its stream broke: it stands for the point it was driving to).
-  double distance = 0.0;
-  engine::PointId point = map_->NearestPoint(xy, std::nullopt, &distance);
-  if (point == engine::kNoPoint || distance > options_.robot_snap_tolerance) {
-    double lane_distance = 0.0;
-    auto on_lane = map_->NearestArcPosition(xy, &lane_distance);
-    if (on_lane.ok() && lane_distance <= options_.robot_snap_tolerance) {
-      point = map_->arc(on_lane->arc).to;
-    } else {
-      std::string nearest = point == engine::kNoPoint ? "none" : "'" + map_->point(point).name + "' " + Fixed(distance) + " m away";
-      return reject(StatusCode::kInvalidArgument,
-                    "robot " + hello.robot_id + ": pose (" + Fixed(xy.x()) + ", " + Fixed(xy.y()) +
-                        ") is not on the map (nearest point " + nearest + ", nearest lane " +
-                        (on_lane.ok() ? Fixed(lane_distance) + " m away" : std::string("none")) +
-                        ", tolerance " + Fixed(options_.robot_snap_tolerance) + " m)");
-    }
-  }
+  const engine::PointId point = *located;
   auto [it, inserted] = robots_.try_emplace(hello.robot_id);
   RobotRuntime& r = it->second;
   if (r.link && r.link != link) {
@@ -148,7 +99,7 @@ void Dispatcher::DoHello(const std::shared_ptr<RobotLink>& link, const RobotInbo
     if (silent.count() <= options_.heartbeat_timeout) {
       return reject(StatusCode::kAlreadyExists,
                     "robot " + hello.robot_id + " already has a live stream (heard " +
-                        Fixed(silent.count()) + " s ago); retry after its heartbeat times out");
+                        engine::FormatFixed(silent.count()) + " s ago); retry after its heartbeat times out");
     }
     CloseLink(r.link, MakeStatus(StatusCode::kUnavailable, "superseded by a new stream"));
     link_robot_.erase(r.link.get());
@@ -372,8 +323,8 @@ void Dispatcher::Tick() {
     if (r.link) {
       const std::chrono::duration<double> silent = now - r.last_heard;
       if (silent.count() > options_.heartbeat_timeout) {
-        MarkOffline(r, "no message for " + Fixed(silent.count()) + " s (heartbeat timeout " +
-                           Fixed(options_.heartbeat_timeout) + " s)");
+        MarkOffline(r, "no message for " + engine::FormatFixed(silent.count()) + " s (heartbeat timeout " +
+                           engine::FormatFixed(options_.heartbeat_timeout) + " s)");
       }
       continue;
     }
@@ -381,7 +332,7 @@ void Dispatcher::Tick() {
     const std::chrono::duration<double> offline = now - *r.offline_since;
     if (offline.count() < options_.offline_grace) continue;
     ServiceStatus status;
-    const std::string why = "robot " + id + " offline for more than " + Fixed(options_.offline_grace) + " s";
+    const std::string why = "robot " + id + " offline for more than " + engine::FormatFixed(options_.offline_grace) + " s";
     auto target = [](const OrderView& v) { return engine::StateAfterRobotLoss(v.record.order.state); };
     if (ReleaseOrders(r.assignment.order_ids, target, why, &status)) {
       r.offline_since.reset();
