@@ -2,6 +2,13 @@
 // time step under the local traffic rules of Chu2024 §3.3 (traffic/), deterministically and
 // as fast as the CPU allows (no clocks, no randomness).
 //
+// Why it is not driven by the dispatch core (engine/dispatch, issue 15): it reproduces the
+// seed's own experiment (Chu2024 Fig. 8, Tables 3-4), in which timed plans made once by the
+// auction are executed under the paper's offline rules (IntersectionGrants on the plan's
+// times, the rear-end rule) with no dispatcher in the loop: no order stream, no re-allocation,
+// no robot reports. The order-stream simulator (order_stream.h) is the one that models the
+// service and is moving onto the core.
+//
 // Motion: each robot follows its plan's waypoint polyline in order; every segment takes its
 // planned duration (eta[i+1] - departure[i], i.e. speed v or an arc's limit) while the robot
 // moves, and it works `dwell` seconds at pick/drop waypoints. Formation members (Chu2024
