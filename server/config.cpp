@@ -10,6 +10,8 @@
 #include <functional>
 #include <sstream>
 
+#include "engine/dispatch/strategy.h"
+
 namespace dispatch::server {
 namespace {
 
@@ -100,9 +102,7 @@ engine::Status ValidateServerConfig(const ServerConfig& c) {
   if (!port_ok(c.http_port)) return InvalidArgument("http_port must be in 0..65535");
   if (c.bind.empty()) return InvalidArgument("bind must not be empty");
   if (c.db.empty()) return InvalidArgument("db must name a SQLite file");
-  if (c.strategy != "auction" && c.strategy != "greedy") {
-    return InvalidArgument("strategy must be 'auction' or 'greedy', not '" + c.strategy + "'");
-  }
+  if (auto strategy = engine::MakeAllocator(c.strategy); !strategy.ok()) return strategy.error();
   for (auto [name, v] : {std::pair{"zeta", c.zeta}, {"alpha", c.alpha}, {"beta", c.beta}}) {
     if (!std::isfinite(v) || v < 0) return InvalidArgument(std::string(name) + " must be finite and >= 0");
   }

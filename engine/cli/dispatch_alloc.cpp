@@ -11,10 +11,9 @@
 #include <memory>
 #include <string>
 
-#include "engine/allocation/auction_allocator.h"
-#include "engine/allocation/greedy_allocator.h"
-#include "engine/io/map_source.h"
 #include "engine/cli/scenario.h"
+#include "engine/dispatch/strategy.h"
+#include "engine/io/map_source.h"
 #include "engine/routing/route_table.h"
 
 namespace dispatch::engine {
@@ -87,15 +86,11 @@ Result<Run> Allocate(std::shared_ptr<const WarehouseMap> map, std::shared_ptr<co
   config.zeta = zeta;
   auto state = FleetState::Create(map, routes, robots, config);
   if (!state.ok()) return state.error();
-  std::unique_ptr<Allocator> allocator;
-  if (strategy == "greedy") {
-    allocator = std::make_unique<GreedyAllocator>();
-  } else {
-    allocator = std::make_unique<AuctionAllocator>();
-  }
+  auto allocator = MakeAllocator(strategy);
+  if (!allocator.ok()) return allocator.error();
   Run run;
   run.zeta = zeta;
-  run.results = AllocateAll(*allocator, orders, state.value());
+  run.results = AllocateAll(**allocator, orders, state.value());
   return run;
 }
 
@@ -109,7 +104,7 @@ int Main(int argc, char** argv) {
       ->capture_default_str();
   app.add_option("--table", table, "Task table CSV (seed format)")->required();
   app.add_option("--strategy", strategy, "auction or greedy")->capture_default_str()
-      ->check(CLI::IsMember({"auction", "greedy"}));
+      ->check(CLI::IsMember(AllocatorNames()));
   app.add_option("--zeta", zetas, "Traffic weights to compare (eq. 5)")->capture_default_str();
   app.add_option("--alpha", config.alpha, "Weight of T_t (eq. 1)")->capture_default_str()
       ->check(CLI::NonNegativeNumber);

@@ -25,8 +25,9 @@
 #include <vector>
 
 #include "engine/allocation/auction_allocator.h"
-#include "engine/io/map_source.h"
 #include "engine/cli/scenario.h"
+#include "engine/dispatch/strategy.h"
+#include "engine/io/map_source.h"
 #include "engine/routing/route_table.h"
 #include "engine/sim/fleet_placement.h"
 #include "engine/sim/head_on_scenario.h"
@@ -331,7 +332,7 @@ int Main(int argc, char** argv) {
   auto* s = app.add_subcommand("stream", "Order stream under the online traffic controller");
   add_stream(s, stream);
   s->add_option("--strategy", stream.strategy, "auction or greedy")->capture_default_str()
-      ->check(CLI::IsMember({"auction", "greedy"}));
+      ->check(CLI::IsMember(AllocatorNames()));
   s->add_option("--zeta", stream.zeta, "Traffic weight of the auction")->capture_default_str();
   s->add_option("--csv", stream.csv, "Write t,min_distance here");
   s->add_option("--orders-csv", stream.orders_csv, "Write per-order results here");
