@@ -71,9 +71,10 @@ RestServer::RestServer(RestHandlers handlers, const std::string& web_root)
     Reply(res, h.Robot(req.matches[1]));
   });
   s.Get("/api/v1/orders", [&h](const httplib::Request& req, httplib::Response& res) {
-    std::optional<std::string> state;
+    std::optional<std::string> state, finished;
     if (req.has_param("state")) state = req.get_param_value("state");
-    Reply(res, h.Orders(state));
+    if (req.has_param("finished")) finished = req.get_param_value("finished");
+    Reply(res, h.Orders(state, finished));
   });
   s.Get(R"(/api/v1/orders/([^/]+))", [&h](const httplib::Request& req, httplib::Response& res) {
     Reply(res, h.Order(req.matches[1]));

@@ -1,5 +1,7 @@
 #include "server/rest_handlers.h"
 
+#include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <cstdint>
 #include <limits>
@@ -247,7 +249,8 @@ RestReply RestHandlers::Robot(const std::string& id) const {
   return {200, RobotToJson(it->second, dispatcher_.map())};
 }
 
-RestReply RestHandlers::Orders(const std::optional<std::string>& state) const {
+RestReply RestHandlers::Orders(const std::optional<std::string>& state,
+                               const std::optional<std::string>& finished) const {
   std::optional<engine::OrderState> filter;
   if (state) {
     filter = engine::ParseOrderState(*state);
@@ -256,13 +259,39 @@ RestReply RestHandlers::Orders(const std::optional<std::string>& state) const {
                             "' (accepted, assigned, in_progress, completed, cancelled, failed)");
     }
   }
-  auto snap = dispatcher_.snapshot();
-  json orders = json::array();
-  for (const auto& o : snap->orders) {
-    if (filter && o->record.order.state != *filter) continue;
-    orders.push_back(OrderToJson(*o, dispatcher_.map(), false));
+  std::size_t keep = kListedFinished;
+  if (finished) {
+    const std::string& f = *finished;
+    const bool digits = !f.empty() && f.size() <= 4 && std::all_of(f.begin(), f.end(), [](char c) {
+      return std::isdigit(static_cast<unsigned char>(c));
+    });
+    if (!digits || std::stoul(f) > kMaxListedFinished) {
+      return Error(400, "finished must be a whole number from 0 to " + std::to_string(kMaxListedFinished));
+    }
+    keep = std::stoul(f);
   }
-  return {200, {{"orders", orders}}};
+  auto snap = dispatcher_.snapshot();
+  std::vector<std::size_t> open, done;  // indexes into the snapshot's orders
+  for (std::size_t i = 0; i < snap->orders.size(); ++i) {
+    const auto& o = snap->orders[i];
+    if (filter && o->record.order.state != *filter) continue;
+    (engine::IsTerminal(o->record.order.state) ? done : open).push_back(i);
+  }
+  const std::size_t finished_total = done.size();
+  if (done.size() > keep) {  // the newest finished: by finished time, then submission
+    auto newer = [&](std::size_t a, std::size_t b) {
+      const double ta = snap->orders[a]->finished_time.value_or(0.0), tb = snap->orders[b]->finished_time.value_or(0.0);
+      return ta != tb ? ta > tb : a > b;
+    };
+    std::nth_element(done.begin(), done.begin() + static_cast<std::ptrdiff_t>(keep), done.end(), newer);
+    done.resize(keep);
+  }
+  std::vector<std::size_t> listed = open;
+  listed.insert(listed.end(), done.begin(), done.end());
+  std::sort(listed.begin(), listed.end());
+  json orders = json::array();
+  for (const std::size_t i : listed) orders.push_back(OrderToJson(*snap->orders[i], dispatcher_.map(), false));
+  return {200, {{"orders", orders}, {"finished_total", finished_total}}};
 }
 
 RestReply RestHandlers::Order(const std::string& id) {

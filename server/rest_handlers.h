@@ -7,6 +7,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include <cstddef>
 #include <memory>
 #include <optional>
 #include <string>
@@ -16,6 +17,10 @@ namespace dispatch::server {
 
 class Dispatcher;
 class ServiceMetrics;
+
+// Finished orders GET /api/v1/orders lists by default and at most (the newest).
+inline constexpr std::size_t kListedFinished = 100;
+inline constexpr std::size_t kMaxListedFinished = 1000;
 
 // A JSON body, or (content_type set) `text` as it is.
 struct RestReply {
@@ -43,7 +48,11 @@ class RestHandlers {
   RestReply Robots() const;
   RestReply Robot(const std::string& id) const;
   // state: a lower-case order state name, or nullopt for all.
-  RestReply Orders(const std::optional<std::string>& state) const;
+  // Every open order and the newest `finished` (default kListedFinished, at most
+  // kMaxListedFinished) finished ones, in submission order, with finished_total: a list that
+  // held every order ever stored grew each HTTP thread's heap with the whole history (issue 15
+  // §3b: 140 kB per order with the web map polling).
+  RestReply Orders(const std::optional<std::string>& state, const std::optional<std::string>& finished) const;
   // GET /api/v1/traffic: every robot's traffic state (where, route, what it waits on).
   RestReply Traffic();
   // With the allocation explanation and "routes": each robot's waypoints of it not reached.

@@ -15,7 +15,7 @@
   const state = {
     floor: null, mapVersion: null, view: new WM.Floor.View(), autoFit: true,
     robots: [], intersections: [], zones: [], orders: [], ordersById: new Map(),
-    selectedId: null, detail: null, heatMax: 0.01, frames: 0, robotsFresh: false,
+    selectedId: null, detail: null, heatMax: 0.01, frames: 0, robotsFresh: false, finishedTotal: null,
     problems: new Map(),
   };
   const live = new WM.Live.LiveLayer($("live"));
@@ -209,7 +209,8 @@
     poll("orders", () => "orders", 1000, j => {
       state.orders = Array.isArray(j.orders) ? j.orders : [];
       state.ordersById = new Map(state.orders.map(o => [o.id, o]));
-      WM.Panels.renderOrders(state.orders, state.selectedId);
+      state.finishedTotal = Number.isFinite(j.finished_total) ? j.finished_total : null;
+      WM.Panels.renderOrders(state.orders, state.selectedId, state.finishedTotal);
     });
     poll("order", () => (state.selectedId ? "orders/" + encodeURIComponent(state.selectedId) : null), 1000, (o, path) => {
       if (!state.selectedId || path !== "orders/" + encodeURIComponent(state.selectedId)) return;  // selection changed meanwhile
@@ -222,7 +223,7 @@
   function select(id) {
     state.selectedId = id;
     state.detail = null;
-    WM.Panels.renderOrders(state.orders, id);
+    WM.Panels.renderOrders(state.orders, id, state.finishedTotal);
     WM.Panels.renderDetail(id ? state.ordersById.get(id) || { id } : null);
     if (!id) problem("order", null);
     scheduleDraw();

@@ -53,7 +53,8 @@ window.WebMap = window.WebMap || {};
   }
 
   // ---- orders -----------------------------------------------------------------------------
-  function renderOrders(orders, selectedId) {
+  // finishedTotal: how many finished orders the server has (it lists only the newest).
+  function renderOrders(orders, selectedId, finishedTotal) {
     const active = orders.filter(o => ACTIVE.has(o.state)).sort((a, b) => String(a.id).localeCompare(String(b.id)));
     const done = orders.filter(o => !ACTIVE.has(o.state))
       .sort((a, b) => (b.finished_time ?? 0) - (a.finished_time ?? 0) || String(b.id).localeCompare(String(a.id)));
@@ -64,10 +65,11 @@ window.WebMap = window.WebMap || {};
         `<span class="oid">${esc(o.id)}</span>${stateBadge(o.state)}<span class="fmark"${o.formation ? ' title="formation">▲' : ">"}</span>` +
         `<span class="client">${esc(o.client_id)}</span><span class="robots">${robots}</span></li>`;
     });
-    if (done.length > MAX_FINISHED_LISTED) items.push(`<li class="more">… ${done.length - MAX_FINISHED_LISTED} older finished orders</li>`);
+    const finished = Math.max(done.length, finishedTotal ?? 0);
+    if (finished > MAX_FINISHED_LISTED) items.push(`<li class="more">… ${finished - Math.min(done.length, MAX_FINISHED_LISTED)} older finished orders</li>`);
     if (!items.length) items.push('<li class="more">no orders yet</li>');
     setHtml($("orders"), items.join(""));
-    setHtml($("order-counts"), `${active.length} active, ${done.length} finished`);
+    setHtml($("order-counts"), `${active.length} active, ${finished} finished`);
   }
 
   // ---- the selected order -----------------------------------------------------------------

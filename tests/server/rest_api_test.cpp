@@ -105,6 +105,42 @@ TEST_F(RestApiTest, OrdersThroughJson) {
   EXPECT_EQ(Body(accepted)["orders"].size(), 1u);
 }
 
+TEST_F(RestApiTest, TheOrderListKeepsOpenOrdersAndOnlyTheNewestFinishedOnes) {
+  // Issue 15 §3b: the list held every order ever stored, and each HTTP thread's heap kept a
+  // whole list's worth (140 kB per order with the web map polling).
+  std::vector<std::string> ids;
+  for (int i = 0; i < 5; ++i) {
+    auto created = client_->Post("/api/v1/orders",
+                                 R"({"client_order_id": "f-)" + std::to_string(i) +
+                                     R"(", "picks": ["K3-2-3N"], "drop": "D-B2"})",
+                                 "application/json");
+    ASSERT_TRUE(created);
+    ASSERT_EQ(created->status, 201) << created->body;
+    ids.push_back(Body(created)["id"]);
+  }
+  for (int i = 0; i < 4; ++i) ASSERT_EQ(client_->Delete("/api/v1/orders/" + ids[static_cast<std::size_t>(i)])->status, 200);
+  auto two = client_->Get("/api/v1/orders?finished=2");
+  ASSERT_TRUE(two);
+  const json l = Body(two);
+  EXPECT_EQ(l["finished_total"], 4);
+  ASSERT_EQ(l["orders"].size(), 3u);  // the open one and the two cancelled last
+  EXPECT_EQ(l["orders"][0]["id"], ids[2]);  // in submission order
+  EXPECT_EQ(l["orders"][1]["id"], ids[3]);
+  EXPECT_EQ(l["orders"][2]["id"], ids[4]);
+  EXPECT_EQ(l["orders"][2]["state"], "accepted");
+  const json none = Body(client_->Get("/api/v1/orders?finished=0"));
+  ASSERT_EQ(none["orders"].size(), 1u);
+  EXPECT_EQ(none["finished_total"], 4);
+  EXPECT_EQ(Body(client_->Get("/api/v1/orders"))["orders"].size(), 5u);  // 100 by default
+  EXPECT_EQ(Body(client_->Get("/api/v1/orders?state=cancelled&finished=1"))["orders"][0]["id"], ids[3]);
+  for (const char* bad : {"-1", "abc", "1001", "", "99999"}) {
+    auto r = client_->Get(std::string("/api/v1/orders?finished=") + bad);
+    ASSERT_TRUE(r);
+    EXPECT_EQ(r->status, 400) << bad;
+    EXPECT_EQ(Body(r)["error"], "finished must be a whole number from 0 to 1000") << bad;
+  }
+}
+
 TEST_F(RestApiTest, ErrorsAreJsonWithAReason) {
   struct Case {
     httplib::Result result;
