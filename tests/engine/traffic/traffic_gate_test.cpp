@@ -171,6 +171,13 @@ class TrafficGateTest : public ::testing::Test {
     for (const auto& [id, sim] : sims_) out += gate_->Describe(id) + "\n";
     return out;
   }
+  // How many waypoints the robot stands past its plan's first pick (negative: before it).
+  long PastPick(const std::string& id) {
+    const Sim& s = sims_[id];
+    std::size_t pick = 0;
+    while (pick < s.plan.size() && s.plan[pick].action != WaypointAction::kPick) ++pick;
+    return static_cast<long>(s.at) - static_cast<long>(pick);
+  }
   // No two robots of different agents came closer than eps1.
   void ExpectEps1Kept() const {
     const MinDistance& d = gate_->min_distance();
@@ -271,15 +278,9 @@ void TrafficGateTest::RestartWhileMoving(bool one_behind) {
   // single robots (their slots are D_f off the points the controller keeps apart).
   AddFormation({"park-P1", "park-P2", "park-P3"}, "K3-2-3N", "D-B2", "f1");
   AddRobot("R4", "park-P4", {"K3-2-2N"}, "D-B1", "o4");
-  auto past_pick = [&](const std::string& id) {
-    const Sim& s = sims_[id];
-    std::size_t pick = 0;
-    while (pick < s.plan.size() && s.plan[pick].action != WaypointAction::kPick) ++pick;
-    return static_cast<long>(s.at) - static_cast<long>(pick);
-  };
   ASSERT_TRUE(Run(40000, {}, [&] {
     for (const auto& id : team_) {
-      if (past_pick(id) < 3) return false;
+      if (PastPick(id) < 3) return false;
     }
     return true;
   }));
@@ -349,15 +350,9 @@ TEST_F(TrafficGateTest, RegressionABlockedFormationMemberIsNeverPlacedAtItsHome)
   // slots and must stay obstacles there: the gate used to put them back at home, and a robot
   // then came D_f = 0.231 m (later 0 m) from one of them.
   AddFormation({"park-P1", "park-P2", "park-P3"}, "K3-2-3N", "D-B2", "f1");
-  auto past_pick = [&](const std::string& id) {
-    const Sim& s = sims_[id];
-    std::size_t pick = 0;
-    while (pick < s.plan.size() && s.plan[pick].action != WaypointAction::kPick) ++pick;
-    return static_cast<long>(s.at) - static_cast<long>(pick);
-  };
   ASSERT_TRUE(Run(40000, {}, [&] {
     for (const auto& id : team_) {
-      if (gate_->RobotState(id).formation != "f1" || past_pick(id) < 3) return false;
+      if (gate_->RobotState(id).formation != "f1" || PastPick(id) < 3) return false;
     }
     return true;
   })) << DescribeAll();
