@@ -84,6 +84,7 @@ struct GateImpl {
   std::map<std::string, GateBot> bots;
   std::map<std::string, GateTeam> teams;  // by formation order id
   std::set<std::string> finished_teams;   // formations that have left their drop point
+  std::set<std::string> strays;  // broken-up teams' members not back on the floor (PlaceStrays)
   std::vector<std::size_t> team_pool;     // removed team agents, reusable
   std::size_t team_agents = 0;            // team agents ever added (their ids)
   MinDistance min_distance;

@@ -63,8 +63,15 @@ bool GateImpl::PlaceNear(GateBot& b) {
 }
 
 void GateImpl::PlaceStrays() {
-  for (auto& [id, o] : bots) {
-    if (o.team.empty() && !o.former_team.empty() && !teams.count(o.former_team) && !OnFloor(o)) PlaceNear(o);
+  for (auto it = strays.begin(); it != strays.end();) {
+    auto bot = bots.find(*it);
+    const bool stray = bot != bots.end() && bot->second.team.empty() && !bot->second.former_team.empty() &&
+                       !teams.count(bot->second.former_team) && !OnFloor(bot->second);
+    if (stray && !PlaceNear(bot->second)) {
+      ++it;
+    } else {
+      it = strays.erase(it);  // placed, or no longer a stray (placed elsewhere, in a team again)
+    }
   }
 }
 
@@ -164,7 +171,7 @@ void GateImpl::StepSolo(GateBot& b, double t, std::vector<GateEffect>& out) {
         (b.xy - map->point(ctl.At(r)).position).norm() >= config.point_clearance + FormationRadius()) {
       ctl.LeftPoint(r);
       b.left = true;
-      if (!b.former_team.empty()) PlaceStrays();  // a teammate's slot may be at the point it left
+      if (!b.former_team.empty() && !strays.empty()) PlaceStrays();  // a teammate's slot may be at the point it left
     }
     Release(b, RunEnd(b, b.idx + 1, next, n), map->IntersectionOf(next), out);
     return;

@@ -87,6 +87,7 @@ void GateImpl::BreakTeam(GateTeam& team) {
       ctl.SetGroup(r, 0, group);
       if (PlaceBot(b, map->NearestPoint(b.xy))) ctl.SetEnvelope(r, FormationRadius());
     }
+    if (!OnFloor(b)) strays.insert(id);
   }
 }
 

@@ -38,13 +38,15 @@ TEST(RobotIntake, APoseNearAPointOrALaneLocatesTheRobot) {
   auto near = LocateRobot(map, "R1", At(at.x() + 0.3, at.y()), 1.0);
   ASSERT_TRUE(near.ok());
   EXPECT_EQ(*near, map.NearestPoint(Eigen::Vector2d(at.x() + 0.3, at.y())));
-  // Half-way along a lane, farther than the tolerance from both ends: the point it drives to.
+  // Half-way along a lane, farther than the tolerance from every point: the point it drives to.
   const Arc& arc = map.arcs().front();
   const Eigen::Vector2d mid = 0.5 * (map.point(arc.from).position + map.point(arc.to).position);
-  const double half = 0.5 * (map.point(arc.to).position - map.point(arc.from).position).norm();
-  auto on_lane = LocateRobot(map, "R1", At(mid.x(), mid.y()), 0.9 * half);
+  const double off = (map.point(map.NearestPoint(mid)).position - mid).norm();
+  ASSERT_GT(off, 0.0);
+  auto on_lane = LocateRobot(map, "R1", At(mid.x(), mid.y()), 0.5 * off);
   ASSERT_TRUE(on_lane.ok()) << on_lane.error().message;
-  EXPECT_TRUE(*on_lane == arc.to || map.NearestPoint(mid) == *on_lane);
+  EXPECT_TRUE(*on_lane == arc.to || *on_lane == arc.from) << map.point(*on_lane).name;  // either direction
+  EXPECT_FALSE(LocateRobot(map, "R1", At(mid.x() + 50.0, mid.y() + 50.0), 0.5 * off).ok());
 }
 
 TEST(RobotIntake, BadIdsAndPosesAreRefusedWithTheReason) {
