@@ -110,7 +110,7 @@ def pct(p):
     return v / 1000 if u == "us" else v * 1000 if u == "s" else v
 rate = re.search(r"Requests/sec:\s+([\d.]+)", wrk)
 r = {"robots": int(n), "dispatchd_cpu_percent": cpu(c0, c1), "fleet_sim_cpu_percent": cpu(f0, f1),
-     "release_latency_ms": fleet["release_latency_ms"], "grants": status["traffic"]["grants"],
+     "release_latency_ms": fleet["release_latency_ms"], "grants": int(status["traffic"]["grants"]),
      "orders": status["orders"], "rest_status_ms": {"p50": pct(50), "p99": pct(99)},
      "rest_requests_per_s": float(rate.group(1)) if rate else None}
 json.dump(r, open(base + ".json", "w"), indent=1)

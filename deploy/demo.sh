@@ -92,9 +92,9 @@ echo
 python3 - "http://$http/api/v1/status" <<'PY'
 import json, sys, urllib.request
 t = json.load(urllib.request.urlopen(sys.argv[1], timeout=10))["traffic"]
-d = t["min_robot_distance"]
+d = t.get("min_robot_distance")  # absent until two robots were seen
 if d:
-    print(f"Minimum robot distance seen: {d['distance']:.3f} m ({' and '.join(d['robots'])} at t = {d['time']:.1f} s; eps1 = 0.6 m)")
+    print(f"Minimum robot distance seen: {d['distance']:.3f} m ({' and '.join(d['robot_ids'])} at t = {d['time']:.1f} s; eps1 = 0.6 m)")
 print(f"Traffic control: {t['grants']} grants, {t['holds']} holds, {t['replans']} re-planned legs, "
       f"{t['deadlocks_resolved']} deadlocks resolved")
 PY

@@ -1,5 +1,7 @@
 #include "server/json_convert.h"
 
+#include <nlohmann/json.hpp>
+
 #include <cmath>
 #include <limits>
 
@@ -79,76 +81,6 @@ std::optional<AllocationRecord> ParseAllocationDetail(const std::string& detail)
   } catch (const json::exception&) {
     return std::nullopt;
   }
-}
-
-nlohmann::json AllocationToJson(const AllocationRecord& allocation, const engine::WarehouseMap& map) {
-  json j = RawAllocation(allocation);
-  for (auto* list : {&j["bids"], &j["companion_bids"]}) {
-    for (auto& bid : *list) {
-      json peaks = json::array();
-      for (const auto& p : bid["peaks"]) {
-        const int zone = p.at(0).get<int>();
-        const bool known = zone >= 0 && static_cast<std::size_t>(zone) < map.zones().size();
-        peaks.push_back({{"zone", known ? map.zones()[static_cast<std::size_t>(zone)].name : "?"},
-                         {"zone_id", zone}, {"peak_robots", p.at(1)}});
-      }
-      bid["peaks"] = peaks;
-    }
-  }
-  return j;
-}
-
-nlohmann::json StopToJson(engine::PointId point, const engine::WarehouseMap& map) {
-  if (point < 0 || static_cast<std::size_t>(point) >= map.point_count()) return {{"point_id", point}};
-  const auto& p = map.point(point);
-  return {{"point_id", point}, {"name", p.name}, {"x", p.position.x()}, {"y", p.position.y()}};
-}
-
-nlohmann::json OrderToJson(const OrderView& view, const engine::WarehouseMap& map, bool explain) {
-  const engine::Order& o = view.record.order;
-  json picks = json::array();
-  for (engine::PointId p : o.picks) picks.push_back(StopToJson(p, map));
-  json j = {{"id", o.id},
-            {"client_id", o.client_id},
-            {"state", engine::OrderStateName(o.state)},
-            {"robots", view.record.robots},
-            {"priority", o.priority},
-            {"picks", picks},
-            {"drop", StopToJson(o.drop, map)},
-            {"formation", o.formation},
-            {"work_time", o.work_time},
-            {"created_time", o.created_time},
-            {"updated_time", view.record.updated_time},
-            {"finished_time", view.finished_time ? json(*view.finished_time) : json(nullptr)},
-            {"distance", view.distance},
-            {"reason", view.record.reason}};
-  if (explain) {
-    j["allocation"] = view.explanation ? AllocationToJson(*view.explanation, map) : json(nullptr);
-  }
-  return j;
-}
-
-nlohmann::json RobotToJson(const RobotView& view, const engine::WarehouseMap& map) {
-  const engine::Robot& r = view.robot;
-  json j = {{"id", r.id},
-            {"state", engine::RobotStateName(r.state)},
-            {"connected", view.connected},
-            {"kind", view.kind},
-            {"x", r.pose.position.x()},
-            {"y", r.pose.position.y()},
-            {"heading", r.pose.heading},
-            {"diameter", r.diameter},
-            {"max_speed", r.max_speed},
-            {"orders", r.task_queue},
-            {"plan_id", view.plan_id},
-            {"plan_waypoints", view.waypoints},
-            {"last_seen", view.last_seen},
-            {"battery", r.battery ? json(*r.battery) : json(nullptr)},
-            {"formation", view.formation.empty() ? json(nullptr) : json(view.formation)},
-            {"held", view.held},
-            {"hold_reason", view.hold_reason}};
-  j["point"] = r.current_point == engine::kNoPoint ? json(nullptr) : StopToJson(r.current_point, map);
-  return j;
 }
 
 }  // namespace dispatch::server

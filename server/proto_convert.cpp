@@ -4,6 +4,28 @@
 #include <cmath>
 
 namespace dispatch::server {
+
+void StopToProto(engine::PointId id, const engine::WarehouseMap& map, pb::ResolvedStop* out) {
+  out->set_point_id(id);
+  if (id < 0 || static_cast<std::size_t>(id) >= map.point_count()) return;
+  const auto& p = map.point(id);
+  out->set_point_name(p.name);
+  out->mutable_position()->set_x(p.position.x());
+  out->mutable_position()->set_y(p.position.y());
+}
+
+pb::WaypointAction ActionToProto(engine::WaypointAction a) {
+  switch (a) {
+    case engine::WaypointAction::kMove: return pb::WAYPOINT_ACTION_MOVE;
+    case engine::WaypointAction::kPick: return pb::WAYPOINT_ACTION_PICK;
+    case engine::WaypointAction::kDrop: return pb::WAYPOINT_ACTION_DROP;
+    case engine::WaypointAction::kWait: return pb::WAYPOINT_ACTION_WAIT;
+    case engine::WaypointAction::kPark: return pb::WAYPOINT_ACTION_PARK;
+    case engine::WaypointAction::kCharge: return pb::WAYPOINT_ACTION_CHARGE;
+  }
+  return pb::WAYPOINT_ACTION_UNSPECIFIED;
+}
+
 namespace {
 
 engine::Result<engine::StopSpec> StopFromProto(const pb::StopSpec& stop, const std::string& what) {
@@ -15,15 +37,6 @@ engine::Result<engine::StopSpec> StopFromProto(const pb::StopSpec& stop, const s
     case pb::StopSpec::TARGET_NOT_SET: break;
   }
   return engine::InvalidArgument(what + " has neither point_name nor position");
-}
-
-void StopToProto(engine::PointId id, const engine::WarehouseMap& map, pb::ResolvedStop* out) {
-  out->set_point_id(id);
-  if (id < 0 || static_cast<std::size_t>(id) >= map.point_count()) return;
-  const auto& p = map.point(id);
-  out->set_point_name(p.name);
-  out->mutable_position()->set_x(p.position.x());
-  out->mutable_position()->set_y(p.position.y());
 }
 
 void BidToProto(const engine::Bid& b, const engine::WarehouseMap& map,
@@ -47,18 +60,6 @@ void BidToProto(const engine::Bid& b, const engine::WarehouseMap& map,
     p->set_peak_robots(n);
   }
   out->set_winner(std::find(winners.begin(), winners.end(), b.robot) != winners.end());
-}
-
-pb::WaypointAction ActionToProto(engine::WaypointAction a) {
-  switch (a) {
-    case engine::WaypointAction::kMove: return pb::WAYPOINT_ACTION_MOVE;
-    case engine::WaypointAction::kPick: return pb::WAYPOINT_ACTION_PICK;
-    case engine::WaypointAction::kDrop: return pb::WAYPOINT_ACTION_DROP;
-    case engine::WaypointAction::kWait: return pb::WAYPOINT_ACTION_WAIT;
-    case engine::WaypointAction::kPark: return pb::WAYPOINT_ACTION_PARK;
-    case engine::WaypointAction::kCharge: return pb::WAYPOINT_ACTION_CHARGE;
-  }
-  return pb::WAYPOINT_ACTION_UNSPECIFIED;
 }
 
 void WaypointToProto(const OutboundWaypoint& w, pb::TimedWaypoint* out) {

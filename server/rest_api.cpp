@@ -18,17 +18,9 @@ constexpr std::size_t kHttpThreads = 64;
 constexpr time_t kReadTimeoutSeconds = 2;
 constexpr time_t kKeepAliveSeconds = 2;
 
-// JSON text; bytes that are not UTF-8 (a path or query echoed in an error) become U+FFFD
-// instead of a type_error 316, which thrown in the error handler ends the process.
-std::string Dump(const nlohmann::json& j) { return j.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace); }
-
 void Reply(httplib::Response& res, const RestReply& reply) {
   res.status = reply.status;
-  if (!reply.content_type.empty()) {
-    res.set_content(reply.text, reply.content_type);
-  } else {
-    res.set_content(Dump(reply.body), "application/json");
-  }
+  res.set_content(reply.text, reply.content_type);
 }
 
 // The web map: from `web_root` when given, else the copy built into the binary.
@@ -102,7 +94,7 @@ RestServer::RestServer(RestHandlers handlers, const std::string& web_root)
       case 414: message = "request URI too long"; break;
       default: message = "request failed with HTTP " + std::to_string(res.status);
     }
-    res.set_content(Dump(nlohmann::json{{"error", message}}), "application/json");
+    res.set_content(RestHandlers::ErrorBody(message), "application/json");
   });
   s.set_exception_handler([](const httplib::Request&, httplib::Response& res, std::exception_ptr ep) {
     std::string what = "internal error";
@@ -113,7 +105,7 @@ RestServer::RestServer(RestHandlers handlers, const std::string& web_root)
     } catch (...) {
     }
     res.status = 500;
-    res.set_content(Dump(nlohmann::json{{"error", what}}), "application/json");
+    res.set_content(RestHandlers::ErrorBody(what), "application/json");
   });
 }
 

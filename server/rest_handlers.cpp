@@ -10,13 +10,12 @@
 
 #include "engine/io/map_json.h"
 #include "server/dispatcher.h"
-#include "server/json_convert.h"
 #include "server/metrics.h"
+#include "server/proto_convert.h"
+#include "server/rest_views.h"
 
 namespace dispatch::server {
 namespace {
-
-using nlohmann::json;
 
 int HttpStatus(StatusCode code) {
   switch (code) {
@@ -31,91 +30,16 @@ int HttpStatus(StatusCode code) {
   return 500;
 }
 
-// Messages echo client input (a path segment, a query value) that may be any bytes, and
-// JSON text must be UTF-8 (dump() throws otherwise): invalid bytes become U+FFFD.
-std::string Utf8(const std::string& text) {
-  return json::parse(json(text).dump(-1, ' ', false, json::error_handler_t::replace)).get<std::string>();
-}
-
-RestReply Error(int status, const std::string& message) { return {status, {{"error", Utf8(message)}}}; }
+RestReply Json(int status, const google::protobuf::Message& body) { return {status, ToJson(body)}; }
+RestReply Error(int status, const std::string& message) { return {status, ErrorJson(message)}; }
 RestReply Error(const ServiceStatus& s) { return Error(HttpStatus(s.code), s.message); }
 
-engine::Result<engine::StopSpec> StopOf(const json& j, const std::string& what) {
-  if (j.is_string()) return engine::StopSpec(j.get<std::string>());
-  if (j.is_object() && j.contains("x") && j.contains("y") && j["x"].is_number() && j["y"].is_number()) {
-    return engine::StopSpec(Eigen::Vector2d(j["x"].get<double>(), j["y"].get<double>()));
-  }
-  return engine::InvalidArgument(what + " must be a point name or {\"x\": .., \"y\": ..}");
-}
-
-// A present field of the wrong type, named (nlohmann's own message does not name it).
-engine::Error WrongType(const std::string& field, const std::string& want, const json& got) {
-  return engine::InvalidArgument(field + " must be " + want + ", got " + (got.is_number() ? got.dump() : got.type_name()));
-}
-
-engine::Result<engine::OrderRequest> RequestOf(const std::string& body) {
-  json j;
-  try {
-    j = json::parse(body);
-  } catch (const json::exception& e) {
-    return engine::InvalidArgument(std::string("body is not JSON: ") + e.what());
-  }
-  if (!j.is_object()) return engine::InvalidArgument("body must be a JSON object");
-  // A misspelt field would otherwise be dropped silently (e.g. "relase_time": the order would
-  // start at once).
-  static const std::set<std::string> kFields = {"client_order_id", "client_id", "priority", "picks",
-                                                "drop", "formation", "work_time", "release_time"};
-  for (const auto& [key, value] : j.items()) {
-    if (!kFields.count(key)) {
-      return engine::InvalidArgument("unknown field '" + key + "' (known: client_order_id, priority, picks, drop, "
-                                     "formation, work_time, release_time)");
-    }
-  }
-  engine::OrderRequest r;
-  const char* id_key = j.contains("client_order_id") ? "client_order_id" : "client_id";
-  if (!j.contains(id_key) || !j[id_key].is_string()) {
-    return engine::InvalidArgument("client_order_id (string) is required");
-  }
-  r.client_id = j[id_key].get<std::string>();
-  if (j.contains("priority")) {
-    const json& p = j["priority"];
-    // int32 as in SubmitOrderRequest; get<int>() would wrap 2^32 + 1 to 1 and cut 1.5 to 1.
-    const bool fits = p.is_number_unsigned() ? p.get<std::uint64_t>() <= std::numeric_limits<std::int32_t>::max()
-                      : p.is_number_integer() ? p.get<std::int64_t>() >= std::numeric_limits<std::int32_t>::min() &&
-                                                    p.get<std::int64_t>() <= std::numeric_limits<std::int32_t>::max()
-                                              : false;
-    if (!fits) return WrongType("priority", "an integer in [-2^31, 2^31 - 1]", p);
-    r.priority = p.get<int>();
-  }
-  if (!j.contains("picks") || !j["picks"].is_array()) {
-    return engine::InvalidArgument("picks (array of stops) is required");
-  }
-  int k = 0;
-  for (const auto& p : j["picks"]) {
-    auto stop = StopOf(p, "pick " + std::to_string(++k));
-    if (!stop.ok()) return stop.error();
-    r.picks.push_back(*stop);
-  }
-  if (!j.contains("drop")) return engine::InvalidArgument("drop is required");
-  auto drop = StopOf(j["drop"], "drop");
-  if (!drop.ok()) return drop.error();
-  r.drop = *drop;
-  if (j.contains("formation")) {
-    if (!j["formation"].is_boolean()) return WrongType("formation", "true or false", j["formation"]);
-    r.formation = j["formation"].get<bool>();
-  }
-  if (j.contains("work_time")) {
-    if (!j["work_time"].is_number()) return WrongType("work_time", "a number of seconds", j["work_time"]);
-    r.work_time = j["work_time"].get<double>();
-  }
-  if (j.contains("release_time") && !j["release_time"].is_null()) {
-    const json& t = j["release_time"];
-    if (!t.is_number() || !std::isfinite(t.get<double>())) {
-      return WrongType("release_time", "a finite number of seconds or null", t);
-    }
-    r.release_time = t.get<double>();
-  }
-  return r;
+// A state filter: the lower-case name (in_progress) or the enum's (ORDER_STATE_IN_PROGRESS).
+std::optional<engine::OrderState> StateFilter(const std::string& name) {
+  if (auto state = engine::ParseOrderState(name)) return state;
+  pb::OrderState value = pb::ORDER_STATE_UNSPECIFIED;
+  if (!pb::OrderState_Parse(name, &value)) return std::nullopt;
+  return OrderStateFromProto(value);
 }
 
 }  // namespace
@@ -125,24 +49,14 @@ RestHandlers::RestHandlers(Dispatcher& dispatcher, ServiceMetrics* metrics)
       metrics_(metrics),
       map_json_(std::make_shared<const std::string>(engine::WriteMapJson(dispatcher.map()))) {}
 
-RestReply RestHandlers::Map() const { return RestReply::Text("application/json", *map_json_); }
+std::string RestHandlers::ErrorBody(const std::string& message) { return ErrorJson(message); }
+
+RestReply RestHandlers::Map() const { return {200, *map_json_}; }
 
 RestReply RestHandlers::Zones() const {
-  auto snap = dispatcher_.snapshot();
-  const auto& zones = dispatcher_.map().zones();
-  json out = json::array();
-  for (std::size_t z = 0; z < zones.size(); ++z) {
-    json polygon = json::array();
-    for (const auto& v : zones[z].polygon) polygon.push_back({v.x(), v.y()});
-    const ZoneView* live = z < snap->zones.size() ? &snap->zones[z] : nullptr;
-    out.push_back({{"id", zones[z].name},
-                   {"polygon", polygon},
-                   {"area", zones[z].area},
-                   {"robots", live ? live->robots.size() : 0},
-                   {"density", live ? live->density : 0.0},
-                   {"robot_ids", live ? json(live->robots) : json::array()}});
-  }
-  return {200, {{"time", snap->time}, {"zones", out}}};
+  pb::ZoneList out;
+  ZonesToProto(*dispatcher_.snapshot(), dispatcher_.map(), &out);
+  return Json(200, out);
 }
 
 RestReply RestHandlers::Intersections(const std::optional<std::string>& active) const {
@@ -154,75 +68,35 @@ RestReply RestHandlers::Intersections(const std::optional<std::string>& active) 
       return Error(400, "active must be 1, true, 0 or false");
     }
   }
-  auto snap = dispatcher_.snapshot();
-  const engine::WarehouseMap& map = dispatcher_.map();
-  auto names = [&map](const std::vector<engine::PointId>& points) {
-    json out = json::array();
-    for (engine::PointId p : points) out.push_back(map.point(p).name);
-    return out;
-  };
-  json out = json::array();
-  for (std::size_t i = 0; i < map.intersections().size(); ++i) {
-    const auto& x = map.intersections()[i];
-    const IntersectionView* live = i < snap->intersections.size() ? &snap->intersections[i] : nullptr;
-    if (only_active && (!live || (live->holders.empty() && live->waiting.empty()))) continue;
-    out.push_back({{"id", x.name},
-                   {"inner", names(x.inner)},
-                   {"approach", names(x.approach)},
-                   {"holders", live ? json(live->holders) : json::array()},
-                   {"waiting", live ? json(live->waiting) : json::array()}});
-  }
-  return {200, {{"time", snap->time}, {"control", snap->traffic.enabled}, {"intersections", out}}};
+  pb::IntersectionList out;
+  IntersectionsToProto(*dispatcher_.snapshot(), dispatcher_.map(), only_active, &out);
+  return Json(200, out);
 }
 
 RestReply RestHandlers::Metrics() const {
   if (!metrics_) return Error(404, "metrics are not enabled");
-  return RestReply::Text("text/plain; version=0.0.4; charset=utf-8", metrics_->Render(*dispatcher_.snapshot()));
+  return {200, metrics_->Render(*dispatcher_.snapshot()), "text/plain; version=0.0.4; charset=utf-8"};
 }
 
-RestReply RestHandlers::Health() const { return {200, {{"status", "ok"}}}; }
+RestReply RestHandlers::Health() const {
+  pb::Health out;
+  out.set_status("ok");
+  return Json(200, out);
+}
 
 RestReply RestHandlers::Ready() const {
   auto snap = dispatcher_.snapshot();
   if (!snap) return Error(503, "dispatcher not ready");
-  return {200, {{"ready", true}, {"snapshot", snap->version}}};
+  pb::Readiness out;
+  out.set_ready(true);
+  out.set_snapshot(snap->version);
+  return Json(200, out);
 }
 
 RestReply RestHandlers::Status() const {
-  auto snap = dispatcher_.snapshot();
-  json orders = json::object();
-  for (const char* s : {"accepted", "assigned", "in_progress", "completed", "cancelled", "failed"}) {
-    orders[s] = 0;
-  }
-  for (const auto& o : snap->orders) orders[engine::OrderStateName(o->record.order.state)] = orders[engine::OrderStateName(o->record.order.state)].get<int>() + 1;
-  int connected = 0;
-  for (const auto& [id, r] : snap->robots) connected += r.connected ? 1 : 0;
-  const TrafficView& t = snap->traffic;
-  json traffic = {{"control", t.enabled},
-                  {"grants", t.grants},
-                  {"holds", t.holds},
-                  {"replans", t.replans},
-                  {"deadlocks_resolved", t.deadlocks_resolved},
-                  {"head_on_conflicts", t.head_on_conflicts},
-                  {"nudges", t.nudges},
-                  {"implausible_reports", t.implausible_reports},
-                  {"awaiting_reconnect", t.awaiting_reconnect},
-                  {"min_robot_distance", nullptr}};
-  if (t.min_distance >= 0) {
-    traffic["min_robot_distance"] = {{"distance", t.min_distance},
-                                     {"robots", {t.min_pair_a, t.min_pair_b}},
-                                     {"time", t.min_time}};
-  }
-  return {200,
-          {{"map", snap->map_name},
-           {"map_version", snap->map_version},
-           {"strategy", snap->strategy},
-           {"time", snap->time},
-           {"time_scale", snap->time_scale},
-           {"snapshot", snap->version},
-           {"orders", orders},
-           {"robots", {{"total", snap->robots.size()}, {"connected", connected}}},
-           {"traffic", traffic}}};
+  pb::ServiceState out;
+  StatusToProto(*dispatcher_.snapshot(), &out);
+  return Json(200, out);
 }
 
 RestReply RestHandlers::Traffic() {
@@ -230,33 +104,36 @@ RestReply RestHandlers::Traffic() {
   Lines lines = dispatcher_.Call<Lines>([this](std::function<void(Lines)> done) {
     done(dispatcher_.TrafficLines());
   });
-  json robots = json::object();
-  for (const auto& [id, line] : lines) robots[id] = line;
-  return {200, {{"robots", robots}}};
+  pb::TrafficReport out;
+  for (auto& [id, line] : lines) (*out.mutable_robots())[id] = std::move(line);
+  return Json(200, out);
 }
 
 RestReply RestHandlers::Robots() const {
   auto snap = dispatcher_.snapshot();
-  json robots = json::array();
-  for (const auto& [id, r] : snap->robots) robots.push_back(RobotToJson(r, dispatcher_.map()));
-  return {200, {{"robots", robots}}};
+  pb::RobotList out;
+  for (const auto& [id, r] : snap->robots) RobotToProto(r, dispatcher_.map(), out.add_robots());
+  return Json(200, out);
 }
 
 RestReply RestHandlers::Robot(const std::string& id) const {
   auto snap = dispatcher_.snapshot();
   auto it = snap->robots.find(id);
   if (it == snap->robots.end()) return Error(404, "no robot with id '" + id + "'");
-  return {200, RobotToJson(it->second, dispatcher_.map())};
+  pb::RobotInfo out;
+  RobotToProto(it->second, dispatcher_.map(), &out);
+  return Json(200, out);
 }
 
 RestReply RestHandlers::Orders(const std::optional<std::string>& state,
                                const std::optional<std::string>& finished) const {
   std::optional<engine::OrderState> filter;
   if (state) {
-    filter = engine::ParseOrderState(*state);
+    filter = StateFilter(*state);
     if (!filter) {
       return Error(400, "unknown state '" + *state +
-                            "' (accepted, assigned, in_progress, completed, cancelled, failed)");
+                            "' (accepted, assigned, in_progress, completed, cancelled, failed, or "
+                            "ORDER_STATE_ACCEPTED ... ORDER_STATE_FAILED)");
     }
   }
   std::size_t keep = kListedFinished;
@@ -277,7 +154,8 @@ RestReply RestHandlers::Orders(const std::optional<std::string>& state,
     if (filter && o->record.order.state != *filter) continue;
     (engine::IsTerminal(o->record.order.state) ? done : open).push_back(i);
   }
-  const std::size_t finished_total = done.size();
+  pb::OrderList out;
+  out.set_finished_total(static_cast<std::uint32_t>(done.size()));
   if (done.size() > keep) {  // the newest finished: by finished time, then submission
     auto newer = [&](std::size_t a, std::size_t b) {
       const double ta = snap->orders[a]->finished_time.value_or(0.0), tb = snap->orders[b]->finished_time.value_or(0.0);
@@ -289,9 +167,8 @@ RestReply RestHandlers::Orders(const std::optional<std::string>& state,
   std::vector<std::size_t> listed = open;
   listed.insert(listed.end(), done.begin(), done.end());
   std::sort(listed.begin(), listed.end());
-  json orders = json::array();
-  for (const std::size_t i : listed) orders.push_back(OrderToJson(*snap->orders[i], dispatcher_.map(), false));
-  return {200, {{"orders", orders}, {"finished_total", finished_total}}};
+  for (const std::size_t i : listed) OrderToProto(*snap->orders[i], dispatcher_.map(), out.add_orders());
+  return Json(200, out);
 }
 
 RestReply RestHandlers::Order(const std::string& id) {
@@ -299,43 +176,42 @@ RestReply RestHandlers::Order(const std::string& id) {
   auto order = snap->FindOrder(id);
   if (!order) order = snap->FindClientOrder(id);
   if (!order) return Error(404, "no order with id or client id '" + id + "'");
-  json j = OrderToJson(*order, dispatcher_.map(), true);
+  pb::OrderDetail out;
+  OrderToProto(*order, dispatcher_.map(), out.mutable_order());
+  if (order->explanation) AllocationToProto(*order->explanation, dispatcher_.map(), out.mutable_allocation());
   const std::string order_id = order->record.order.id;
   OrderRoutes routes = dispatcher_.Call<OrderRoutes>([this, order_id](std::function<void(OrderRoutes)> done) {
     done(dispatcher_.RoutesOf(order_id));
   });
-  json by_robot = json::object();
-  for (const auto& [robot, waypoints] : routes) {
-    json list = json::array();
-    for (const auto& w : waypoints) {
-      list.push_back({{"seq", w.seq}, {"x", w.xy.x()}, {"y", w.xy.y()},
-                      {"action", engine::WaypointActionName(w.action)}, {"released", w.released}});
-    }
-    by_robot[robot] = list;
-  }
-  j["routes"] = by_robot;
-  return {200, j};
+  RoutesToProto(routes, &out);
+  return Json(200, out);
 }
 
 RestReply RestHandlers::SubmitOrder(const std::string& body) {
-  auto request = RequestOf(body);
+  pb::SubmitOrderRequest parsed;
+  if (auto read = FromJson(body, &parsed); !read.ok()) return Error(FromEngineError(read.error()));
+  auto request = OrderRequestFromProto(parsed);
   if (!request.ok()) return Error(FromEngineError(request.error()));
   SubmitReply reply = dispatcher_.Call<SubmitReply>(
       [this, r = std::move(request).value()](std::function<void(SubmitReply)> done) mutable {
         dispatcher_.SubmitOrder(std::move(r), std::move(done));
       });
   if (!reply.status.ok()) return Error(reply.status);
-  json j = OrderToJson(*reply.order, dispatcher_.map(), false);
-  j["created"] = reply.created;
-  return {reply.created ? 201 : 200, j};
+  pb::SubmitOrderResponse out;
+  OrderToProto(*reply.order, dispatcher_.map(), out.mutable_order());
+  out.set_created(reply.created);
+  return Json(reply.created ? 201 : 200, out);
 }
 
 RestReply RestHandlers::CancelOrder(const std::string& id, const std::string& reason) {
-  OrderReply reply = dispatcher_.Call<OrderReply>([this, id, reason](std::function<void(OrderReply)> done) {
-    dispatcher_.CancelOrder(id, reason, std::move(done));
+  // The reason is stored and sent back in Order.reason: a proto string, so UTF-8.
+  OrderReply reply = dispatcher_.Call<OrderReply>([this, id, why = ValidUtf8(reason)](std::function<void(OrderReply)> done) {
+    dispatcher_.CancelOrder(id, why, std::move(done));
   });
   if (!reply.status.ok()) return Error(reply.status);
-  return {200, OrderToJson(*reply.order, dispatcher_.map(), false)};
+  pb::Order out;
+  OrderToProto(*reply.order, dispatcher_.map(), &out);
+  return Json(200, out);
 }
 
 }  // namespace dispatch::server

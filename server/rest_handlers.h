@@ -1,11 +1,10 @@
 // RestHandlers: the REST API's logic (SPEC §4 "REST"), answering with an HTTP status and a
 // JSON body; rest_api.cpp only routes cpp-httplib requests here. This header is free of
 // Eigen and engine headers so that httplib.h (whose <resolv.h> defines `_res`) never meets
-// Eigen in one translation unit (STYLE.md). Reads use the dispatcher's snapshot; writes wait
+// Eigen in one translation unit (STYLE.md). Every JSON body is a proto message's JSON mapping
+// (issue 15 §2): REST and gRPC have one schema. Reads use the dispatcher's snapshot; writes wait
 // for the dispatcher loop's reply. Thread-safe.
 #pragma once
-
-#include <nlohmann/json.hpp>
 
 #include <cstddef>
 #include <memory>
@@ -22,19 +21,12 @@ class ServiceMetrics;
 inline constexpr std::size_t kListedFinished = 100;
 inline constexpr std::size_t kMaxListedFinished = 1000;
 
-// A JSON body, or (content_type set) `text` as it is.
+// An answer: a JSON body (the proto3 JSON mapping of an operator.proto / orders.proto
+// message, see server/rest_views.h) or, for the map and the metrics, text of its own type.
 struct RestReply {
-  RestReply(int status, nlohmann::json body) : status(status), body(std::move(body)) {}
-  static RestReply Text(std::string content_type, std::string text) {
-    RestReply r(200, nullptr);
-    r.content_type = std::move(content_type);
-    r.text = std::move(text);
-    return r;
-  }
   int status = 200;
-  nlohmann::json body;
-  std::string content_type;
   std::string text;
+  std::string content_type = "application/json";
 };
 
 class RestHandlers {
@@ -47,7 +39,8 @@ class RestHandlers {
   RestReply Status() const;
   RestReply Robots() const;
   RestReply Robot(const std::string& id) const;
-  // state: a lower-case order state name, or nullopt for all.
+  // state: an order state, lower case (in_progress) or as the enum (ORDER_STATE_IN_PROGRESS);
+  // nullopt for all.
   // Every open order and the newest `finished` (default kListedFinished, at most
   // kMaxListedFinished) finished ones, in submission order, with finished_total: a list that
   // held every order ever stored grew each HTTP thread's heap with the whole history (issue 15
@@ -66,11 +59,14 @@ class RestHandlers {
   RestReply Intersections(const std::optional<std::string>& active = std::nullopt) const;
   // GET /metrics: Prometheus text format.
   RestReply Metrics() const;
-  // body: {"client_order_id": "...", "picks": ["P1-1-1" | {"x":..,"y":..}, ...],
-  //        "drop": "D1" | {"x":..,"y":..}, "priority": 0, "formation": false,
-  //        "work_time": 5.0, "release_time": 0.0}
+  // body: a SubmitOrderRequest, e.g. {"client_order_id": "...", "picks": [{"point_name":
+  // "P1-1-1"} | {"position": {"x": .., "y": ..}}, ...], "drop": {...}, "priority": 0,
+  // "formation": false, "work_time": 5.0, "release_time": 0.0}; answers a SubmitOrderResponse.
   RestReply SubmitOrder(const std::string& body);
   RestReply CancelOrder(const std::string& id, const std::string& reason);
+
+  // An ErrorReply body (also for httplib's own errors: 404, 413, ...).
+  static std::string ErrorBody(const std::string& message);
 
  private:
   Dispatcher& dispatcher_;

@@ -1,7 +1,8 @@
-// The live map's controller: polls the REST API (robots, intersections and zones every
-// 200 ms, status every 500 ms, orders and the selected order every second; the map once and
+// The live map's controller: polls the REST API (robots, intersections and zones every 200 ms,
+// status every 500 ms, orders and the selected order every second; the map once and
 // again when its version changes), keeps the latest answers, and redraws the live layers once
-// per animation frame after new data. Fetch failures are shown in the page and retried.
+// per animation frame after new data (the answers' proto JSON turned into views by api.js).
+// Fetch failures are shown in the page and retried.
 // window.dispatchMap = {robots(): [{id, x, y, state}] as drawn, frames: live updates applied}.
 "use strict";
 
@@ -186,34 +187,36 @@
   function start() {
     loadMap();
     poll("robots", () => "robots", 200, j => {
-      state.robots = Array.isArray(j.robots) ? j.robots : [];
+      state.robots = (Array.isArray(j.robots) ? j.robots : []).map(WM.Api.robot);
       state.robotsFresh = true;
       scheduleDraw();
     });
     poll("intersections", () => "intersections?active=1", 200, j => {
-      state.intersections = Array.isArray(j.intersections) ? j.intersections : [];
+      state.intersections = (Array.isArray(j.intersections) ? j.intersections : []).map(WM.Api.intersection);
       WM.Panels.renderIntersections(state.intersections);
       scheduleDraw();
     });
     poll("zones", () => "zones", 200, j => {
-      state.zones = Array.isArray(j.zones) ? j.zones : [];
+      state.zones = (Array.isArray(j.zones) ? j.zones : []).map(WM.Api.zone);
       const peak = Math.max(0, ...state.zones.map(z => (isFinite(z.density) ? z.density : 0)));
       if (peak > state.heatMax) { state.heatMax = peak; WM.Panels.renderLegend(state.heatMax); }
       scheduleDraw();
     });
-    poll("status", () => "status", 500, s => {
+    poll("status", () => "status", 500, j => {
+      const s = WM.Api.status(j);
       WM.Panels.renderStatus(s);
       if (s.map_version && state.mapVersion && s.map_version !== state.mapVersion) loadMap();
       if (s.map_version) state.mapVersion = s.map_version;
     });
     poll("orders", () => "orders", 1000, j => {
-      state.orders = Array.isArray(j.orders) ? j.orders : [];
+      state.orders = (Array.isArray(j.orders) ? j.orders : []).map(WM.Api.order);
       state.ordersById = new Map(state.orders.map(o => [o.id, o]));
       state.finishedTotal = Number.isFinite(j.finished_total) ? j.finished_total : null;
       WM.Panels.renderOrders(state.orders, state.selectedId, state.finishedTotal);
     });
-    poll("order", () => (state.selectedId ? "orders/" + encodeURIComponent(state.selectedId) : null), 1000, (o, path) => {
+    poll("order", () => (state.selectedId ? "orders/" + encodeURIComponent(state.selectedId) : null), 1000, (j, path) => {
       if (!state.selectedId || path !== "orders/" + encodeURIComponent(state.selectedId)) return;  // selection changed meanwhile
+      const o = WM.Api.detail(j);
       state.detail = o;
       WM.Panels.renderDetail(o);
       scheduleDraw();
@@ -228,8 +231,9 @@
     if (!id) problem("order", null);
     scheduleDraw();
     if (id) {  // at once, not at the next poll
-      getJson("orders/" + encodeURIComponent(id)).then(o => {
+      getJson("orders/" + encodeURIComponent(id)).then(j => {
         if (state.selectedId !== id) return;
+        const o = WM.Api.detail(j);
         state.detail = o; WM.Panels.renderDetail(o); scheduleDraw();
       }, err => problem("order", err));
     }

@@ -19,6 +19,7 @@ import subprocess
 import time
 
 import grpc
+from google.protobuf import json_format
 from e2e_harness import CANCELLED, FAILED, RANK, TestFailure, check, state_name
 from warehouse.dispatch.v1 import common_pb2, orders_pb2
 
@@ -58,10 +59,8 @@ def content(o):
 
 
 def rest_content(j):
-    """content() of a REST order (which has no release_time)."""
-    return dict(id=j["id"], client=j["client_id"], priority=j["priority"],
-                picks=[p["point_id"] for p in j["picks"]], drop=j["drop"]["point_id"],
-                formation=j["formation"], work_time=j["work_time"], created=j["created_time"])
+    """content() of a REST order: its JSON is the gRPC Order's proto3 JSON mapping."""
+    return content(json_format.ParseDict(j, orders_pb2.Order()))
 
 
 class Book:
@@ -210,7 +209,7 @@ def check_intact(h, server, book, what):
     check(len(rest) == len(grpc_orders),
           f"{what}: REST lists {len(rest)} orders, gRPC {len(grpc_orders)}")
     for j in rest:
-        want = {k: v for k, v in book.orders.get(j["client_id"], {}).items() if k != "release"}
+        want = book.orders.get(j["client_order_id"], {})
         check(rest_content(j) == want, f"{what}: REST order {j['id']} is {rest_content(j)}, "
                                        f"acknowledged {want}")
     h.log(f"{what}: all {len(book.orders)} acknowledged orders intact "

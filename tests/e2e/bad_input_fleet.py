@@ -192,10 +192,11 @@ def junk_on_a_live_stream(server, book):
     s.send(hello("RX-junk"))
     s.expect_end(Code.INVALID_ARGUMENT, "Hello sent twice")
     r = robot(server, "RX-junk")
-    check((r["x"], r["y"]) == PARK,
-          f"RX-junk is at ({r['x']}, {r['y']}), not where it last sanely was, {PARK}")
-    check(r["point"] is not None, "RX-junk stands at no map point after its reports")
-    check(r["heading"] == 0.0, f"RX-junk heading {r['heading']}")
+    pose = r["pose"]
+    check((pose["x"], pose["y"]) == PARK,
+          f"RX-junk is at ({pose['x']}, {pose['y']}), not where it last sanely was, {PARK}")
+    check(r.get("point") is not None, "RX-junk stands at no map point after its reports")
+    check(pose["theta"] == 0.0, f"RX-junk heading {pose['theta']}")
     check(r["battery"] == 0.5, f"RX-junk battery {r['battery']}, not its last sane 0.5")
     after = server.orders.GetOrder(orders_pb2.GetOrderRequest(order_id=victim), timeout=10)
     check(after.state != COMPLETED,

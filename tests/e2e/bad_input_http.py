@@ -42,8 +42,22 @@ STALLED = 16  # stalled and idle clients each: more than cpp-httplib's default o
 READ_TIMEOUT_MAX = 15.0  # a stalled request must be given up by then (httplib's default: 5 s)
 
 
+def stop(spec):
+    """A StopSpec in JSON from a point name or an {"x", "y"} dict; anything else as it is."""
+    if isinstance(spec, str):
+        return {"point_name": spec}
+    if isinstance(spec, dict) and set(spec) == {"x", "y"}:
+        return {"position": spec}
+    return spec
+
+
 def order(client, **fields):
-    body = {"client_order_id": client, "picks": ["K1-1-1N"], "drop": "D-B1"}
+    """A SubmitOrderRequest's JSON (the REST body is the proto3 JSON mapping)."""
+    body = {"client_order_id": client, "picks": [stop("K1-1-1N")], "drop": stop("D-B1")}
+    if isinstance(fields.get("picks"), list):
+        fields["picks"] = [stop(p) for p in fields["picks"]]
+    if "drop" in fields:
+        fields["drop"] = stop(fields["drop"])
     body.update(fields)
     return json.dumps(body)
 
@@ -63,23 +77,30 @@ def not_json(server):
 def wrong_types(server):
     post_fails(server, 400, order("t-1", picks=5), "picks")
     post_fails(server, 400, order("t-2", picks="K1-1-1N"), "picks")
-    post_fails(server, 400, order("t-3", picks=[7]), "pick 1")
-    post_fails(server, 400, order("t-4", picks=[{"x": "19", "y": 17}]), "pick 1")
+    post_fails(server, 400, order("t-3", picks=[7]), "picks[0]")
+    post_fails(server, 400, order("t-4", picks=[{"position": {"x": "nineteen", "y": 17}}]), "picks[0].position.x")
+    post_fails(server, 400, order("t-4b", picks=[{}]), "pick 1", "neither point_name nor position")
+    post_fails(server, 400, order("t-4c", picks=[{"x": 19, "y": 17, "z": 0}]), "picks[0]", "cannot find field")
     post_fails(server, 400, order("t-5", drop=None), "drop")
     post_fails(server, 400, order("t-6", drop=[6.5, 2.75]), "drop")
     post_fails(server, 400, order("t-7", priority="high"), "priority")
     post_fails(server, 400, order("t-8", priority=2**32 + 1), "priority")  # not wrapped to 1
     post_fails(server, 400, order("t-9", priority=1.5), "priority")
     post_fails(server, 400, order("t-10", priority=True), "priority")
-    post_fails(server, 400, order("t-11", work_time="5"), "work_time")
-    post_fails(server, 400, order("t-12", formation="yes"), "formation")
+    post_fails(server, 400, order("t-11", work_time="five"), "work_time")
+    post_fails(server, 400, order("t-12", formation="maybe"), "formation")
     post_fails(server, 400, order("t-13", formation=1), "formation")
     post_fails(server, 400, order("t-14", release_time="soon"), "release_time")
-    post_fails(server, 400, '{"client_order_id": "t-15", "picks": ["K1-1-1N"], "drop": "D-B1", '
+    post_fails(server, 400, '{"client_order_id": "t-15", "picks": [{"point_name": "K1-1-1N"}], '
+                            '"drop": {"point_name": "D-B1"}, '
                             '"release_time": 1e999}', "1e999")  # a JSON parse error, no field
-    post_fails(server, 400, json.dumps({"client_order_id": 5, "picks": ["K1-1-1N"],
-                                        "drop": "D-B1"}), "client_order_id")
-    post_fails(server, 400, json.dumps({"picks": ["K1-1-1N"], "drop": "D-B1"}), "client_order_id")
+    post_fails(server, 400, json.dumps({"client_order_id": 5, "picks": [stop("K1-1-1N")],
+                                        "drop": stop("D-B1")}), "client_order_id")
+    post_fails(server, 400, json.dumps({"picks": [stop("K1-1-1N")], "drop": stop("D-B1")}), "client_order_id")
+    # The old REST shape (stops as bare names) is not a SubmitOrderRequest.
+    post_fails(server, 400, json.dumps({"client_order_id": "t-16", "picks": ["K1-1-1N"], "drop": "D-B1"}),
+               "StopSpec")
+    post_fails(server, 400, order("t-17", relase_time=60), "relase_time")
 
 
 def bad_orders(server, book):
@@ -95,7 +116,7 @@ def bad_orders(server, book):
     post_fails(server, 409, order(first, drop="D-B2"), first, book.orders[first]["id"])
     status, ctype, data = http_call(server, "POST", ORDERS, order(first))
     j = json_body(status, ctype, data, "the same submission again")
-    check(status == 200 and j["created"] is False and j["id"] == book.orders[first]["id"],
+    check(status == 200 and j["created"] is False and j["order"]["id"] == book.orders[first]["id"],
           f"the same submission again: HTTP {status} {j}")
 
 

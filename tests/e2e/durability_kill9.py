@@ -123,10 +123,10 @@ def main():
         # was on line had reported, and nobody came closer than eps1 after the restart.
         check("every robot that was on line before the restart has reported" in log,
               "dispatchd#2 never saw the whole fleet report back (or did not wait for it)")
-        closest = server.rest("/api/v1/status")["traffic"]["min_robot_distance"]
+        closest = server.rest("/api/v1/status")["traffic"].get("min_robot_distance")
         check(closest is not None, "no robot distance measured after the restart")
         check(closest["distance"] >= EPS1 - 1e-6,
-              f"after the restart robots {closest['robots']} came {closest['distance']:.6f} m close "
+              f"after the restart robots {closest['robot_ids']} came {closest['distance']:.6f} m close "
               f"(eps1 = {EPS1} m)")
 
 

@@ -120,9 +120,9 @@ def main():
         check("robot R1 offline: stream closed" not in log,
               "R1's stream was closed by the client: the test wants the heartbeat path")
         r1 = server.rest("/api/v1/robots/R1")
-        check(not r1["connected"] and r1["state"] == "offline",
+        check(not r1["connected"] and r1["state"] == "ROBOT_STATE_OFFLINE",
               f"R1 after the loss: connected={r1['connected']} state={r1['state']}")
-        check(r1["orders"] == [], f"R1 still holds orders: {r1['orders']}")
+        check(r1["order_ids"] == [], f"R1 still holds orders: {r1['order_ids']}")
         check("the server closed its stream" in first.log_text(),
               "fleet-sim did not see the server close the silent robot's stream")
 

@@ -233,10 +233,11 @@ def browser_checks(h, server, page, base_url, orders, out):
     # Click an allocated order still under way (its routes are left), formation preferred.
     def pick():
         active = [server.rest(f"/api/v1/orders/{o}") for o in orders]
-        active = [o for o in active if o.get("allocation") and o["state"] in ("assigned", "in_progress")]
-        return sorted(active, key=lambda o: (not o["formation"], o["id"]))
+        active = [o for o in active if o.get("allocation")
+                  and o["order"]["state"] in ("ORDER_STATE_ASSIGNED", "ORDER_STATE_IN_PROGRESS")]
+        return sorted(active, key=lambda o: (not o["order"]["formation"], o["order"]["id"]))
     chosen = h.wait_for(pick, 20, "an allocated order under way")[0]
-    oid = chosen["id"]
+    oid = chosen["order"]["id"]
     page.click(f'#orders li[data-order-id="{oid}"]')
     shown = page.wait(f"""(() => {{ const p = document.getElementById('detail-panel');
         if (p.hidden || document.getElementById('detail-title').textContent !== {json.dumps(oid)}) return null;
@@ -250,11 +251,11 @@ def browser_checks(h, server, page, base_url, orders, out):
                       10, f"the explanation of {oid} after the click")
     alloc = chosen["allocation"]
     h.log(f"clicked {oid}: {len(shown['bids'])} bids shown, winners {shown['winners']}")
-    check(sorted(shown["bids"]) == sorted(b["robot"] for b in alloc["bids"]),
-          f"{oid}: bids shown {shown['bids']}, REST has {[b['robot'] for b in alloc['bids']]}")
+    check(sorted(shown["bids"]) == sorted(b["robot_id"] for b in alloc["bids"]),
+          f"{oid}: bids shown {shown['bids']}, REST has {[b['robot_id'] for b in alloc['bids']]}")
     check(shown["cells"] == 7, f"{oid}: a bid row has {shown['cells']} cells, want robot T_t T_d T_w F bid win")
-    check(shown["winners"] and set(shown["winners"]) <= set(alloc["winners"]),
-          f"{oid}: winners marked {shown['winners']}, REST winners {alloc['winners']}")
+    check(shown["winners"] and set(shown["winners"]) <= set(alloc["winner_ids"]),
+          f"{oid}: winners marked {shown['winners']}, REST winners {alloc['winner_ids']}")
     check(shown["reason"] == alloc["reason"], f"{oid}: reason shown {shown['reason']!r}, REST {alloc['reason']!r}")
     check(shown["companions"] == len(alloc.get("companion_bids") or []),
           f"{oid}: {shown['companions']} companion bids shown, REST has {len(alloc.get('companion_bids') or [])}")
@@ -268,7 +269,8 @@ def browser_checks(h, server, page, base_url, orders, out):
                                  ".map(e => e.dataset.routeOf))].sort().join(' ')", 10,
                                  f"the remaining routes of {oid}")
         h.log(f"routes drawn for {drawn_routes}")
-        check(set(drawn_routes.split()) <= set(chosen["robots"]), f"routes of {drawn_routes}, order has {chosen['robots']}")
+        robots = chosen["order"]["robot_ids"]
+        check(set(drawn_routes.split()) <= set(robots), f"routes of {drawn_routes}, order has {robots}")
 
     page.screenshot(os.path.join(out, "web_map.png"))
     problems = page.evaluate(PROBLEMS)

@@ -103,7 +103,7 @@ TEST_F(OperatorEndpointsTest, ZonesCountTheConnectedRobotsInThem) {
   const json before = GetJson("/api/v1/zones");
   ASSERT_EQ(before["zones"].size(), server_->dispatcher().map().zones().size());
   for (const auto& z : before["zones"]) {
-    EXPECT_EQ(z["robots"], 0);
+    EXPECT_TRUE(z["robot_ids"].empty());
     EXPECT_GT(z["area"].get<double>(), 0);
     EXPECT_GE(z["polygon"].size(), 3u);
   }
@@ -113,16 +113,16 @@ TEST_F(OperatorEndpointsTest, ZonesCountTheConnectedRobotsInThem) {
   const json after = GetJson("/api/v1/zones");
   int total = 0;
   for (const auto& z : after["zones"]) {
-    total += z["robots"].get<int>();
-    if (z["robots"] == 1) {
+    total += static_cast<int>(z["robot_ids"].size());
+    if (z["robot_ids"].size() == 1) {
       EXPECT_EQ(z["robot_ids"], json::array({"R7"}));
       EXPECT_DOUBLE_EQ(z["density"].get<double>(), 1.0 / z["area"].get<double>());
       // park-P1's zone: the polygon holds the robot's position.
       const auto& p = z["polygon"];
       double lo_x = 1e9, hi_x = -1e9, lo_y = 1e9, hi_y = -1e9;
       for (const auto& v : p) {
-        lo_x = std::min(lo_x, v[0].get<double>()), hi_x = std::max(hi_x, v[0].get<double>());
-        lo_y = std::min(lo_y, v[1].get<double>()), hi_y = std::max(hi_y, v[1].get<double>());
+        lo_x = std::min(lo_x, v["x"].get<double>()), hi_x = std::max(hi_x, v["x"].get<double>());
+        lo_y = std::min(lo_y, v["y"].get<double>()), hi_y = std::max(hi_y, v["y"].get<double>());
       }
       EXPECT_TRUE(kParkX >= lo_x && kParkX <= hi_x && kParkY >= lo_y && kParkY <= hi_y) << z.dump();
     }
@@ -137,8 +137,8 @@ TEST_F(OperatorEndpointsTest, IntersectionsShowWhoHoldsTheGrant) {
   for (const auto& x : idle["intersections"]) {
     EXPECT_FALSE(x["inner"].empty());
     EXPECT_FALSE(x["approach"].empty());
-    EXPECT_TRUE(x["holders"].empty());
-    EXPECT_TRUE(x["waiting"].empty());
+    EXPECT_TRUE(x["holder_ids"].empty());
+    EXPECT_TRUE(x["waiting_ids"].empty());
   }
   FakeRobot robot(ChannelTo(*server_), "R7");
   robot.Connect(kParkX, kParkY);
@@ -151,21 +151,21 @@ TEST_F(OperatorEndpointsTest, IntersectionsShowWhoHoldsTheGrant) {
   const auto deadline = std::chrono::steady_clock::now() + kTimeout;
   for (bool seen = false; !seen && std::chrono::steady_clock::now() < deadline;) {
     held = GetJson("/api/v1/intersections");
-    for (const auto& x : held["intersections"]) seen = seen || (x["id"] == grant->intersection_name() && !x["holders"].empty());
+    for (const auto& x : held["intersections"]) seen = seen || (x["id"] == grant->intersection_name() && !x["holder_ids"].empty());
   }
   int holders = 0;
   for (const auto& x : held["intersections"]) {
     if (x["id"] == grant->intersection_name()) {
-      EXPECT_EQ(x["holders"], json::array({"R7"})) << x.dump();
+      EXPECT_EQ(x["holder_ids"], json::array({"R7"})) << x.dump();
     }
-    holders += static_cast<int>(x["holders"].size());
+    holders += static_cast<int>(x["holder_ids"].size());
   }
   EXPECT_EQ(holders, 1);
   // ?active=1: only the intersection R7 holds (the others are idle), the same entry.
   const json active = GetJson("/api/v1/intersections?active=1");
   ASSERT_EQ(active["intersections"].size(), 1u) << active.dump();
   EXPECT_EQ(active["intersections"][0]["id"], grant->intersection_name());
-  EXPECT_EQ(active["intersections"][0]["holders"], json::array({"R7"}));
+  EXPECT_EQ(active["intersections"][0]["holder_ids"], json::array({"R7"}));
   EXPECT_EQ(GetJson("/api/v1/intersections?active=0")["intersections"].size(),
             server_->dispatcher().map().intersections().size());
   auto bad = client_->Get("/api/v1/intersections?active=maybe");
@@ -182,9 +182,10 @@ TEST_F(OperatorEndpointsTest, OrderDetailHasEachRobotsRemainingRoute) {
   ASSERT_GT(plan.waypoints_size(), 2);
   const json order = GetJson("/api/v1/orders/" + id);
   ASSERT_TRUE(order["routes"].contains("R7")) << order.dump();
-  const json& route = order["routes"]["R7"];
+  const json& route = order["routes"]["R7"]["waypoints"];
   ASSERT_FALSE(route.empty());
-  EXPECT_EQ(route.back()["action"], "drop");
+  EXPECT_EQ(route.back()["action"], "WAYPOINT_ACTION_DROP");
+  EXPECT_EQ(order["order"]["id"], id);
   EXPECT_TRUE(order["allocation"].is_object());
   std::size_t released = 0;
   for (const auto& w : route) released += w["released"].get<bool>() ? 1 : 0;
@@ -193,10 +194,10 @@ TEST_F(OperatorEndpointsTest, OrderDetailHasEachRobotsRemainingRoute) {
   for (const auto& w : route) {
     bool found = false;
     for (const auto& p : plan.waypoints()) {
-      if (p.sequence() == w["seq"].get<std::uint64_t>()) {
+      if (std::to_string(p.sequence()) == w["sequence"].get<std::string>()) {  // uint64: a string
         found = true;
-        EXPECT_DOUBLE_EQ(p.x(), w["x"].get<double>());
-        EXPECT_DOUBLE_EQ(p.y(), w["y"].get<double>());
+        EXPECT_DOUBLE_EQ(p.x(), w["position"]["x"].get<double>());
+        EXPECT_DOUBLE_EQ(p.y(), w["position"]["y"].get<double>());
       }
     }
     EXPECT_TRUE(found) << w.dump();
@@ -280,7 +281,7 @@ TEST_F(OperatorEndpointsTest, WebRootServesThePageFromAFolder) {
   auto missing = client_->Get("/app-that-is-not-there.js");
   ASSERT_TRUE(missing);
   EXPECT_EQ(missing->status, 404);
-  EXPECT_EQ(GetJson("/api/v1/status")["map"], "chu2024");  // the API is still there
+  EXPECT_EQ(GetJson("/api/v1/status")["map_name"], "chu2024");  // the API is still there
 
   ServerConfig bad = TestConfig(dir_.File("ops3.db"));
   bad.web_root = dir_.File("no-such-folder");

@@ -2,8 +2,12 @@
 // httplib.h comes after every header that pulls in Eigen (see STYLE.md on `_res`).
 #include "tests/server/test_support.h"
 
+#include <google/protobuf/util/json_util.h>
+#include <google/protobuf/util/message_differencer.h>
 #include <httplib.h>
 #include <nlohmann/json.hpp>
+
+#include "warehouse/dispatch/v1/operator.pb.h"
 
 namespace dispatch::server::testing {
 namespace {
@@ -43,58 +47,103 @@ TEST_F(RestApiTest, HealthReadyAndStatus) {
   auto status = client_->Get("/api/v1/status");
   ASSERT_TRUE(status);
   const json s = Body(status);
-  EXPECT_EQ(s["map"], "chu2024");
+  EXPECT_EQ(s["map_name"], "chu2024");
   EXPECT_EQ(s["strategy"], "auction");
   EXPECT_EQ(s["orders"]["accepted"], 0);
+  EXPECT_EQ(s["traffic"]["grants"], "0");  // uint64: a string in proto3 JSON
+  EXPECT_FALSE(s["traffic"].contains("min_robot_distance"));  // no two robots seen yet
+}
+
+// Issue 15 §2: a REST body is the proto message's JSON mapping: what POST answers parses as a
+// SubmitOrderResponse and equals what gRPC GetOrder returns for the same order.
+TEST_F(RestApiTest, RestBodiesAreTheProtoMessagesJson) {
+  auto created = client_->Post("/api/v1/orders",
+                               R"({"client_order_id": "same-1", "picks": [{"point_name": "K3-2-3N"}],
+                                   "drop": {"point_name": "D-B2"}, "priority": 2, "release_time": 30})",
+                               "application/json");
+  ASSERT_TRUE(created);
+  ASSERT_EQ(created->status, 201) << created->body;
+  pb::SubmitOrderResponse rest;
+  ASSERT_TRUE(google::protobuf::util::JsonStringToMessage(created->body, &rest).ok()) << created->body;
+  EXPECT_TRUE(rest.created());
+  auto stub = pb::OrderService::NewStub(ChannelTo(*server_));
+  grpc::ClientContext ctx;
+  pb::GetOrderRequest get;
+  get.set_client_order_id("same-1");
+  pb::Order grpc_order;
+  ASSERT_TRUE(stub->GetOrder(WithDeadline(ctx), get, &grpc_order).ok());
+  EXPECT_TRUE(google::protobuf::util::MessageDifferencer::Equals(rest.order(), grpc_order))
+      << "REST: " << rest.order().DebugString() << "gRPC: " << grpc_order.DebugString();
+  EXPECT_EQ(grpc_order.priority(), 2);
+  EXPECT_EQ(grpc_order.release_time(), 30.0);
+  // The detail and the list carry the same Order.
+  pb::OrderDetail detail;
+  auto one = client_->Get("/api/v1/orders/" + grpc_order.id());
+  ASSERT_TRUE(one);
+  ASSERT_TRUE(google::protobuf::util::JsonStringToMessage(one->body, &detail).ok()) << one->body;
+  EXPECT_TRUE(google::protobuf::util::MessageDifferencer::Equals(detail.order(), grpc_order));
+  pb::OrderList list;
+  auto all = client_->Get("/api/v1/orders");
+  ASSERT_TRUE(all);
+  ASSERT_TRUE(google::protobuf::util::JsonStringToMessage(all->body, &list).ok()) << all->body;
+  ASSERT_EQ(list.orders_size(), 1);
+  EXPECT_TRUE(google::protobuf::util::MessageDifferencer::Equals(list.orders(0), grpc_order));
 }
 
 TEST_F(RestApiTest, OrdersThroughJson) {
-  const std::string order = R"({"client_order_id": "rest-1", "picks": ["K3-2-3N"], "drop": "D-B2"})";
+  const std::string order =
+      R"({"client_order_id": "rest-1", "picks": [{"point_name": "K3-2-3N"}], "drop": {"point_name": "D-B2"}})";
   auto created = client_->Post("/api/v1/orders", order, "application/json");
   ASSERT_TRUE(created);
   EXPECT_EQ(created->status, 201) << created->body;
-  const json c = Body(created);
+  const json c = Body(created)["order"];
   const std::string id = c["id"];
-  EXPECT_EQ(c["client_id"], "rest-1");
-  EXPECT_EQ(c["state"], "accepted");
-  EXPECT_TRUE(c["robots"].is_array());
+  EXPECT_EQ(c["client_order_id"], "rest-1");
+  EXPECT_EQ(c["state"], "ORDER_STATE_ACCEPTED");
+  EXPECT_TRUE(c["robot_ids"].is_array());
+  EXPECT_FALSE(c.contains("finished_time"));  // absent while open
 
   auto repeat = client_->Post("/api/v1/orders", order, "application/json");
   ASSERT_TRUE(repeat);
   EXPECT_EQ(repeat->status, 200);
-  EXPECT_EQ(Body(repeat)["id"], id);
+  EXPECT_EQ(Body(repeat)["order"]["id"], id);
   EXPECT_FALSE(Body(repeat)["created"].get<bool>());
 
-  auto conflict = client_->Post("/api/v1/orders",
-                                R"({"client_order_id": "rest-1", "picks": ["K3-2-3N"], "drop": "D-B1"})",
-                                "application/json");
+  auto conflict = client_->Post(
+      "/api/v1/orders",
+      R"({"client_order_id": "rest-1", "picks": [{"point_name": "K3-2-3N"}], "drop": {"point_name": "D-B1"}})",
+      "application/json");
   ASSERT_TRUE(conflict);
   EXPECT_EQ(conflict->status, 409);
   EXPECT_NE(Body(conflict)["error"].get<std::string>().find(id), std::string::npos);
 
-  auto coords = client_->Post(
-      "/api/v1/orders", R"({"client_order_id": "rest-2", "picks": [{"x": 4, "y": 5}], "drop": "D-B1"})",
-      "application/json");
+  auto coords = client_->Post("/api/v1/orders",
+                              R"({"client_order_id": "rest-2", "picks": [{"position": {"x": 4, "y": 5}}],
+                                  "drop": {"point_name": "D-B1"}})",
+                              "application/json");
   ASSERT_TRUE(coords);
   EXPECT_EQ(coords->status, 201) << coords->body;
-  EXPECT_EQ(Body(coords)["picks"][0]["name"], "K1-1-1N");
+  EXPECT_EQ(Body(coords)["order"]["picks"][0]["point_name"], "K1-1-1N");
 
   auto list = client_->Get("/api/v1/orders");
   ASSERT_TRUE(list);
   const json l = Body(list);
   ASSERT_EQ(l["orders"].size(), 2u);
   EXPECT_EQ(l["orders"][0]["id"], id);
-  EXPECT_EQ(l["orders"][0]["state"], "accepted");
+  EXPECT_EQ(l["orders"][0]["state"], "ORDER_STATE_ACCEPTED");
 
   auto one = client_->Get("/api/v1/orders/" + id);
   ASSERT_TRUE(one);
   EXPECT_EQ(one->status, 200);
-  EXPECT_TRUE(Body(one).contains("allocation"));
+  EXPECT_EQ(Body(one)["order"]["id"], id);
+  EXPECT_FALSE(Body(one).contains("allocation"));  // not allocated (no robots)
+  EXPECT_TRUE(Body(one)["routes"].empty());
 
   auto cancelled = client_->Delete("/api/v1/orders/" + id);
   ASSERT_TRUE(cancelled);
   EXPECT_EQ(cancelled->status, 200);
-  EXPECT_EQ(Body(cancelled)["state"], "cancelled");
+  EXPECT_EQ(Body(cancelled)["state"], "ORDER_STATE_CANCELLED");
+  EXPECT_TRUE(Body(cancelled).contains("finished_time"));
 
   auto filtered = client_->Get("/api/v1/orders?state=cancelled");
   ASSERT_TRUE(filtered);
@@ -103,6 +152,10 @@ TEST_F(RestApiTest, OrdersThroughJson) {
   auto accepted = client_->Get("/api/v1/orders?state=accepted");
   ASSERT_TRUE(accepted);
   EXPECT_EQ(Body(accepted)["orders"].size(), 1u);
+  auto by_enum = client_->Get("/api/v1/orders?state=ORDER_STATE_ACCEPTED");  // the enum's name too
+  ASSERT_TRUE(by_enum);
+  ASSERT_EQ(Body(by_enum)["orders"].size(), 1u);
+  EXPECT_EQ(Body(by_enum)["orders"][0]["client_order_id"], "rest-2");
 }
 
 TEST_F(RestApiTest, TheOrderListKeepsOpenOrdersAndOnlyTheNewestFinishedOnes) {
@@ -112,11 +165,11 @@ TEST_F(RestApiTest, TheOrderListKeepsOpenOrdersAndOnlyTheNewestFinishedOnes) {
   for (int i = 0; i < 5; ++i) {
     auto created = client_->Post("/api/v1/orders",
                                  R"({"client_order_id": "f-)" + std::to_string(i) +
-                                     R"(", "picks": ["K3-2-3N"], "drop": "D-B2"})",
+                                     R"(", "picks": [{"point_name": "K3-2-3N"}], "drop": {"point_name": "D-B2"}})",
                                  "application/json");
     ASSERT_TRUE(created);
     ASSERT_EQ(created->status, 201) << created->body;
-    ids.push_back(Body(created)["id"]);
+    ids.push_back(Body(created)["order"]["id"]);
   }
   for (int i = 0; i < 4; ++i) ASSERT_EQ(client_->Delete("/api/v1/orders/" + ids[static_cast<std::size_t>(i)])->status, 200);
   auto two = client_->Get("/api/v1/orders?finished=2");
@@ -127,7 +180,7 @@ TEST_F(RestApiTest, TheOrderListKeepsOpenOrdersAndOnlyTheNewestFinishedOnes) {
   EXPECT_EQ(l["orders"][0]["id"], ids[2]);  // in submission order
   EXPECT_EQ(l["orders"][1]["id"], ids[3]);
   EXPECT_EQ(l["orders"][2]["id"], ids[4]);
-  EXPECT_EQ(l["orders"][2]["state"], "accepted");
+  EXPECT_EQ(l["orders"][2]["state"], "ORDER_STATE_ACCEPTED");
   const json none = Body(client_->Get("/api/v1/orders?finished=0"));
   ASSERT_EQ(none["orders"].size(), 1u);
   EXPECT_EQ(none["finished_total"], 4);
@@ -148,17 +201,17 @@ TEST_F(RestApiTest, ErrorsAreJsonWithAReason) {
   };
   std::vector<Case> cases;
   cases.push_back({client_->Post("/api/v1/orders", "{not json", "application/json"), 400});
-  cases.push_back({client_->Post("/api/v1/orders", R"({"client_order_id": "x", "picks": ["NOPE"], "drop": "D-B1"})",
+  const std::string stops = R"("picks": [{"point_name": "K3-2-3N"}], "drop": {"point_name": "D-B1"})";
+  cases.push_back({client_->Post("/api/v1/orders",
+                                 R"({"client_order_id": "x", "picks": [{"point_name": "NOPE"}], "drop": {"point_name": "D-B1"}})",
                                  "application/json"),
                    400});
-  cases.push_back({client_->Post("/api/v1/orders", R"({"picks": ["K3-2-3N"], "drop": "D-B1"})", "application/json"), 400});
+  cases.push_back({client_->Post("/api/v1/orders", "{" + stops + "}", "application/json"), 400});
   // A misspelt field is named, not dropped (the order would have been released at once).
-  cases.push_back({client_->Post("/api/v1/orders",
-                                 R"({"client_order_id": "y", "picks": ["K3-2-3N"], "drop": "D-B1", "relase_time": 60})",
+  cases.push_back({client_->Post("/api/v1/orders", R"({"client_order_id": "y", "relase_time": 60, )" + stops + "}",
                                  "application/json"),
                    400});
-  cases.push_back({client_->Post("/api/v1/orders",
-                                 R"({"client_order_id": "z", "picks": ["K3-2-3N"], "drop": "D-B1", "release_time": 1e300})",
+  cases.push_back({client_->Post("/api/v1/orders", R"({"client_order_id": "z", "release_time": 1e300, )" + stops + "}",
                                  "application/json"),
                    400});
   cases.push_back({client_->Get("/api/v1/orders/ord-424242"), 404});
@@ -192,7 +245,9 @@ TEST_F(RestApiTest, RobotsAppearWhenTheyConnect) {
   const json r = Body(got);
   EXPECT_EQ(r["id"], "R7");
   EXPECT_TRUE(r["connected"].get<bool>());
-  EXPECT_EQ(r["point"]["name"], "park-P1");
+  EXPECT_EQ(r["point"]["point_name"], "park-P1");
+  EXPECT_EQ(r["state"], "ROBOT_STATE_IDLE");
+  EXPECT_EQ(r["pose"]["x"], 3.875);
   auto all = client_->Get("/api/v1/robots");
   ASSERT_TRUE(all);
   EXPECT_EQ(Body(all)["robots"].size(), 1u);
