@@ -6,7 +6,8 @@
 # finished so far, then restarts dispatchd on the same database and runs 3 batches more.
 # A flat line is the target: memory must not grow with the number of orders ever served.
 # Not part of the test suite (minutes of wall time). Environment: BATCHES (default 20),
-# BIN (default build-release, built when missing), POLL (default 1: poll GET /api/v1/orders).
+# BIN (default build-release, built when missing), POLL (default 1: poll GET /api/v1/orders),
+# RETAINED (default 1000: dispatchd --finished-retained, the finished orders kept in memory).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bin=${BIN:-build-release}
@@ -15,6 +16,7 @@ if [ ! -x "$bin/server/dispatchd" ]; then
 fi
 batches=${BATCHES:-20}
 poll=${POLL:-1}
+retained=${RETAINED:-1000}
 run=$(mktemp -d /tmp/dispatch-soak.XXXXXX)
 scenarios=$(cd .. && pwd)/shared/scenarios
 {
@@ -34,7 +36,7 @@ trap stop_all EXIT
 start_server() {  # start_server GRPC_PORT HTTP_PORT: sets grpc, http, server_pid
   rm -f "$run/ports.json"
   "$bin/server/dispatchd" --bind 127.0.0.1 --grpc-port "$1" --http-port "$2" --db "$run/dispatch.db" \
-    --map chu2024 --time-scale 10 --log-level warn --ports-file "$run/ports.json" >>"$run/dispatchd.log" 2>&1 &
+    --map chu2024 --time-scale 10 --finished-retained "$retained" --log-level warn --ports-file "$run/ports.json" >>"$run/dispatchd.log" 2>&1 &
   server_pid=$!
   for _ in $(seq 300); do [ -s "$run/ports.json" ] && break; sleep 0.1; done
   [ -s "$run/ports.json" ] || { echo "soak: dispatchd did not start" >&2; cat "$run/dispatchd.log" >&2; exit 1; }

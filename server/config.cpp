@@ -50,6 +50,7 @@ std::vector<Key> Keys() {
       MakeKey("t_w2", &ServerConfig::t_w2),
       MakeKey("blocked_after", &ServerConfig::blocked_after),
       MakeKey("route_cache_mb", &ServerConfig::route_cache_mb),
+      MakeKey("finished_retained", &ServerConfig::finished_retained),
       MakeKey("web_root", &ServerConfig::web_root),
       MakeKey("ports_file", &ServerConfig::ports_file),
       MakeKey("ready_fd", &ServerConfig::ready_fd),
@@ -119,6 +120,7 @@ engine::Status ValidateServerConfig(const ServerConfig& c) {
     if (!positive(v)) return InvalidArgument(std::string(name) + " must be > 0 seconds");
   }
   if (c.route_cache_mb < 1) return InvalidArgument("route_cache_mb must be >= 1");
+  if (c.finished_retained < 0) return InvalidArgument("finished_retained must be >= 0");
   if (!c.web_root.empty() && !std::filesystem::is_directory(c.web_root)) {
     return InvalidArgument("web_root '" + c.web_root + "' is not a folder");
   }
@@ -159,6 +161,9 @@ engine::Result<ParsedCommandLine> ParseCommandLine(int argc, char** argv) {
       ->capture_default_str();
   app.add_option("--route-cache-mb", flags.route_cache_mb,
                  "Lazy route table cache bound, MiB (large grid floors)")->capture_default_str();
+  app.add_option("--finished-retained", flags.finished_retained,
+                 "Finished orders kept in memory (the newest); older ones are read from the database")
+      ->capture_default_str();
   app.add_option("--web-root", flags.web_root,
                  "Serve the web map from this folder instead of the built-in copy");
   app.add_option("--ports-file", flags.ports_file, "Write the chosen ports as JSON here");

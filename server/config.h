@@ -34,6 +34,9 @@ struct ServerConfig {
   // all-pairs table does not fit), MiB. It should hold the destinations in use at once (every
   // robot's next stop): on a 38k-cell floor one destination takes 0.46 MB.
   int route_cache_mb = 1024;
+  // Finished orders (completed, cancelled, failed) kept in memory beyond the open ones: the
+  // newest this many; older ones are read from the database when asked for (issue 15 §3b).
+  int finished_retained = 1000;
   // Serve the web map's files from this folder instead of the copy built into the binary
   // ("" = built-in; for working on the page without rebuilding).
   std::string web_root;

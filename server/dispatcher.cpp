@@ -1,4 +1,5 @@
-// Dispatcher: loop, recovery, snapshots and the order commands. Allocation and plans are in
+// Dispatcher: loop, recovery and snapshots. The order book and the order commands are in
+// dispatcher_orders.cpp, allocation in dispatcher_allocation.cpp, plans in
 // dispatcher_plans.cpp, robot streams in dispatcher_robots.cpp.
 #include "server/dispatcher.h"
 
@@ -7,7 +8,6 @@
 #include <algorithm>
 #include <cmath>
 
-#include "engine/dispatch/order_intake.h"
 #include "engine/dispatch/strategy.h"
 #include "server/json_convert.h"
 
@@ -80,7 +80,15 @@ Dispatcher::~Dispatcher() {
 }
 
 engine::Status Dispatcher::Recover() {
-  // Orders, in submission order.
+  // Orders, in submission order. The finished ones are sorted by finish time (they load in
+  // submission order) and trimmed to the newest finished_retained after every page, so a long
+  // history never passes through memory whole.
+  auto keep_newest = [this](std::size_t slack) {
+    std::stable_sort(finished_.begin(), finished_.end(), [this](const std::string& a, const std::string& b) {
+      return Find(a)->finished_time.value_or(0.0) < Find(b)->finished_time.value_or(0.0);
+    });
+    Retire(slack);
+  };
   storage::OrderQuery query;
   query.page_size = storage::kMaxPageSize;
   for (;;) {
@@ -89,7 +97,6 @@ engine::Status Dispatcher::Recover() {
     for (const auto& record : page->orders) {
       auto view = std::make_shared<OrderView>();
       view->record = record;
-      view->position = static_cast<std::int64_t>(orders_.size()) + 1;
       if (engine::IsTerminal(record.order.state)) view->finished_time = record.updated_time;
       time_base_ = std::max({time_base_, record.updated_time, record.order.created_time});
       const std::string& id = record.order.id;
@@ -100,7 +107,9 @@ engine::Status Dispatcher::Recover() {
     }
     if (page->next_page_token.empty()) break;
     query.page_token = page->next_page_token;
+    keep_newest(storage::kMaxPageSize);
   }
+  keep_newest(0);
   // Allocation explanations from the journal (the latest per order wins).
   storage::EventQuery events;
   events.limit = 1000;
@@ -145,8 +154,10 @@ engine::Status Dispatcher::Recover() {
     it->second.assignment = a;
     it->second.has_assignment = true;
   }
-  spdlog::info("recovered {} orders, {} robots, {} assignments; dispatcher time {:.1f} s",
-               orders_.size(), robots_.size(), assignments->size(), time_base_);
+  std::uint64_t retired = 0;
+  for (const auto& [state, n] : finished_in_store_) retired += n;
+  spdlog::info("recovered {} orders ({} finished ones left in the store), {} robots, {} assignments; "
+               "dispatcher time {:.1f} s", orders_.size(), retired, robots_.size(), assignments->size(), time_base_);
   if (!awaiting_reconnect_.empty()) {
     spdlog::info("traffic control waits up to {:.1f} s for the {} robots that were on line to report",
                  options_.heartbeat_timeout, awaiting_reconnect_.size());
@@ -257,6 +268,7 @@ void Dispatcher::Flush() {
   // it in the snapshot. Changes nobody is told about yet (robot reports, grants) are
   // published at most every kPublishEvery: a snapshot copies every robot and order, and 500
   // robots reporting at 10 Hz make hundreds of batches a second.
+  Retire(std::min(kRetireSlack, options_.finished_retained / 16));  // small retentions trim exactly
   if (dirty_ && (deferred_need_publish_ || Clock::now() - last_publish_ >= kPublishEvery)) Publish();
   deferred_need_publish_ = false;
   std::vector<std::function<void()>> effects;
@@ -273,8 +285,10 @@ void Dispatcher::Publish() {
   snap->strategy = options_.strategy;
   snap->time_scale = options_.time_scale;
   snap->orders = orders_;
-  if (!published_index_ || published_index_->by_id.size() != by_id_.size()) {
+  snap->finished_in_store = finished_in_store_;
+  if (!published_index_ || published_generation_ != book_generation_) {
     published_index_ = std::make_shared<const Snapshot::OrderIndex>(Snapshot::OrderIndex{by_id_, by_client_id_});
+    published_generation_ = book_generation_;
   }
   snap->index = published_index_;
   for (const auto& [id, r] : robots_) {
@@ -345,24 +359,6 @@ std::vector<ZoneView> Dispatcher::ZoneViews(const std::map<std::string, RobotVie
   return out;
 }
 
-std::shared_ptr<const OrderView> Dispatcher::Find(const std::string& order_id) const {
-  auto it = by_id_.find(order_id);
-  return it == by_id_.end() ? nullptr : orders_[it->second];
-}
-
-void Dispatcher::Put(std::shared_ptr<OrderView> view) {
-  const std::string id = view->record.order.id;
-  auto it = by_id_.find(id);
-  if (it == by_id_.end()) {
-    by_id_.emplace(id, orders_.size());
-    by_client_id_.emplace(view->record.order.client_id, orders_.size());
-    orders_.push_back(std::move(view));
-  } else {
-    orders_[it->second] = std::move(view);
-  }
-  dirty_ = true;
-}
-
 void Dispatcher::Journal(const storage::OrderEvent& event) {
   Defer([this, event] { hub_.Publish(event); });
 }
@@ -376,124 +372,6 @@ void Dispatcher::CloseLink(const std::shared_ptr<RobotLink>& link, ServiceStatus
   // After the publish: a robot (or test) that sees its stream end finds what it sent before
   // the end in the snapshot. Rare, so it costs nothing.
   Defer([link, status = std::move(status)] { link->Close(status); });
-}
-
-std::string Dispatcher::NextOrderId() {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "ord-%06lld", static_cast<long long>(last_order_number_ + 1));
-  return buf;
-}
-
-// --- Orders --------------------------------------------------------------------------------
-
-void Dispatcher::SubmitOrder(engine::OrderRequest request, std::function<void(SubmitReply)> done) {
-  // The route searches towards the order's stops run first, on the route worker: the loop's
-  // reachability check and the auction then find them cached.
-  auto shared = std::make_shared<const engine::OrderRequest>(std::move(request));
-  route_worker_->Run([this, shared, done = std::move(done)](bool cancelled) {
-    if (!cancelled) {
-      for (const engine::PointId p : engine::StopsOf(*map_, *shared, options_.snap)) routes_->Prepare(p);
-    }
-    Post([this, shared, done] {
-      DoSubmit(*shared, [this, done](SubmitReply reply) {
-        Defer([done, reply = std::move(reply)]() mutable { done(std::move(reply)); });
-      });
-    });
-  });
-}
-
-void Dispatcher::CancelOrder(std::string order_id, std::string reason,
-                             std::function<void(OrderReply)> done) {
-  Post([this, order_id = std::move(order_id), reason = std::move(reason), done = std::move(done)] {
-    DoCancel(order_id, reason, [this, done](OrderReply reply) {
-      Defer([done, reply = std::move(reply)]() mutable { done(std::move(reply)); });
-    });
-  });
-}
-
-void Dispatcher::DoSubmit(const engine::OrderRequest& request,
-                          const std::function<void(SubmitReply)>& done) {
-  SubmitReply reply;
-  engine::OrderRequest req = request;
-  req.created_time = Now();
-  auto admitted = engine::AdmitOrder(*map_, *routes_, req, options_.snap, NextOrderId());
-  if (!admitted.ok()) {
-    reply.status = FromEngineError(admitted.error());
-    return done(std::move(reply));
-  }
-  engine::Order order = std::move(admitted).value();
-  if (auto it = by_client_id_.find(order.client_id); it != by_client_id_.end()) {
-    const auto& existing = orders_[it->second];
-    if (storage::OrderContentHash(order) == existing->record.content_hash) {
-      reply.order = existing;
-      reply.created = false;
-      return done(std::move(reply));
-    }
-    reply.status = MakeStatus(
-        StatusCode::kAlreadyExists,
-        "client_order_id '" + order.client_id + "' already names order " +
-            existing->record.order.id + " with different content; this submission (picks, drop, "
-            "formation, priority, work time or release time) differs from it");
-    return done(std::move(reply));
-  }
-  auto inserted = store_.InsertOrder(order);
-  if (!inserted.ok()) {
-    reply.status = inserted.error().code == engine::ErrorCode::kFailedPrecondition
-                       ? MakeStatus(StatusCode::kAlreadyExists, inserted.error().message)
-                       : FromEngineError(inserted.error());
-    if (reply.status.code == StatusCode::kUnavailable) {
-      reply.status.message = "order '" + order.client_id + "' was NOT accepted: " + reply.status.message;
-    }
-    spdlog::warn("submit {}: {}", order.client_id, reply.status.message);
-    return done(std::move(reply));
-  }
-  ++last_order_number_;
-  auto view = std::make_shared<OrderView>();
-  view->record = inserted->record;
-  view->position = static_cast<std::int64_t>(orders_.size()) + 1;
-  Put(view);
-  reply.order = view;
-  reply.created = inserted->created;
-  done(std::move(reply));
-  storage::EventQuery first;
-  first.order_id = order.id;
-  first.limit = 1;
-  if (auto events = store_.ListEvents(first); events.ok() && !events->empty()) {
-    Journal(events->front());
-  }
-  spdlog::info("order {} ({}) accepted", order.id, order.client_id);
-  allocation_due_ = true;
-}
-
-void Dispatcher::DoCancel(const std::string& order_id, const std::string& reason,
-                          const std::function<void(OrderReply)>& done) {
-  OrderReply reply;
-  auto view = Find(order_id);
-  if (!view) {
-    reply.status = MakeStatus(StatusCode::kNotFound, "no order with id '" + order_id + "'");
-    return done(std::move(reply));
-  }
-  const engine::OrderState state = view->record.order.state;
-  if (state == engine::OrderState::kCancelled) {
-    reply.order = view;
-    return done(std::move(reply));
-  }
-  if (engine::IsTerminal(state)) {
-    reply.status = MakeStatus(StatusCode::kFailedPrecondition,
-                              "order " + order_id + " is already " +
-                                  engine::OrderStateName(state) + "; only open orders can be cancelled");
-    return done(std::move(reply));
-  }
-  ServiceStatus status;
-  const std::string why = reason.empty() ? "cancelled by client" : reason;
-  if (!ReleaseOrders({order_id}, [](const OrderView&) { return engine::OrderState::kCancelled; },
-                     why, &status)) {
-    reply.status = status;
-    return done(std::move(reply));
-  }
-  reply.order = Find(order_id);
-  done(std::move(reply));
-  allocation_due_ = true;
 }
 
 }  // namespace dispatch::server

@@ -66,6 +66,7 @@
 #include <string>
 #include <thread>
 #include <unordered_map>
+#include <unordered_set>
 #include <vector>
 
 #include "engine/dispatch/allocation_round.h"
@@ -93,6 +94,9 @@ struct DispatcherOptions {
   double offline_grace = 10.0;       // wall seconds
   engine::SnapOptions snap;          // order stops
   double robot_snap_tolerance = 1.0;  // metres from a Hello pose to its nearest point
+  // Finished orders kept in memory (the newest by finish time) besides every open one; the
+  // others are read from the store when asked for (FindAnywhere, ListOrders).
+  std::size_t finished_retained = 1000;
   std::string map_version;
   // Traffic control (engine/traffic/traffic_gate.h): waypoints released point by point
   // through the engine's TrafficController. Off: every waypoint is sent released (no grants or holds).
@@ -161,6 +165,12 @@ class Dispatcher {
   std::vector<std::pair<std::string, std::string>> TrafficLines() const;
   // Loop thread only: the waypoints of `order_id` its robots have not reached yet.
   OrderRoutes RoutesOf(const std::string& order_id) const;
+  // Any thread: the order with server id (or, by_client_id, client order id) `key`: from the
+  // snapshot, else from the store (a finished order beyond DispatcherOptions::finished_retained;
+  // with `explain` its allocation explanation is read from the journal). nullptr when there is
+  // no such order; an error when the store cannot be read.
+  engine::Result<std::shared_ptr<const OrderView>> FindAnywhere(const std::string& key, bool by_client_id,
+                                                                bool explain) const;
 
   // Runs `fn` on the loop thread.
   void Post(std::function<void()> fn);
@@ -200,7 +210,12 @@ class Dispatcher {
   void DoCancel(const std::string& order_id, const std::string& reason,
                 const std::function<void(OrderReply)>& done);
   std::shared_ptr<const OrderView> Find(const std::string& order_id) const;
-  void Put(std::shared_ptr<OrderView> view);  // replaces (or adds) an order in the book
+  // Replaces (or adds, numbering its position) an order in the book; a finished one joins the
+  // finished list that Retire trims.
+  void Put(std::shared_ptr<OrderView> view);
+  // Once more than finished_retained + slack finished orders are in memory, the oldest
+  // finished ones leave it (they stay in the store) down to finished_retained.
+  void Retire(std::size_t slack);
   // Publishes a committed journal event to the watchers (deferred, see Defer).
   void Journal(const storage::OrderEvent& event);
   // Runs `effect` at the end of this batch; with `after_publish` only once the snapshot
@@ -318,9 +333,15 @@ class Dispatcher {
   std::unique_ptr<engine::TrafficGate> gate_;  // null when traffic control is off
   Clock::time_point wall_start_;
   double time_base_ = 0.0;  // dispatcher seconds at wall_start_
+  // The book: every open order and the newest finished ones, by position (submission order).
   std::vector<std::shared_ptr<const OrderView>> orders_;
   std::unordered_map<std::string, std::size_t> by_id_;
   std::unordered_map<std::string, std::size_t> by_client_id_;
+  std::int64_t last_position_ = 0;
+  std::deque<std::string> finished_;  // the finished orders in memory, in finish order
+  std::map<engine::OrderState, std::uint64_t> finished_in_store_;  // retired, by state
+  std::uint64_t book_generation_ = 0;  // changes when orders join or leave the book
+  std::uint64_t published_generation_ = 0;
   std::shared_ptr<const Snapshot::OrderIndex> published_index_;  // copy of the two maps above
   std::map<std::string, RobotRuntime> robots_;
   std::unordered_map<const RobotLink*, std::string> link_robot_;
@@ -330,6 +351,9 @@ class Dispatcher {
   std::vector<std::function<void()>> deferred_;  // effects of the current batch
   bool deferred_need_publish_ = false;            // one of them waits for the snapshot
   static constexpr std::chrono::milliseconds kPublishEvery{20};
+  // Finished orders beyond finished_retained before Retire trims (one rebuild of the book's
+  // indexes per this many finishes, not one per finish).
+  static constexpr std::size_t kRetireSlack = 64;
   Clock::time_point last_publish_{};
   bool retry_allocation_ = false;
   bool allocation_due_ = false;  // an allocation round runs at the end of this batch

@@ -244,6 +244,8 @@ void Dispatcher::DoTaskEvent(RobotRuntime& r, const engine::TaskReport& m) {
   const bool trimmed = drop.trimmed;
   const bool complete = drop.complete;
   const double now = Now();
+  auto driven = order_distance_.find(m.order_id);
+  const double distance = driven != order_distance_.end() ? driven->second : 0.0;
   std::optional<storage::OrderEvent> event;
   auto committed = store_.RunInTransaction([&](storage::Store& s) -> engine::Status {
     if (trimmed) {
@@ -256,6 +258,7 @@ void Dispatcher::DoTaskEvent(RobotRuntime& r, const engine::TaskReport& m) {
       t.to = engine::OrderState::kCompleted;
       t.time = now;
       t.detail = robot + " dropped at " + where;
+      t.distance = distance;
       auto e = s.TransitionOrder(t);
       if (!e.ok()) return e.error();
       event = *e;
@@ -281,11 +284,8 @@ void Dispatcher::DoTaskEvent(RobotRuntime& r, const engine::TaskReport& m) {
     copy->record.order.state = engine::OrderState::kCompleted;
     copy->record.updated_time = now;
     copy->finished_time = now;
-    auto driven = order_distance_.find(m.order_id);
-    if (driven != order_distance_.end()) {
-      copy->distance = driven->second;
-      order_distance_.erase(driven);
-    }
+    copy->record.distance = distance;
+    order_distance_.erase(m.order_id);
   }
   Put(copy);
   if (event) Journal(*event);

@@ -102,6 +102,7 @@ std::string ServiceMetrics::Render(const Snapshot& snap) {
     robots[engine::RobotStateName(s)] = 0;
   }
   for (const auto& o : snap.orders) orders[engine::OrderStateName(o->record.order.state)] += 1;
+  for (const auto& [state, n] : snap.finished_in_store) orders[engine::OrderStateName(state)] += static_cast<double>(n);
   double connected = 0;
   for (const auto& [id, r] : snap.robots) {
     robots[engine::RobotStateName(r.connected ? r.robot.state : engine::RobotState::kOffline)] += 1;

@@ -120,18 +120,6 @@ class WatchReactor final : public QueuedWriter<grpc::ServerWriteReactor<pb::Orde
 
 constexpr int kDefaultPageSize = 100;
 
-// The index in a page token "p<digits>" (as ListOrders issues them), or nothing.
-std::optional<std::size_t> PageTokenIndex(const std::string& token) {
-  if (token.size() < 2 || token.size() > 20 || token[0] != 'p') return std::nullopt;
-  if (token[1] == '0' && token.size() > 2) return std::nullopt;  // issued without leading zeros
-  std::size_t index = 0;
-  for (std::size_t i = 1; i < token.size(); ++i) {
-    if (token[i] < '0' || token[i] > '9') return std::nullopt;
-    index = index * 10 + static_cast<std::size_t>(token[i] - '0');
-  }
-  return index;
-}
-
 }  // namespace
 
 grpc::ServerUnaryReactor* OrderServiceImpl::SubmitOrder(grpc::CallbackServerContext* context,
@@ -166,23 +154,23 @@ grpc::ServerUnaryReactor* OrderServiceImpl::SubmitOrder(grpc::CallbackServerCont
 grpc::ServerUnaryReactor* OrderServiceImpl::GetOrder(grpc::CallbackServerContext* context,
                                                      const pb::GetOrderRequest* request,
                                                      pb::Order* response) {
-  auto snap = dispatcher_.snapshot();
-  std::shared_ptr<const OrderView> order;
+  engine::Result<std::shared_ptr<const OrderView>> order = std::shared_ptr<const OrderView>();
   std::string key;
   switch (request->key_case()) {
     case pb::GetOrderRequest::kOrderId:
-      order = snap->FindOrder(request->order_id());
+      order = dispatcher_.FindAnywhere(request->order_id(), false, false);
       key = "id '" + request->order_id() + "'";
       break;
     case pb::GetOrderRequest::kClientOrderId:
-      order = snap->FindClientOrder(request->client_order_id());
+      order = dispatcher_.FindAnywhere(request->client_order_id(), true, false);
       key = "client_order_id '" + request->client_order_id() + "'";
       break;
     case pb::GetOrderRequest::KEY_NOT_SET:
       return Done(context, {grpc::StatusCode::INVALID_ARGUMENT, "give order_id or client_order_id"});
   }
-  if (!order) return Done(context, {grpc::StatusCode::NOT_FOUND, "no order with " + key});
-  OrderToProto(*order, dispatcher_.map(), response);
+  if (!order.ok()) return Done(context, ToGrpcStatus(FromEngineError(order.error())));
+  if (!*order) return Done(context, {grpc::StatusCode::NOT_FOUND, "no order with " + key});
+  OrderToProto(**order, dispatcher_.map(), response);
   return Done(context, grpc::Status::OK);
 }
 
@@ -204,6 +192,9 @@ grpc::ServerUnaryReactor* OrderServiceImpl::CancelOrder(grpc::CallbackServerCont
 grpc::ServerUnaryReactor* OrderServiceImpl::ListOrders(grpc::CallbackServerContext* context,
                                                        const pb::ListOrdersRequest* request,
                                                        pb::ListOrdersResponse* response) {
+  // From the store: it holds every order (memory only the open ones and the newest
+  // finished), and it is written before the snapshot changes, so it is never behind it.
+  storage::OrderQuery query;
   std::set<engine::OrderState> states;
   for (int s : request->states()) {
     if (s == pb::ORDER_STATE_UNSPECIFIED) continue;  // "no filter" (common.proto)
@@ -212,34 +203,30 @@ grpc::ServerUnaryReactor* OrderServiceImpl::ListOrders(grpc::CallbackServerConte
       return Done(context, {grpc::StatusCode::INVALID_ARGUMENT,
                             "states: " + std::to_string(s) + " is not an OrderState"});
     }
-    states.insert(*state);
+    if (states.insert(*state).second) query.states.push_back(*state);
   }
   if (request->page_size() < 0) {
     return Done(context, {grpc::StatusCode::INVALID_ARGUMENT, "page_size must be >= 0"});
   }
-  const int page = request->page_size() == 0 ? kDefaultPageSize
-                                             : std::min(request->page_size(), storage::kMaxPageSize);
-  auto snap = dispatcher_.snapshot();
-  std::size_t after = 0;
-  if (!request->page_token().empty()) {
-    // Tokens are "p<index>" with the index of the next order, at most the current count
-    // (orders are never removed); anything else is not one this server issued.
-    auto index = PageTokenIndex(request->page_token());
-    if (!index || *index > snap->orders.size()) {
+  query.page_size = request->page_size() == 0 ? kDefaultPageSize
+                                              : std::min(request->page_size(), storage::kMaxPageSize);
+  query.page_token = request->page_token();
+  auto page = dispatcher_.store().ListOrders(query);
+  if (!page.ok()) {
+    if (page.error().code == engine::ErrorCode::kInvalidArgument) {
       return Done(context, {grpc::StatusCode::INVALID_ARGUMENT,
                             "page_token '" + request->page_token() + "' is not one this server issued"});
     }
-    after = *index;
+    return Done(context, ToGrpcStatus(FromEngineError(page.error())));
   }
-  for (std::size_t i = after; i < snap->orders.size(); ++i) {
-    const auto& view = *snap->orders[i];
-    if (!states.empty() && !states.count(view.record.order.state)) continue;
-    if (response->orders_size() == page) {
-      response->set_next_page_token("p" + std::to_string(i));
-      break;
-    }
+  OrderView view;
+  for (auto& record : page->orders) {
+    view.record = std::move(record);
+    view.finished_time.reset();
+    if (engine::IsTerminal(view.record.order.state)) view.finished_time = view.record.updated_time;
     OrderToProto(view, dispatcher_.map(), response->add_orders());
   }
+  response->set_next_page_token(page->next_page_token);
   return Done(context, grpc::Status::OK);
 }
 
@@ -253,11 +240,10 @@ class RefusedWatch final : public grpc::ServerWriteReactor<pb::OrderEvent> {
 grpc::ServerWriteReactor<pb::OrderEvent>* OrderServiceImpl::WatchOrders(
     grpc::CallbackServerContext* /*context*/, const pb::WatchOrdersRequest* request) {
   // Named orders must exist (a submitted order is in the snapshot before SubmitOrder replies).
-  auto snap = dispatcher_.snapshot();
   for (const std::string& id : request->order_ids()) {
-    if (!snap->FindOrder(id)) {
-      return new RefusedWatch(Fitted({grpc::StatusCode::NOT_FOUND, "no order with id '" + id + "'"}));
-    }
+    auto order = dispatcher_.FindAnywhere(id, false, false);
+    if (!order.ok()) return new RefusedWatch(Fitted(ToGrpcStatus(FromEngineError(order.error()))));
+    if (!*order) return new RefusedWatch(Fitted({grpc::StatusCode::NOT_FOUND, "no order with id '" + id + "'"}));
   }
   return new WatchReactor(dispatcher_, *request);
 }
@@ -265,7 +251,9 @@ grpc::ServerWriteReactor<pb::OrderEvent>* OrderServiceImpl::WatchOrders(
 grpc::ServerUnaryReactor* OrderServiceImpl::ExplainAllocation(
     grpc::CallbackServerContext* context, const pb::ExplainAllocationRequest* request,
     pb::AllocationExplanation* response) {
-  auto order = dispatcher_.snapshot()->FindOrder(request->order_id());
+  auto found = dispatcher_.FindAnywhere(request->order_id(), false, true);
+  if (!found.ok()) return Done(context, ToGrpcStatus(FromEngineError(found.error())));
+  const std::shared_ptr<const OrderView> order = *found;
   if (!order) {
     return Done(context, {grpc::StatusCode::NOT_FOUND, "no order with id '" + request->order_id() + "'"});
   }

@@ -234,7 +234,7 @@ void OrderToProto(const OrderView& view, const engine::WarehouseMap& map, pb::Or
   out->set_state(OrderStateToProto(o.state));
   for (const auto& r : view.record.robots) out->add_robot_ids(r);
   if (view.finished_time) out->set_finished_time(*view.finished_time);
-  out->set_distance(view.distance);
+  out->set_distance(view.record.distance);
   out->set_reason(view.record.reason);
 }
 

@@ -155,7 +155,9 @@ RestReply RestHandlers::Orders(const std::optional<std::string>& state,
     (engine::IsTerminal(o->record.order.state) ? done : open).push_back(i);
   }
   pb::OrderList out;
-  out.set_finished_total(static_cast<std::uint32_t>(done.size()));
+  std::uint64_t finished_total = done.size();  // with those only in the store
+  for (const auto& [s, n] : snap->finished_in_store) finished_total += !filter || s == *filter ? n : 0;
+  out.set_finished_total(static_cast<std::uint32_t>(finished_total));
   if (done.size() > keep) {  // the newest finished: by finished time, then submission
     auto newer = [&](std::size_t a, std::size_t b) {
       const double ta = snap->orders[a]->finished_time.value_or(0.0), tb = snap->orders[b]->finished_time.value_or(0.0);
@@ -172,9 +174,10 @@ RestReply RestHandlers::Orders(const std::optional<std::string>& state,
 }
 
 RestReply RestHandlers::Order(const std::string& id) {
-  auto snap = dispatcher_.snapshot();
-  auto order = snap->FindOrder(id);
-  if (!order) order = snap->FindClientOrder(id);
+  auto found = dispatcher_.FindAnywhere(id, false, true);
+  if (found.ok() && !*found) found = dispatcher_.FindAnywhere(id, true, true);
+  if (!found.ok()) return Error(FromEngineError(found.error()));
+  const std::shared_ptr<const OrderView> order = *found;
   if (!order) return Error(404, "no order with id or client id '" + id + "'");
   pb::OrderDetail out;
   OrderToProto(*order, dispatcher_.map(), out.mutable_order());

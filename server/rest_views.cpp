@@ -104,16 +104,18 @@ void StatusToProto(const Snapshot& snap, pb::ServiceState* out) {
   out->set_time_scale(snap.time_scale);
   out->set_snapshot(snap.version);
   pb::OrderCounts* counts = out->mutable_orders();
-  for (const auto& o : snap.orders) {
-    switch (o->record.order.state) {
-      case engine::OrderState::kAccepted: counts->set_accepted(counts->accepted() + 1); break;
-      case engine::OrderState::kAssigned: counts->set_assigned(counts->assigned() + 1); break;
-      case engine::OrderState::kInProgress: counts->set_in_progress(counts->in_progress() + 1); break;
-      case engine::OrderState::kCompleted: counts->set_completed(counts->completed() + 1); break;
-      case engine::OrderState::kCancelled: counts->set_cancelled(counts->cancelled() + 1); break;
-      case engine::OrderState::kFailed: counts->set_failed(counts->failed() + 1); break;
+  auto count = [counts](engine::OrderState state, std::uint32_t n) {
+    switch (state) {
+      case engine::OrderState::kAccepted: counts->set_accepted(counts->accepted() + n); break;
+      case engine::OrderState::kAssigned: counts->set_assigned(counts->assigned() + n); break;
+      case engine::OrderState::kInProgress: counts->set_in_progress(counts->in_progress() + n); break;
+      case engine::OrderState::kCompleted: counts->set_completed(counts->completed() + n); break;
+      case engine::OrderState::kCancelled: counts->set_cancelled(counts->cancelled() + n); break;
+      case engine::OrderState::kFailed: counts->set_failed(counts->failed() + n); break;
     }
-  }
+  };
+  for (const auto& o : snap.orders) count(o->record.order.state, 1);
+  for (const auto& [state, n] : snap.finished_in_store) count(state, static_cast<std::uint32_t>(n));
   std::uint32_t connected = 0;
   for (const auto& [id, r] : snap.robots) connected += r.connected ? 1 : 0;
   out->mutable_robots()->set_total(static_cast<std::uint32_t>(snap.robots.size()));

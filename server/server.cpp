@@ -118,6 +118,7 @@ engine::Result<std::unique_ptr<DispatchServer>> DispatchServer::Start(const Serv
   options.heartbeat_interval = config.heartbeat_interval;
   options.heartbeat_timeout = config.heartbeat_timeout;
   options.offline_grace = config.offline_grace;
+  options.finished_retained = static_cast<std::size_t>(config.finished_retained);
   options.traffic_control = config.traffic_control;
   options.traffic.speed = allocation.speed;
   options.traffic.t_w1 = config.t_w1;

@@ -36,7 +36,6 @@ struct OrderView {
   std::optional<AllocationRecord> explanation;  // the auction behind the award
   std::optional<double> finished_time;  // set once terminal
   std::set<std::string> dropped_by;     // team members that reported the drop
-  double distance = 0.0;  // metres driven for it (set when it completes)
 };
 
 struct RobotView {
@@ -87,8 +86,12 @@ struct Snapshot {
   std::string map_version;
   std::string strategy;
   double time_scale = 1.0;
-  std::vector<std::shared_ptr<const OrderView>> orders;  // submission order
-  // Order id / client id -> index in `orders`; shared by snapshots until an order is added.
+  // Every open order and the newest finished ones (DispatcherOptions::finished_retained), in
+  // submission order; the older finished ones are only in the store (Dispatcher::FindAnywhere).
+  std::vector<std::shared_ptr<const OrderView>> orders;
+  // How many finished orders, by state, are only in the store (not in `orders`).
+  std::map<engine::OrderState, std::uint64_t> finished_in_store;
+  // Order id / client id -> index in `orders`; shared by snapshots until the set changes.
   struct OrderIndex {
     std::unordered_map<std::string, std::size_t> by_id, by_client_id;
   };

@@ -66,6 +66,9 @@ CREATE TABLE map_versions (
   recorded_time REAL NOT NULL
 );
 )sql"},
+    {4, "metres driven for each order", R"sql(
+ALTER TABLE orders ADD COLUMN distance REAL NOT NULL DEFAULT 0;
+)sql"},
 };
 
 }  // namespace

@@ -23,7 +23,7 @@ using engine::OrderState;
 
 constexpr const char* kOrderColumns =
     "id, client_id, state, priority, formation, created_time, updated_time, content_hash, "
-    "robots, reason, body, seq";
+    "robots, reason, body, seq, distance";
 constexpr const char* kEventColumns =
     "id, order_id, type, state, previous_state, time, robots, detail";
 
@@ -207,6 +207,7 @@ Result<OrderRecord> SqliteStore::ReadOrder(Statement& stmt) {
   if (!robots.ok()) return WithContext("order '" + r.order.id + "'", robots.error());
   r.robots = std::move(robots).value();
   r.reason = stmt.ColText(9);
+  r.distance = stmt.ColReal(12);
   if (Status s = DecodeOrderBody(stmt.ColText(10), r.order); !s.ok()) {
     return WithContext("order '" + r.order.id + "'", s.error());
   }
@@ -403,6 +404,9 @@ Result<OrderPage> SqliteStore::ListOrders(const OrderQuery& query) {
 
 Result<OrderEvent> SqliteStore::TransitionOrder(const OrderTransition& t) {
   if (!std::isfinite(t.time)) return engine::InvalidArgument("transition time must be finite");
+  if (t.distance && !(std::isfinite(*t.distance) && *t.distance >= 0)) {
+    return engine::InvalidArgument("transition distance must be a finite number of metres >= 0");
+  }
   std::lock_guard lock(mu_);
   std::optional<OrderEvent> out;
   Status status = InTransaction([&]() -> Status {
@@ -419,14 +423,15 @@ Result<OrderEvent> SqliteStore::TransitionOrder(const OrderTransition& t) {
     if (!robots_json.ok()) return robots_json.error();
     const bool ends_badly = t.to == OrderState::kCancelled || t.to == OrderState::kFailed;
     Result<Statement> update = Prepare(
-        "UPDATE orders SET state = ?, updated_time = ?, robots = ?, reason = ? WHERE id = ?");
+        "UPDATE orders SET state = ?, updated_time = ?, robots = ?, reason = ?, distance = ? WHERE id = ?");
     if (!update.ok()) return update.error();
     Status run = update.value()
                      .Text(1, engine::OrderStateName(t.to))
                      .Real(2, t.time)
                      .Text(3, robots_json.value())
                      .Text(4, ends_badly ? t.detail : current->reason)
-                     .Text(5, t.order_id)
+                     .Real(5, t.distance.value_or(current->distance))
+                     .Text(6, t.order_id)
                      .Run();
     if (!run.ok()) return run;
     OrderEvent event;

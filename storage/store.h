@@ -47,6 +47,7 @@ struct OrderRecord {
   std::vector<std::string> robots;   // robots serving it, leader first; empty before award
   double updated_time = 0.0;         // time of the last state change, seconds
   std::string reason;                // why it failed or was cancelled; empty otherwise
+  double distance = 0.0;             // metres its robots drove for it (set when it completes)
 };
 
 enum class OrderEventType {
@@ -83,6 +84,7 @@ struct OrderTransition {
   // Robots serving the order after the change; nullopt keeps the stored ones.
   std::optional<std::vector<std::string>> robots;
   std::string detail;  // journaled; for cancelled/failed also stored as the order's reason
+  std::optional<double> distance;  // metres driven for it; nullopt keeps the stored value
 };
 
 struct OrderQuery {

@@ -201,6 +201,8 @@ TEST_F(OrderFlowTest, RegressionAPickOrDropIsTakenOnlyWhereTheRobotStands) {
   ASSERT_TRUE(watcher.WaitForState(id, pb::ORDER_STATE_COMPLETED));
   const pb::Order order = Get(id);
   EXPECT_GT(order.distance(), 5.0);
+  // Stored with the completion: ListOrders reads the store, and a restart keeps it.
+  EXPECT_DOUBLE_EQ(List().orders(0).distance(), order.distance());
   // The forged arrivals were processed before the real reports (one stream, in order) and
   // flagged; the early picked / dropped events counted only once it had reached the stops.
   EXPECT_EQ(server_->dispatcher().snapshot()->traffic.implausible_reports, 2u);

@@ -56,7 +56,7 @@ TEST_F(FaultInjectionStoreTest, TheNthWriteFailsAndChangesNothing) {
 TEST_F(FaultInjectionStoreTest, EveryKindOfWriteCanFail) {
   ASSERT_TRUE(store_->InsertOrder(MakeOrder("o1")).ok());  // write 1
   store_->FailWritesFrom(2);
-  EXPECT_FALSE(store_->TransitionOrder({"o1", OrderState::kAssigned, 1, {}, ""}).ok());
+  EXPECT_FALSE(store_->TransitionOrder({"o1", OrderState::kAssigned, 1, {}, "", {}}).ok());
   EXPECT_FALSE(store_->AppendProgress("o1", 1, "x").ok());
   RobotRecord robot;
   robot.robot.id = "R1";
@@ -74,7 +74,7 @@ TEST_F(FaultInjectionStoreTest, EveryKindOfWriteCanFail) {
   EXPECT_TRUE(sqlite_->ListAssignments().value().empty());
   EXPECT_EQ(sqlite_->LatestMapVersion().error().code, ErrorCode::kNotFound);
   store_->FailWritesFrom(0);
-  EXPECT_TRUE(store_->TransitionOrder({"o1", OrderState::kAssigned, 1, {}, ""}).ok());
+  EXPECT_TRUE(store_->TransitionOrder({"o1", OrderState::kAssigned, 1, {}, "", {}}).ok());
 }
 
 TEST_F(FaultInjectionStoreTest, AFailureInsideATransactionUndoesItsEarlierWrites) {
@@ -82,7 +82,7 @@ TEST_F(FaultInjectionStoreTest, AFailureInsideATransactionUndoesItsEarlierWrites
   Status status = store_->RunInTransaction([](Store& tx) -> Status {
     auto order = tx.InsertOrder(MakeOrder("o1"));  // write 1: succeeds inside the transaction
     if (!order.ok()) return order.error();
-    auto assigned = tx.TransitionOrder({"o1", OrderState::kAssigned, 1, std::vector<std::string>{"R1"}, ""});  // fails
+    auto assigned = tx.TransitionOrder({"o1", OrderState::kAssigned, 1, std::vector<std::string>{"R1"}, "", {}});  // fails
     if (!assigned.ok()) return assigned.error();
     return engine::Ok{};
   });

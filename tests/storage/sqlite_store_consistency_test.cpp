@@ -114,7 +114,7 @@ TEST_F(SqliteStoreTest, AFailedStatementLeavesNoPartialOrder) {
 
   // A transition whose journal entry fails does not change the state.
   fail_on = "INSERT INTO order_events";
-  EXPECT_FALSE(store->TransitionOrder({"o1", OrderState::kAssigned, 2, std::vector<std::string>{"R1"}, ""}).ok());
+  EXPECT_FALSE(store->TransitionOrder({"o1", OrderState::kAssigned, 2, std::vector<std::string>{"R1"}, "", {}}).ok());
   EXPECT_EQ(store->GetOrder("o1")->order.state, OrderState::kAccepted);
   EXPECT_TRUE(store->GetOrder("o1")->robots.empty());
   EXPECT_EQ(store->ListEvents({}).value().size(), 1u);
@@ -133,7 +133,7 @@ TEST_F(SqliteStoreTest, RunInTransactionIsAllOrNothingAndNests) {
   ASSERT_NE(store, nullptr);
   Status aborted = store->RunInTransaction([](Store& tx) -> Status {
     if (!tx.InsertOrder(MakeOrder("a", "ca")).ok()) return engine::IoError("unexpected");
-    if (!tx.TransitionOrder({"a", OrderState::kAssigned, 1, std::vector<std::string>{"R1"}, ""}).ok()) {
+    if (!tx.TransitionOrder({"a", OrderState::kAssigned, 1, std::vector<std::string>{"R1"}, "", {}}).ok()) {
       return engine::IoError("unexpected");
     }
     return engine::InvalidArgument("changed my mind");
@@ -255,7 +255,7 @@ TEST_F(SqliteStoreTest, RandomOperationsMatchAnInMemoryModel) {
       }
     } else if (op == 1) {
       const OrderState to = states[rng() % states.size()];
-      auto r = store->TransitionOrder({"id-" + client, to, 1.0, {}, ""});
+      auto r = store->TransitionOrder({"id-" + client, to, 1.0, {}, "", {}});
       if (it == model.end()) {
         EXPECT_EQ(r.error().code, ErrorCode::kNotFound);
       } else if (engine::CanTransition(it->second.state, to)) {

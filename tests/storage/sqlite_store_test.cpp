@@ -114,7 +114,7 @@ TEST_F(SqliteStoreTest, EverythingSurvivesCloseAndReopen) {
     ASSERT_TRUE(store->InsertOrder(MakeOrder("o1", "c1")).ok());
     ASSERT_TRUE(store->InsertOrder(formation).ok());
     ASSERT_TRUE(store->TransitionOrder({"o2", OrderState::kAssigned, 3.0,
-                                        std::vector<std::string>{"R7", "R1", "R2"}, "auction"})
+                                        std::vector<std::string>{"R7", "R1", "R2"}, "auction", {}})
                     .ok());
     ASSERT_TRUE(store->AppendProgress("o2", 4.0, "R7 re-planned").ok());
     ASSERT_TRUE(store->UpsertRobot({robot, "differential", 4.5, 17, 18}).ok());
@@ -257,22 +257,22 @@ TEST_F(SqliteStoreTest, StateTransitionsFollowTheLifecycleAndAreJournaledInOrder
   ASSERT_TRUE(store->InsertOrder(MakeOrder("a", "ca")).ok());
   ASSERT_TRUE(store->InsertOrder(MakeOrder("b", "cb")).ok());
   const std::vector<std::string> team = {"R1"};
-  ASSERT_TRUE(store->TransitionOrder({"a", OrderState::kAssigned, 2.0, team, "won"}).ok());
-  ASSERT_TRUE(store->TransitionOrder({"b", OrderState::kCancelled, 2.5, {}, "client"}).ok());
-  ASSERT_TRUE(store->TransitionOrder({"a", OrderState::kInProgress, 3.0, {}, "picking"}).ok());
+  ASSERT_TRUE(store->TransitionOrder({"a", OrderState::kAssigned, 2.0, team, "won", {}}).ok());
+  ASSERT_TRUE(store->TransitionOrder({"b", OrderState::kCancelled, 2.5, {}, "client", {}}).ok());
+  ASSERT_TRUE(store->TransitionOrder({"a", OrderState::kInProgress, 3.0, {}, "picking", {}}).ok());
   ASSERT_TRUE(store->AppendProgress("a", 3.5, "picked at P1").ok());
-  ASSERT_TRUE(store->TransitionOrder({"a", OrderState::kCompleted, 4.0, {}, "dropped"}).ok());
+  ASSERT_TRUE(store->TransitionOrder({"a", OrderState::kCompleted, 4.0, {}, "dropped", {}}).ok());
 
   // Forbidden moves change nothing and journal nothing.
   const size_t journal = store->ListEvents({}).value().size();
-  auto back = store->TransitionOrder({"a", OrderState::kAssigned, 5.0, {}, ""});
+  auto back = store->TransitionOrder({"a", OrderState::kAssigned, 5.0, {}, "", {}});
   ASSERT_FALSE(back.ok());
   EXPECT_EQ(back.error().code, ErrorCode::kFailedPrecondition);
   EXPECT_NE(back.error().message.find("from completed to assigned"), std::string::npos)
       << back.error().message;
-  EXPECT_EQ(store->TransitionOrder({"b", OrderState::kCancelled, 5.0, {}, ""}).error().code,
+  EXPECT_EQ(store->TransitionOrder({"b", OrderState::kCancelled, 5.0, {}, "", {}}).error().code,
             ErrorCode::kFailedPrecondition);
-  EXPECT_EQ(store->TransitionOrder({"zz", OrderState::kAssigned, 5.0, {}, ""}).error().code,
+  EXPECT_EQ(store->TransitionOrder({"zz", OrderState::kAssigned, 5.0, {}, "", {}}).error().code,
             ErrorCode::kNotFound);
   EXPECT_EQ(store->AppendProgress("zz", 5.0, "").error().code, ErrorCode::kNotFound);
   EXPECT_EQ(store->ListEvents({}).value().size(), journal);
@@ -322,7 +322,7 @@ TEST_F(SqliteStoreTest, ListOrdersPagesWithAStateFilter) {
     const std::string id = "o" + std::to_string(i);
     ASSERT_TRUE(store->InsertOrder(MakeOrder(id, "c" + std::to_string(i))).ok());
     if (i % 3 == 0) {
-      ASSERT_TRUE(store->TransitionOrder({id, OrderState::kAssigned, 1, {}, ""}).ok());
+      ASSERT_TRUE(store->TransitionOrder({id, OrderState::kAssigned, 1, {}, "", {}}).ok());
     }
   }
   std::vector<std::string> seen;

@@ -1,0 +1,223 @@
+// Dispatcher: the order book (open orders and the newest finished ones in memory, the rest in
+// the store: DispatcherOptions::finished_retained) and the order commands (submit, cancel).
+#include <spdlog/spdlog.h>
+
+#include <algorithm>
+
+#include "engine/dispatch/order_intake.h"
+#include "server/dispatcher.h"
+#include "server/json_convert.h"
+
+namespace dispatch::server {
+
+std::shared_ptr<const OrderView> Dispatcher::Find(const std::string& order_id) const {
+  auto it = by_id_.find(order_id);
+  return it == by_id_.end() ? nullptr : orders_[it->second];
+}
+
+void Dispatcher::Put(std::shared_ptr<OrderView> view) {
+  const std::string id = view->record.order.id;
+  const bool finished = engine::IsTerminal(view->record.order.state);
+  auto it = by_id_.find(id);
+  if (it == by_id_.end()) {
+    view->position = ++last_position_;
+    by_id_.emplace(id, orders_.size());
+    by_client_id_.emplace(view->record.order.client_id, orders_.size());
+    orders_.push_back(std::move(view));
+    ++book_generation_;
+    if (finished) finished_.push_back(id);
+  } else {
+    if (finished && !engine::IsTerminal(orders_[it->second]->record.order.state)) finished_.push_back(id);
+    orders_[it->second] = std::move(view);
+  }
+  dirty_ = true;
+}
+
+void Dispatcher::Retire(std::size_t slack) {
+  if (finished_.size() <= options_.finished_retained + slack) return;
+  std::unordered_set<std::string> leaving;
+  while (finished_.size() > options_.finished_retained) {
+    leaving.insert(std::move(finished_.front()));
+    finished_.pop_front();
+  }
+  std::vector<std::shared_ptr<const OrderView>> kept;
+  kept.reserve(orders_.size() - leaving.size());
+  for (auto& view : orders_) {
+    if (leaving.count(view->record.order.id)) {
+      ++finished_in_store_[view->record.order.state];
+    } else {
+      kept.push_back(std::move(view));
+    }
+  }
+  orders_ = std::move(kept);
+  by_id_.clear();
+  by_client_id_.clear();
+  for (std::size_t i = 0; i < orders_.size(); ++i) {
+    by_id_.emplace(orders_[i]->record.order.id, i);
+    by_client_id_.emplace(orders_[i]->record.order.client_id, i);
+  }
+  ++book_generation_;
+  dirty_ = true;
+}
+
+engine::Result<std::shared_ptr<const OrderView>> Dispatcher::FindAnywhere(const std::string& key, bool by_client_id,
+                                                                          bool explain) const {
+  auto snap = snapshot();
+  if (auto view = by_client_id ? snap->FindClientOrder(key) : snap->FindOrder(key)) return view;
+  auto record = by_client_id ? store_.GetOrderByClientId(key) : store_.GetOrder(key);
+  if (!record.ok()) {
+    if (record.error().code == engine::ErrorCode::kNotFound) return std::shared_ptr<const OrderView>();
+    return record.error();
+  }
+  auto view = std::make_shared<OrderView>();
+  view->record = std::move(record).value();
+  if (engine::IsTerminal(view->record.order.state)) view->finished_time = view->record.updated_time;
+  if (explain) {  // the latest allocation detail in its journal
+    storage::EventQuery events;
+    events.order_id = view->record.order.id;
+    for (;;) {
+      auto batch = store_.ListEvents(events);
+      if (!batch.ok()) return batch.error();
+      for (const auto& event : *batch) {
+        events.after_id = event.id;
+        if (auto explanation = ParseAllocationDetail(event.detail)) view->explanation = std::move(explanation);
+      }
+      if (batch->size() < static_cast<std::size_t>(events.limit)) break;
+    }
+  }
+  return std::shared_ptr<const OrderView>(std::move(view));
+}
+
+std::string Dispatcher::NextOrderId() {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "ord-%06lld", static_cast<long long>(last_order_number_ + 1));
+  return buf;
+}
+
+// --- Orders --------------------------------------------------------------------------------
+
+void Dispatcher::SubmitOrder(engine::OrderRequest request, std::function<void(SubmitReply)> done) {
+  // The route searches towards the order's stops run first, on the route worker: the loop's
+  // reachability check and the auction then find them cached.
+  auto shared = std::make_shared<const engine::OrderRequest>(std::move(request));
+  route_worker_->Run([this, shared, done = std::move(done)](bool cancelled) {
+    if (!cancelled) {
+      for (const engine::PointId p : engine::StopsOf(*map_, *shared, options_.snap)) routes_->Prepare(p);
+    }
+    Post([this, shared, done] {
+      DoSubmit(*shared, [this, done](SubmitReply reply) {
+        Defer([done, reply = std::move(reply)]() mutable { done(std::move(reply)); });
+      });
+    });
+  });
+}
+
+void Dispatcher::CancelOrder(std::string order_id, std::string reason,
+                             std::function<void(OrderReply)> done) {
+  Post([this, order_id = std::move(order_id), reason = std::move(reason), done = std::move(done)] {
+    DoCancel(order_id, reason, [this, done](OrderReply reply) {
+      Defer([done, reply = std::move(reply)]() mutable { done(std::move(reply)); });
+    });
+  });
+}
+
+void Dispatcher::DoSubmit(const engine::OrderRequest& request,
+                          const std::function<void(SubmitReply)>& done) {
+  SubmitReply reply;
+  engine::OrderRequest req = request;
+  req.created_time = Now();
+  auto admitted = engine::AdmitOrder(*map_, *routes_, req, options_.snap, NextOrderId());
+  if (!admitted.ok()) {
+    reply.status = FromEngineError(admitted.error());
+    return done(std::move(reply));
+  }
+  engine::Order order = std::move(admitted).value();
+  if (auto it = by_client_id_.find(order.client_id); it != by_client_id_.end()) {
+    const auto& existing = orders_[it->second];
+    if (storage::OrderContentHash(order) == existing->record.content_hash) {
+      reply.order = existing;
+      reply.created = false;
+      return done(std::move(reply));
+    }
+    reply.status = MakeStatus(
+        StatusCode::kAlreadyExists,
+        "client_order_id '" + order.client_id + "' already names order " +
+            existing->record.order.id + " with different content; this submission (picks, drop, "
+            "formation, priority, work time or release time) differs from it");
+    return done(std::move(reply));
+  }
+  // Not in memory: new, or finished long ago (retired). The store decides which.
+  auto inserted = store_.InsertOrder(order);
+  if (!inserted.ok()) {
+    reply.status = inserted.error().code == engine::ErrorCode::kFailedPrecondition
+                       ? MakeStatus(StatusCode::kAlreadyExists, inserted.error().message)
+                       : FromEngineError(inserted.error());
+    if (reply.status.code == StatusCode::kUnavailable) {
+      reply.status.message = "order '" + order.client_id + "' was NOT accepted: " + reply.status.message;
+    }
+    spdlog::warn("submit {}: {}", order.client_id, reply.status.message);
+    return done(std::move(reply));
+  }
+  auto view = std::make_shared<OrderView>();
+  view->record = inserted->record;
+  if (!inserted->created) {  // a repeat of a retired order: answered from the store
+    if (engine::IsTerminal(view->record.order.state)) view->finished_time = view->record.updated_time;
+    reply.order = view;
+    reply.created = false;
+    return done(std::move(reply));
+  }
+  ++last_order_number_;
+  Put(view);
+  reply.order = view;
+  reply.created = inserted->created;
+  done(std::move(reply));
+  storage::EventQuery first;
+  first.order_id = order.id;
+  first.limit = 1;
+  if (auto events = store_.ListEvents(first); events.ok() && !events->empty()) {
+    Journal(events->front());
+  }
+  spdlog::info("order {} ({}) accepted", order.id, order.client_id);
+  allocation_due_ = true;
+}
+
+void Dispatcher::DoCancel(const std::string& order_id, const std::string& reason,
+                          const std::function<void(OrderReply)>& done) {
+  OrderReply reply;
+  auto view = Find(order_id);
+  if (!view) {  // retired (finished) or unknown
+    auto stored = FindAnywhere(order_id, false, false);
+    if (!stored.ok()) {
+      reply.status = FromEngineError(stored.error());
+      return done(std::move(reply));
+    }
+    view = *stored;
+  }
+  if (!view) {
+    reply.status = MakeStatus(StatusCode::kNotFound, "no order with id '" + order_id + "'");
+    return done(std::move(reply));
+  }
+  const engine::OrderState state = view->record.order.state;
+  if (state == engine::OrderState::kCancelled) {
+    reply.order = view;
+    return done(std::move(reply));
+  }
+  if (engine::IsTerminal(state)) {
+    reply.status = MakeStatus(StatusCode::kFailedPrecondition,
+                              "order " + order_id + " is already " +
+                                  engine::OrderStateName(state) + "; only open orders can be cancelled");
+    return done(std::move(reply));
+  }
+  ServiceStatus status;
+  const std::string why = reason.empty() ? "cancelled by client" : reason;
+  if (!ReleaseOrders({order_id}, [](const OrderView&) { return engine::OrderState::kCancelled; },
+                     why, &status)) {
+    reply.status = status;
+    return done(std::move(reply));
+  }
+  reply.order = Find(order_id);
+  done(std::move(reply));
+  allocation_due_ = true;
+}
+
+}  // namespace dispatch::server
