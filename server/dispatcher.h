@@ -210,8 +210,8 @@ class Dispatcher {
   void DoCancel(const std::string& order_id, const std::string& reason,
                 const std::function<void(OrderReply)>& done);
   std::shared_ptr<const OrderView> Find(const std::string& order_id) const;
-  // Replaces (or adds, numbering its position) an order in the book; a finished one joins the
-  // finished list that Retire trims.
+  // Replaces (or adds, at the end) an order in the book; a finished one joins the finished
+  // list that Retire trims.
   void Put(std::shared_ptr<OrderView> view);
   // Once more than finished_retained + slack finished orders are in memory, the oldest
   // finished ones leave it (they stay in the store) down to finished_retained.
@@ -337,7 +337,6 @@ class Dispatcher {
   std::vector<std::shared_ptr<const OrderView>> orders_;
   std::unordered_map<std::string, std::size_t> by_id_;
   std::unordered_map<std::string, std::size_t> by_client_id_;
-  std::int64_t last_position_ = 0;
   std::deque<std::string> finished_;  // the finished orders in memory, in finish order
   std::map<engine::OrderState, std::uint64_t> finished_in_store_;  // retired, by state
   std::uint64_t book_generation_ = 0;  // changes when orders join or leave the book

@@ -20,7 +20,6 @@ void Dispatcher::Put(std::shared_ptr<OrderView> view) {
   const bool finished = engine::IsTerminal(view->record.order.state);
   auto it = by_id_.find(id);
   if (it == by_id_.end()) {
-    view->position = ++last_position_;
     by_id_.emplace(id, orders_.size());
     by_client_id_.emplace(view->record.order.client_id, orders_.size());
     orders_.push_back(std::move(view));

@@ -32,7 +32,6 @@ struct AllocationRecord {
 
 struct OrderView {
   storage::OrderRecord record;  // order (current state), robots, reason, updated_time
-  std::int64_t position = 0;    // 1-based submission position (ListOrders paging key)
   std::optional<AllocationRecord> explanation;  // the auction behind the award
   std::optional<double> finished_time;  // set once terminal
   std::set<std::string> dropped_by;     // team members that reported the drop
