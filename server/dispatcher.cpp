@@ -46,14 +46,14 @@ engine::Result<std::unique_ptr<Dispatcher>> Dispatcher::Create(
   };
   auto rounds = std::make_unique<engine::RoundRunner>(map, routes, options.allocation,
                                                       std::move(allocator).value(), stopwatch);
-  std::unique_ptr<Dispatcher> d(new Dispatcher(std::move(map), std::move(routes), store,
-                                               std::move(options), std::move(rounds)));
-  if (d->options_.traffic_control) {
-    if (auto valid = d->options_.traffic.Validate(); !valid.ok()) return valid.error();
-    auto gate = engine::TrafficGate::Create(d->map_, d->routes_, d->options_.traffic);
-    if (!gate.ok()) return gate.error();
-    d->gate_ = std::move(gate).value();
-  }
+  engine::CoreOptions core_options;
+  core_options.robot_snap_tolerance = options.robot_snap_tolerance;
+  core_options.traffic_control = options.traffic_control;
+  core_options.traffic = options.traffic;
+  auto core = engine::DispatchCore::Create(map, routes, core_options);
+  if (!core.ok()) return core.error();
+  std::unique_ptr<Dispatcher> d(new Dispatcher(std::move(map), std::move(routes), store, std::move(options),
+                                               std::move(rounds), std::move(core).value()));
   if (auto recovered = d->Recover(); !recovered.ok()) return recovered.error();
   d->Publish();
   return d;
@@ -61,12 +61,14 @@ engine::Result<std::unique_ptr<Dispatcher>> Dispatcher::Create(
 
 Dispatcher::Dispatcher(std::shared_ptr<const engine::WarehouseMap> map,
                        std::shared_ptr<const engine::RouteTable> routes, storage::Store& store,
-                       DispatcherOptions options, std::unique_ptr<engine::RoundRunner> rounds)
+                       DispatcherOptions options, std::unique_ptr<engine::RoundRunner> rounds,
+                       std::unique_ptr<engine::DispatchCore> core)
     : map_(std::move(map)),
       routes_(std::move(routes)),
       store_(store),
       options_(std::move(options)),
       rounds_(std::move(rounds)),
+      core_(std::move(core)),
       wall_start_(Clock::now()),
       // Below the loop's priority: traffic control first when the cores are busy.
       route_worker_(std::make_unique<WorkerThread>(kWorkerNice)),
@@ -128,36 +130,42 @@ engine::Status Dispatcher::Recover() {
     }
     if (batch->size() < static_cast<std::size_t>(events.limit)) break;
   }
+  // The open orders enter the core with their robots.
+  for (const auto& view : orders_) {
+    const storage::OrderRecord& rec = view->record;
+    if (!engine::IsTerminal(rec.order.state)) core_->AddOrder(rec.order, rec.robots);
+  }
   // Robots (all offline until they reconnect) and their plans.
   auto robots = store_.ListRobots();
   if (!robots.ok()) return robots.error();
-  for (auto& record : *robots) {
-    RobotRuntime r;
-    r.record = record;
-    r.record.robot.state = engine::RobotState::kOffline;
-    r.offline_since = Clock::now();
-    time_base_ = std::max(time_base_, record.last_seen);
-    // On line when the old process stopped: where it is now is known when it reports.
-    if (gate_ && record.robot.state != engine::RobotState::kOffline) {
-      awaiting_reconnect_.insert(record.robot.id);
-    } else {
-      PlaceAway(r);
-    }
-    robots_.emplace(record.robot.id, std::move(r));
-  }
   auto assignments = store_.ListAssignments();
   if (!assignments.ok()) return assignments.error();
+  std::map<std::string, engine::Assignment> plans;
   for (auto& a : *assignments) {
-    auto it = robots_.find(a.robot_id);
-    if (it == robots_.end()) continue;
     time_base_ = std::max(time_base_, a.updated_time);
-    it->second.assignment = a;
-    it->second.has_assignment = true;
+    plans[a.robot_id] = std::move(a);
+  }
+  for (auto& record : *robots) {
+    const std::string id = record.robot.id;
+    RobotSession& s = sessions_[id];
+    s.kind = record.kind;
+    s.last_seen = record.last_seen;
+    s.last_acked_sequence = record.last_acked_sequence;
+    s.next_sequence = record.next_sequence;
+    s.offline_since = Clock::now();
+    time_base_ = std::max(time_base_, record.last_seen);
+    // On line when the old process stopped: where it is now is known when it reports.
+    const bool was_on_line = options_.traffic_control && record.robot.state != engine::RobotState::kOffline;
+    if (was_on_line) awaiting_reconnect_.insert(id);
+    auto plan = plans.find(id);
+    core_->RestoreRobot(std::move(record.robot),
+                        plan == plans.end() ? std::nullopt : std::optional<engine::Assignment>(std::move(plan->second)),
+                        !was_on_line);
   }
   std::uint64_t retired = 0;
   for (const auto& [state, n] : finished_in_store_) retired += n;
   spdlog::info("recovered {} orders ({} finished ones left in the store), {} robots, {} assignments; "
-               "dispatcher time {:.1f} s", orders_.size(), retired, robots_.size(), assignments->size(), time_base_);
+               "dispatcher time {:.1f} s", orders_.size(), retired, sessions_.size(), plans.size(), time_base_);
   if (!awaiting_reconnect_.empty()) {
     spdlog::info("traffic control waits up to {:.1f} s for the {} robots that were on line to report",
                  options_.heartbeat_timeout, awaiting_reconnect_.size());
@@ -174,11 +182,11 @@ void Dispatcher::Start() {
 
 void Dispatcher::CloseStreams() {
   Post([this] {
-    for (auto& [id, robot] : robots_) {
-      if (robot.link) {
-        CloseLink(robot.link, MakeStatus(StatusCode::kUnavailable, "dispatcher shutting down"));
-        link_robot_.erase(robot.link.get());
-        robot.link.reset();
+    for (auto& [id, s] : sessions_) {
+      if (s.link) {
+        CloseLink(s.link, MakeStatus(StatusCode::kUnavailable, "dispatcher shutting down"));
+        link_robot_.erase(s.link.get());
+        s.link.reset();
         dirty_ = true;
       }
     }
@@ -221,7 +229,7 @@ void Dispatcher::Loop() {
   // Ticks also run the traffic controller for robots that report nothing new (a held point
   // frees up): at least 20 times per wall second; and the loop wakes when a robot's planned
   // departure comes (TrafficGate::NextWake).
-  const double tick_s = std::clamp(options_.heartbeat_timeout / 10.0, 0.01, gate_ ? 0.05 : 0.5);
+  const double tick_s = std::clamp(options_.heartbeat_timeout / 10.0, 0.01, core_->gate() ? 0.05 : 0.5);
   const auto tick = std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(tick_s));
   auto next_tick = Clock::now() + tick;
   for (;;) {
@@ -230,8 +238,8 @@ void Dispatcher::Loop() {
     {
       auto wake = dirty_ ? std::min(next_tick, last_publish_ + kPublishEvery) : next_tick;
       // A robot that only waits for its planned departure is released then, not a tick late.
-      if (gate_) {
-        const double at = gate_->NextWake();
+      if (const engine::TrafficGate* gate = core_->gate()) {
+        const double at = gate->NextWake();
         if (at < Now() + tick_s * options_.time_scale) {
           const auto wait = std::chrono::duration<double>(std::max(0.0, at - Now()) / options_.time_scale);
           wake = std::min(wake, Clock::now() + std::chrono::duration_cast<Clock::duration>(wait));
@@ -251,6 +259,7 @@ void Dispatcher::Loop() {
     Flush();
     // Allocation runs once per batch, after the batch's replies are out: an order is
     // acknowledged when it is committed, and the orders of a burst are auctioned together.
+    if (core_->TakeAllocationDue()) allocation_due_ = true;
     if (allocation_due_) {
       AllocatePending();
       StepTraffic();
@@ -291,19 +300,21 @@ void Dispatcher::Publish() {
     published_generation_ = book_generation_;
   }
   snap->index = published_index_;
-  for (const auto& [id, r] : robots_) {
+  const engine::TrafficGate* gate = core_->gate();
+  for (const auto& [id, r] : core_->robots()) {
     RobotView view;
-    view.robot = r.record.robot;
-    view.kind = r.record.kind;
-    view.connected = r.link != nullptr;
-    view.last_seen = r.record.last_seen;
+    view.robot = r.robot;
+    if (auto s = sessions_.find(id); s != sessions_.end()) {
+      view.kind = s->second.kind;
+      view.connected = s->second.link != nullptr;
+      view.last_seen = s->second.last_seen;
+    }
     if (r.has_assignment) {
-      view.robot.task_queue = r.assignment.order_ids;
       view.plan_id = r.assignment.plan_id;
       view.waypoints = r.assignment.plan.waypoints.size();
     }
-    if (gate_) {
-      engine::GateRobotState traffic = gate_->RobotState(id);
+    if (gate) {
+      engine::GateRobotState traffic = gate->RobotState(id);
       view.held = traffic.held;
       view.hold_reason = std::move(traffic.reason);
       view.formation = std::move(traffic.formation);
@@ -311,19 +322,20 @@ void Dispatcher::Publish() {
     snap->robots.emplace(id, std::move(view));
   }
   snap->zones = ZoneViews(snap->robots);
-  snap->traffic.implausible_reports = traffic_counts_.implausible;
-  if (gate_) {
-    for (auto& g : gate_->Intersections()) {
+  snap->traffic.implausible_reports = implausible_;
+  if (gate) {
+    for (auto& g : gate->Intersections()) {
       snap->intersections.push_back({std::move(g.holders), std::move(g.waiting)});
     }
     TrafficView& t = snap->traffic;
+    const engine::CoreCounts& counts = core_->counts();
     t.enabled = true;
-    t.grants = traffic_counts_.grants;
-    t.holds = traffic_counts_.holds;
-    t.replans = traffic_counts_.replans;
-    t.deadlocks_resolved = gate_->stats().deadlocks_resolved;
-    t.head_on_conflicts = gate_->stats().head_on_conflicts;
-    t.nudges = gate_->stats().nudges;
+    t.grants = counts.grants;
+    t.holds = counts.holds;
+    t.replans = counts.replans;
+    t.deadlocks_resolved = gate->stats().deadlocks_resolved;
+    t.head_on_conflicts = gate->stats().head_on_conflicts;
+    t.nudges = gate->stats().nudges;
     t.awaiting_reconnect.assign(awaiting_reconnect_.begin(), awaiting_reconnect_.end());
     if (std::isfinite(min_distance_.distance)) {
       t.min_distance = min_distance_.distance;

@@ -70,6 +70,7 @@
 #include <vector>
 
 #include "engine/dispatch/allocation_round.h"
+#include "engine/dispatch/dispatch_core.h"
 #include "engine/dispatch/robot_progress.h"
 #include "engine/fleet/order.h"
 #include "engine/routing/route_table.h"
@@ -118,14 +119,8 @@ struct OrderReply {
   std::shared_ptr<const OrderView> order;
 };
 
-// One waypoint of an order's remaining route (for operators: GET /api/v1/orders/{id}).
-struct RouteWaypoint {
-  std::uint64_t seq = 0;
-  Eigen::Vector2d xy = Eigen::Vector2d::Zero();
-  engine::WaypointAction action = engine::WaypointAction::kMove;
-  bool released = false;
-};
-using OrderRoutes = std::map<std::string, std::vector<RouteWaypoint>>;  // by robot id
+using engine::OrderRoutes;
+using engine::RouteWaypoint;
 
 class Dispatcher {
  public:
@@ -186,26 +181,35 @@ class Dispatcher {
 
  private:
   using Clock = std::chrono::steady_clock;
-  struct RobotRuntime {
-    storage::RobotRecord record;
-    std::shared_ptr<RobotLink> link;  // null when not connected
+  // What the service keeps of a robot besides the core's book: its stream and the session's
+  // bookkeeping (message sequences, heartbeats).
+  struct RobotSession {
+    std::string kind;                       // drive kinematics, e.g. "differential"
+    double last_seen = 0.0;                 // dispatcher seconds of its last message
+    std::uint64_t last_acked_sequence = 0;  // server message sequence it acknowledged
+    std::uint64_t next_sequence = 1;        // next server message sequence to use
+    std::shared_ptr<RobotLink> link;        // null when not connected
     Clock::time_point last_heard;
     std::optional<Clock::time_point> offline_since;  // set while offline with orders to watch
-    storage::AssignmentRecord assignment;  // plan.waypoints[0] anchors; then one segment per order
-    bool has_assignment = false;
-    // What it reported reaching, where, and its picks and drops waiting for its progress.
-    engine::RobotProgress progress;
-    std::optional<double> held_since;  // dispatcher seconds of the Hold in force
+    std::optional<double> held_since;                // dispatcher seconds of the Hold in force
+  };
+  // An allocation round on its way into the store: the core's commit, and per award the
+  // explanation as the journal keeps it.
+  struct ServerRound {
+    engine::RoundCommit commit;
+    std::vector<AllocationRecord> records;
+    std::vector<std::string> details;  // AllocationDetail(records[i]), made on the worker
   };
 
   Dispatcher(std::shared_ptr<const engine::WarehouseMap> map,
              std::shared_ptr<const engine::RouteTable> routes, storage::Store& store,
-             DispatcherOptions options, std::unique_ptr<engine::RoundRunner> rounds);
+             DispatcherOptions options, std::unique_ptr<engine::RoundRunner> rounds,
+             std::unique_ptr<engine::DispatchCore> core);
   engine::Status Recover();
   void Loop();
   double Now() const;
 
-  // Orders (dispatcher.cpp).
+  // Orders (dispatcher_orders.cpp).
   void DoSubmit(const engine::OrderRequest& request, const std::function<void(SubmitReply)>& done);
   void DoCancel(const std::string& order_id, const std::string& reason,
                 const std::function<void(OrderReply)>& done);
@@ -216,6 +220,18 @@ class Dispatcher {
   // Once more than finished_retained + slack finished orders are in memory, the oldest
   // finished ones leave it (they stay in the store) down to finished_retained.
   void Retire(std::size_t slack);
+  std::string NextOrderId();
+
+  // Carrying out the core's changes (dispatcher_commit.cpp). Commit stores `change` in one
+  // transaction (journal, plans, the robots' reserved message sequences; with `round` the
+  // awards' explanations), then applies it to the core and the order views and sends its
+  // messages. False (and *status) when the store failed: nothing changed.
+  bool Commit(const engine::Change& change, const ServerRound* round, ServiceStatus* status = nullptr);
+  // The robot as stored: the core's robot and the session.
+  storage::RobotRecord RecordOf(const std::string& robot_id) const;
+  // Stamps the robot's next message sequence and the time, and sends if connected.
+  void SendTo(const std::string& robot_id, RobotOutbound message);
+  void Send(std::vector<engine::RobotCommand> commands);
   // Publishes a committed journal event to the watchers (deferred, see Defer).
   void Journal(const storage::OrderEvent& event);
   // Runs `effect` at the end of this batch; with `after_publish` only once the snapshot
@@ -224,79 +240,30 @@ class Dispatcher {
   // holds need no snapshot and do not force one (see Flush).
   void Defer(std::function<void()> effect, bool after_publish = true);
   void CloseLink(const std::shared_ptr<RobotLink>& link, ServiceStatus status);
-  std::string NextOrderId();
 
-  // Allocation rounds (dispatcher_allocation.cpp): the core's RoundRunner on the allocation
-  // worker, from a copy of its inputs made on the loop thread.
-  // What must not have changed for an award computed on the copy to be committed.
-  struct RoundKey {
-    std::uint64_t plan_id = 0;
-    std::string last_order;  // the queue's last order ("": none)
-    engine::PointId start = engine::kNoPoint;
-    bool operator==(const RoundKey& o) const {
-      return plan_id == o.plan_id && last_order == o.last_order && start == o.start;
-    }
-  };
-  struct RoundAward {
-    engine::RoundAward plan;  // segments per winner (its award moved into record)
-    AllocationRecord record;  // the award and the weights it was made with
-    std::string detail;       // the explanation as stored (AllocationDetail), made on the worker
-  };
-  // A round's awards on their way into the store, kCommitChunk per loop turn.
-  struct RoundCommit {
-    std::map<std::string, RoundKey> keys;  // as the round saw them; then as committed
-    std::vector<RoundAward> awards;
-    std::size_t next = 0;                  // the first award not looked at yet
-    std::set<std::string> spoiled;         // robots the round may not change any more
-  };
-  // Loop: starts a round on the allocation worker (or marks one due after the running one).
+  // Allocation rounds (dispatcher_allocation.cpp): the core's round inputs, run by the
+  // RoundRunner on the allocation worker, committed back a few awards per loop turn.
   void AllocatePending();
-  // Loop: whether a round may use the robot; where a new plan of it would start; its key.
-  bool Eligible(const RobotRuntime& robot) const;
-  engine::PointId StartOf(const RobotRuntime& robot) const;
-  RoundKey KeyOf(const RobotRuntime& robot) const;
-  // Worker: the round's awards.
-  std::vector<RoundAward> RunRound(const engine::RoundInput& input);
-  // Loop: commits the round's next kCommitChunk awards, in one store transaction: those whose
-  // orders are still accepted and whose robots are still eligible with the keys the round saw;
-  // marks another round due when some were not. False if the store failed (nothing of this
-  // chunk changed).
-  bool CommitRound(RoundCommit& commit);
-  // Loop: CommitRound, then the rest of the round in a later loop turn (robots are served in
-  // between), then the end of the round.
-  void CommitNext(std::shared_ptr<RoundCommit> commit);
-  // Takes `order_ids` away from their robots and moves each to target(order) (cancelled,
-  // failed, or accepted for re-allocation) with `reason`; orders queued after them on the
-  // same robots go back to accepted. One store transaction; false (and *status) on failure,
-  // with nothing changed.
-  bool ReleaseOrders(const std::vector<std::string>& order_ids,
-                     const std::function<engine::OrderState(const OrderView&)>& target,
-                     const std::string& reason, ServiceStatus* status);
-  // Assignment (full plan) or PlanUpdate (waypoints from `from_sequence` on).
-  RobotOutbound PlanMessage(const RobotRuntime& robot, bool full, std::uint64_t from_sequence) const;
-  // Stamps the robot's next message sequence and the time, and sends if connected.
-  void SendTo(RobotRuntime& robot, RobotOutbound message);
-  RobotRuntime* RobotOf(const std::string& id);
+  std::shared_ptr<ServerRound> RunRound(const engine::RoundInput& input);
+  void CommitNext(std::shared_ptr<ServerRound> round);
 
   // Robots (dispatcher_robots.cpp).
   void DoRobotMessage(const std::shared_ptr<RobotLink>& link, const RobotInbound& message);
   void DoHello(const std::shared_ptr<RobotLink>& link, const RobotInbound& hello);
-  void DoWaypointReached(RobotRuntime& robot, const RobotInbound& message);
-  void DoTaskEvent(RobotRuntime& robot, const engine::TaskReport& report);
-  // Runs the robot's waiting picks and drops again (it reported progress).
-  void RetryTaskEvents(RobotRuntime& robot, std::vector<engine::TaskReport> waiting);
+  // A report's outcome: its order start stored, then the picks and drops that waited for it.
+  void Progressed(const std::string& robot_id, engine::ReportOutcome outcome);
+  void DoTaskEvent(const std::string& robot_id, const engine::TaskReport& report);
   // A report that was not plausible (engine/dispatch/report_check.h): logged and counted.
-  void Implausible(RobotRuntime& robot, const std::string& what, const std::string& why);
+  void Implausible(const std::string& robot_id, const std::string& what, const std::string& why);
   void DoRobotGone(const std::shared_ptr<RobotLink>& link);
-  void MarkOffline(RobotRuntime& robot, const std::string& why);
-  // Places a robot that is not connected in the gate at its stored point (an obstacle).
-  void PlaceAway(const RobotRuntime& robot);
+  void MarkOffline(const std::string& robot_id, const std::string& why);
+  // The robot is lost (offline too long, blocked): its orders go back (core PlanLoss).
+  bool LoseRobot(const std::string& robot_id, const std::string& why);
   // The robot reported after a restart; the wait ends when nobody is awaited any more.
   void Reported(const std::string& robot_id);
   // The wait after a restart is over: traffic control resumes (dispatcher_traffic.cpp).
   void EndRecoveryWait(bool timed_out);
   std::string AwaitedList() const;  // "R3, R7": the robots the wait is for
-  void StartOrder(const std::string& order_id, const std::string& detail);
   void Tick();
   void Publish();
   // Publishes the snapshot if anything changed, then runs the deferred effects.
@@ -305,11 +272,7 @@ class Dispatcher {
   std::vector<ZoneView> ZoneViews(const std::map<std::string, RobotView>& robots) const;
 
   // Traffic control (dispatcher_traffic.cpp).
-  engine::GatePlan GatePlanOf(const RobotRuntime& robot) const;
-  void SyncGate(const RobotRuntime& robot);  // tells the gate the robot's current plan
   void StepTraffic();
-  void ApplyGateEffect(engine::GateEffect& effect);
-  std::uint64_t ReleasedUpTo(const RobotRuntime& robot) const;
 
   const std::shared_ptr<const engine::WarehouseMap> map_;
   const std::shared_ptr<const engine::RouteTable> routes_;
@@ -330,7 +293,7 @@ class Dispatcher {
   // Allocation worker state (only rounds on allocation_worker_ touch it).
   std::unique_ptr<engine::RoundRunner> rounds_;
   // Loop-thread state (no lock: only the loop touches it after Start).
-  std::unique_ptr<engine::TrafficGate> gate_;  // null when traffic control is off
+  std::unique_ptr<engine::DispatchCore> core_;  // the dispatch book and its rules
   Clock::time_point wall_start_;
   double time_base_ = 0.0;  // dispatcher seconds at wall_start_
   // The book: every open order and the newest finished ones, by position (submission order).
@@ -342,7 +305,7 @@ class Dispatcher {
   std::uint64_t book_generation_ = 0;  // changes when orders join or leave the book
   std::uint64_t published_generation_ = 0;
   std::shared_ptr<const Snapshot::OrderIndex> published_index_;  // copy of the two maps above
-  std::map<std::string, RobotRuntime> robots_;
+  std::map<std::string, RobotSession> sessions_;  // every robot the core knows
   std::unordered_map<const RobotLink*, std::string> link_robot_;
   std::int64_t last_order_number_ = 0;
   std::uint64_t snapshot_version_ = 0;
@@ -354,21 +317,17 @@ class Dispatcher {
   // indexes per this many finishes, not one per finish).
   static constexpr std::size_t kRetireSlack = 64;
   Clock::time_point last_publish_{};
-  bool retry_allocation_ = false;
+  bool retry_allocation_ = false;  // a store failure left work for the next tick
   bool allocation_due_ = false;  // an allocation round runs at the end of this batch
   bool round_running_ = false;   // a round is on the worker or waits to be committed
   bool round_again_ = false;     // a round became due meanwhile
   engine::MinDistance min_distance_;
-  std::unordered_map<std::string, double> order_distance_;  // metres driven, open orders
   Clock::time_point next_distance_sample_{};
   // Restart (see the top): robots on line before it that have not reported since, and when
   // the gate stops waiting for them.
   std::set<std::string> awaiting_reconnect_;
   Clock::time_point awaiting_until_{};
-  struct {
-    std::uint64_t grants = 0, holds = 0, replans = 0;
-    std::uint64_t implausible = 0;  // robot reports not taken (Implausible)
-  } traffic_counts_;
+  std::uint64_t implausible_ = 0;  // robot reports not taken (Implausible)
   // Route searches of new orders (SubmitOrder) and allocation rounds: off the loop thread.
   // Stopped first (Stop, destructor): what they still hold reaches the loop's queue.
   std::unique_ptr<WorkerThread> route_worker_;

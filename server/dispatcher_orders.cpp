@@ -167,17 +167,17 @@ void Dispatcher::DoSubmit(const engine::OrderRequest& request,
   }
   ++last_order_number_;
   Put(view);
+  core_->AddOrder(std::move(order));
   reply.order = view;
   reply.created = inserted->created;
   done(std::move(reply));
   storage::EventQuery first;
-  first.order_id = order.id;
+  first.order_id = view->record.order.id;
   first.limit = 1;
   if (auto events = store_.ListEvents(first); events.ok() && !events->empty()) {
     Journal(events->front());
   }
-  spdlog::info("order {} ({}) accepted", order.id, order.client_id);
-  allocation_due_ = true;
+  spdlog::info("order {} ({}) accepted", view->record.order.id, view->record.order.client_id);
 }
 
 void Dispatcher::DoCancel(const std::string& order_id, const std::string& reason,
@@ -207,16 +207,15 @@ void Dispatcher::DoCancel(const std::string& order_id, const std::string& reason
                                   engine::OrderStateName(state) + "; only open orders can be cancelled");
     return done(std::move(reply));
   }
-  ServiceStatus status;
   const std::string why = reason.empty() ? "cancelled by client" : reason;
-  if (!ReleaseOrders({order_id}, [](const OrderView&) { return engine::OrderState::kCancelled; },
-                     why, &status)) {
-    reply.status = status;
+  auto change = core_->PlanCancel(order_id, why, Now());
+  if (!change.ok()) {  // open in the views, not in the core: cannot happen
+    reply.status = FromEngineError(change.error());
     return done(std::move(reply));
   }
+  if (!Commit(*change, nullptr, &reply.status)) return done(std::move(reply));
   reply.order = Find(order_id);
   done(std::move(reply));
-  allocation_due_ = true;
 }
 
 }  // namespace dispatch::server

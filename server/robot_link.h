@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "engine/dispatch/robot_message.h"
 #include "engine/fleet/plan.h"
 #include "engine/fleet/robot.h"
 #include "server/service_status.h"
@@ -44,41 +45,9 @@ struct RobotInbound {
   int point_id = -1;
 };
 
-// A waypoint as sent: the engine waypoint (seq = the robot's life-long waypoint sequence)
-// plus the order it serves and whether the robot may drive to it.
-struct OutboundWaypoint {
-  engine::Waypoint waypoint;
-  std::string order_id;
-  bool released = true;
-};
-
-struct RobotOutbound {
-  enum class Kind { kWelcome, kAssignment, kPlanUpdate, kCancel, kGrant, kHold, kResume };
-  Kind kind = Kind::kWelcome;
-  std::uint64_t sequence = 0;
-  double server_time = 0.0;
-  // kWelcome
-  double time_scale = 1.0;
-  double heartbeat_interval = 1.0;
-  double heartbeat_timeout = 5.0;
-  std::uint64_t resume_from_sequence = 1;
-  std::string map_version;
-  // kAssignment, kPlanUpdate
-  std::uint64_t plan_id = 0;
-  std::uint64_t from_sequence = 0;  // kPlanUpdate
-  std::vector<std::string> order_ids;
-  std::vector<OutboundWaypoint> waypoints;
-  std::uint64_t released_up_to = 0;
-  std::vector<std::string> formation_members;
-  // kCancel (order_ids above: the cancelled orders), kHold: why
-  std::string reason;
-  // kGrant (released_up_to above: the new horizon; intersection -1 for a plain lane release),
-  // kResume (released_up_to above)
-  int intersection_id = -1;
-  std::string intersection_name;
-  // kHold: stop at this waypoint sequence (0: at once)
-  std::uint64_t stop_at_sequence = 0;
-};
+// What the dispatcher tells a robot: the core's message (engine/dispatch/robot_message.h).
+using OutboundWaypoint = engine::MessageWaypoint;
+using RobotOutbound = engine::RobotMessage;
 
 class RobotLink {
  public:
