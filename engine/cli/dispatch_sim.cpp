@@ -29,6 +29,7 @@
 #include "engine/dispatch/strategy.h"
 #include "engine/io/map_source.h"
 #include "engine/routing/route_table.h"
+#include "engine/sim/core_stream.h"
 #include "engine/sim/fleet_placement.h"
 #include "engine/sim/head_on_scenario.h"
 #include "engine/sim/order_stream.h"
@@ -148,6 +149,9 @@ struct StreamArgs {
   std::uint64_t seed = 1;
   double interval = 2.0, zeta = 100.0, dt = 0.1, max_time = 36000.0, formations = 0.0;
   bool check_safety = false;
+  // "core": the service's dispatch core with robots following its messages (core_stream.h);
+  // "stream": the order-stream model (order_stream.h).
+  std::string model = "core";
 };
 
 struct Setup {
@@ -195,6 +199,11 @@ StreamConfig ConfigOf(const StreamArgs& a, const std::string& strategy, double z
   return c;
 }
 
+Result<StreamResult> Simulate(const StreamArgs& a, const Setup& s, const StreamConfig& c) {
+  if (a.model == "core") return SimulateOnCore(s.map, s.routes, s.robots, s.orders, c);
+  return SimulateOrderStream(s.map, s.routes, s.robots, s.orders, c);
+}
+
 void PrintSummary(const std::string& label, const StreamResult& r) {
   std::printf("%s: %zu/%zu orders completed, makespan %.1f s, throughput %.1f orders/h, "
               "mean completion %.1f s\n",
@@ -205,11 +214,15 @@ void PrintSummary(const std::string& label, const StreamResult& r) {
               r.total_distance, r.total_waiting_time, r.stops, r.traffic.replans,
               r.traffic.grants, r.traffic.deadlocks_resolved, r.traffic.nudges,
               r.traffic.head_on_conflicts, r.overall_min_distance);
+  if (!r.min_pair.empty()) std::printf("  closest: %s at %.1f s\n", r.min_pair.c_str(), r.min_time);
   if (r.safety) {
     std::printf("  safety check: %zu violations\n", r.safety->violations.size());
     for (std::size_t i = 0; i < r.safety->violations.size() && i < 5; ++i) {
       std::printf("    %s\n", r.safety->violations[i].Describe().c_str());
     }
+  }
+  for (std::size_t i = 0; i < r.too_close.size() && i < 5; ++i) {
+    std::printf("  too close: %s\n", r.too_close[i].c_str());
   }
   for (std::size_t i = 0; i < r.blocked.size() && i < 5; ++i) {
     std::printf("  blocked: %s\n", r.blocked[i].c_str());
@@ -225,8 +238,7 @@ int RunStream(const StreamArgs& a) {
   if (a.orders.empty() && a.random == 0) return Fail("stream: give --orders FILE or --random N");
   auto setup = Prepare(a);
   if (!setup.ok()) return Fail(setup.error().message);
-  auto r = SimulateOrderStream(setup->map, setup->routes, setup->robots, setup->orders,
-                               ConfigOf(a, a.strategy, a.zeta));
+  auto r = Simulate(a, *setup, ConfigOf(a, a.strategy, a.zeta));
   if (!r.ok()) return Fail(r.error().message);
   char label[1024];
   std::snprintf(label, sizeof label, "%s on %s, %zu robots, %s (zeta %g)",
@@ -275,7 +287,7 @@ int RunCompare(StreamArgs a) {
                                       std::tuple{"greedy", "greedy", 0.0}}) {
     StreamConfig c = ConfigOf(a, strategy, zeta);
     c.record_series = false;
-    auto r = SimulateOrderStream(setup->map, setup->routes, setup->robots, setup->orders, c);
+    auto r = Simulate(a, *setup, c);
     if (!r.ok()) return Fail(r.error().message);
     std::printf("%-18s %5zu/%-3zu %10.1f %12.1f %10.1f %10.1f %9.1f %8zu %9zu\n", name,
                 r->completed, r->orders.size(), r->makespan, r->throughput_per_hour,
@@ -326,6 +338,9 @@ int Main(int argc, char** argv) {
         ->capture_default_str()->check(CLI::Range(0.0, 1.0));
     c->add_option("--dt", a.dt, "Time step, s")->capture_default_str()->check(CLI::PositiveNumber);
     c->add_option("--max-time", a.max_time, "Simulated seconds before giving up")->capture_default_str();
+    c->add_option("--model", a.model, "core (the service's dispatch core, robots following its messages) "
+                                      "or stream (the order-stream model)")
+        ->capture_default_str()->check(CLI::IsMember({"core", "stream"}));
     c->add_flag("--check-safety", a.check_safety,
                 "Run CheckSafety over every step (eps1 spacing, crossings in intersections)");
   };

@@ -108,9 +108,14 @@ struct StreamResult {
   std::size_t stops = 0;              // moving -> traffic wait transitions
   TrafficStats traffic;               // re-plans, grants, deadlocks resolved, head-on log
   std::vector<std::string> blocked;   // "R3: blocked after ..." for robots taken off
+  // SimulateOnCore: each time the closest pair came nearer than eps1, the two robots' traffic
+  // state then (as the service logs it).
+  std::vector<std::string> too_close;
   std::vector<double> times;          // per step (record_series)
   std::vector<double> min_distance;   // per step, +inf when no pair within distance_cap
   double overall_min_distance = std::numeric_limits<double>::infinity();
+  std::string min_pair;       // "R3 R7" at overall_min_distance (SimulateOnCore)
+  double min_time = 0.0;      // when (SimulateOnCore)
   std::size_t steps = 0;
   std::optional<SafetyReport> safety;  // when StreamConfig::check_safety
   std::vector<SafetyFrame> frames;     // when StreamConfig::record_frames

@@ -1,0 +1,42 @@
+// Order-stream simulation on the dispatch core (issue 15 §3): the service's DispatchCore
+// (engine/dispatch/dispatch_core.h) - allocation rounds, awards, the TrafficGate with its
+// formation teams, picks, drops, releases of blocked robots - driven in process by robots that
+// follow its messages (WaypointRobot), on a fixed time step, deterministically. What a
+// formation, a re-plan or a grant does here is what it does in dispatchd.
+//
+// Loop per step t (dt = time_step):
+//  1. Orders whose release time (else created time) is <= t enter the core.
+//  2. When the core says a round is due (an order arrived or came back, a robot finished an
+//     order) - and, with allocation_period > 0, at most every allocation_period - one round of
+//     the chosen strategy runs on the core's inputs and all its awards that still hold are
+//     applied (the service commits them a few per loop turn; here at once).
+//  3. Every robot advances to t and reports (arrivals, picks, drops, then a state report);
+//     the core's changes are applied and its messages delivered at once (no network).
+//  4. The gate steps (grants, holds, re-plans); a blocked robot gives its orders back (started
+//     ones fail, the others are re-allocated) and stays where it stands, in fault.
+// Orders not finished by max_time fail ("not finished by ...").
+//
+// StreamResult: per order, the leader (robots[0] of the award), the team, completion time or
+// failure; the gate's traffic statistics; total distance driven, robot-seconds waiting with a
+// plan (not moving, not working), moving -> waiting transitions; overall_min_distance is the
+// gate's (centre distance of robots of different agents, from the robots' positions at every
+// step). The per-step distance series and CheckSafety frames are not recorded (config
+// record_series / check_safety / record_frames are ignored); nor is `preassigned` supported.
+//
+// Pure function of its inputs; thread-safe.
+#pragma once
+
+#include <memory>
+#include <vector>
+
+#include "engine/sim/order_stream.h"
+
+namespace dispatch::engine {
+
+// Errors: bad config, null map/routes, no robots, the preassigned strategy, robots that cannot
+// be placed (unknown or shared start points).
+Result<StreamResult> SimulateOnCore(std::shared_ptr<const WarehouseMap> map, std::shared_ptr<const RouteTable> routes,
+                                    const std::vector<FleetRobot>& robots, std::vector<Order> orders,
+                                    const StreamConfig& config = {});
+
+}  // namespace dispatch::engine

@@ -1,0 +1,86 @@
+// A simulated robot that follows the dispatch core's messages (issue 15 §3: the simulator is
+// the core plus a motion model): it stands on or drives between the waypoints of its current
+// plan, straight towards the next one at up to `speed` m/s, never past the last released
+// waypoint, never leaving a waypoint before its planned departure (eta + dwell: ahead of plan
+// it waits, behind plan it goes at full speed). At a waypoint with a dwell it stands that long;
+// at a pick or drop it then reports the pick or drop. Every waypoint reached is reported once,
+// in order.
+//
+// Messages (Apply): an Assignment replaces the plan, a PlanUpdate its tail from from_sequence;
+// Grant and Resume raise the release horizon; Hold stops it at once (or at a waypoint) until
+// Resume; Cancel voids the named orders' waypoints (it stops at its next waypoint).
+//
+// Fault model: a stalled robot stands still (it still reports).
+//
+// The same rules as the wire robot of fleet-sim (clients/sim_robot.h), on the engine's values
+// and in process. Not thread-safe: one owner.
+#pragma once
+
+#include <Eigen/Core>
+
+#include <cstdint>
+#include <deque>
+#include <string>
+#include <vector>
+
+#include "engine/dispatch/robot_message.h"
+
+namespace dispatch::engine {
+
+struct RobotEvent {
+  enum class Kind { kReached, kPicked, kDropped };
+  Kind kind = Kind::kReached;
+  std::uint64_t sequence = 0;  // the waypoint
+  std::string order_id;        // kPicked, kDropped
+};
+
+class WaypointRobot {
+ public:
+  WaypointRobot(std::string id, const Eigen::Vector2d& xy, double speed);
+
+  const std::string& id() const { return id_; }
+  const Eigen::Vector2d& xy() const { return xy_; }
+  double heading() const { return heading_; }
+  std::uint64_t last_reached() const { return last_reached_; }
+  bool moving() const { return moving_; }
+  bool working() const { return dwelling_; }
+  // No plan left: standing on its last waypoint (or never given one), not working.
+  bool idle() const;
+  double driven() const { return driven_; }  // metres so far
+  void set_stalled(bool stalled) { stalled_ = stalled; }
+
+  void Apply(const RobotMessage& message);
+  // Advances to `now` (>= the previous call's), appending what happened to `out`.
+  void Step(double now, std::vector<RobotEvent>& out);
+
+ private:
+  struct Stop {
+    Waypoint wp;
+    std::string order_id;
+    bool arrived = false;
+  };
+  void Adopt(const std::vector<MessageWaypoint>& wps);
+  void Arrive(Stop& s, double t, std::vector<RobotEvent>& out);
+  void Finish(const Stop& s, std::vector<RobotEvent>& out) const;
+  bool Released(const Stop& s) const { return static_cast<std::uint64_t>(s.wp.seq) <= released_up_to_; }
+
+  std::string id_;
+  Eigen::Vector2d xy_;
+  double heading_ = 0.0;
+  double speed_;
+  double now_ = 0.0;
+  bool started_ = false;
+  bool moving_ = false;
+  double driven_ = 0.0;
+  std::deque<Stop> stops_;  // the front is the one driven to (or stood on)
+  std::uint64_t released_up_to_ = 0;
+  std::uint64_t last_reached_ = 0;
+  bool held_ = false;
+  std::uint64_t hold_at_ = 0;  // stop at this waypoint (0: at once)
+  bool dwelling_ = false;
+  double dwell_until_ = 0.0;
+  Stop dwell_stop_;
+  bool stalled_ = false;
+};
+
+}  // namespace dispatch::engine

@@ -1,0 +1,126 @@
+// SimulateOnCore (engine/sim/core_stream.h): the service's DispatchCore driven by in-process
+// robots - the seed's task tables, a 200-order stream under the three strategies, determinism
+// and the errors.
+#include "engine/sim/core_stream.h"
+
+#include <gtest/gtest.h>
+
+#include <set>
+#include <string>
+#include <vector>
+
+#include "engine/cli/scenario.h"
+#include "order_stream_test_support.h"
+
+namespace dispatch::engine::testing {
+namespace {
+
+std::vector<Order> TaskTable(const World& w, const std::string& name) {
+  auto orders = LoadTaskTableOrders(*w.map, std::string(DISPATCH_SHARED_DIR) + "/scenarios/" + name);
+  if (!orders.ok()) throw std::runtime_error(orders.error().message);
+  return std::move(orders).value();
+}
+
+std::vector<FleetRobot> Fleet(const World& w, std::size_t n) {
+  auto robots = PlaceRobots(*w.map, n);
+  if (!robots.ok()) throw std::runtime_error(robots.error().message);
+  return std::move(robots).value();
+}
+
+StreamConfig Config(AllocationStrategy strategy = AllocationStrategy::kAuction, double zeta = 100.0) {
+  StreamConfig c;
+  c.strategy = strategy;
+  c.allocation.zeta = zeta;
+  c.max_time = 20000;
+  c.record_series = false;
+  return c;
+}
+
+// Every order completes, robots keep eps1 (0.6 m) apart and the gate granted intersections.
+void ExpectCompleteAndClear(const World& w, const std::vector<Order>& orders, const StreamResult& r,
+                            const StreamConfig& c) {
+  ExpectSane(w, orders, r, c);
+  EXPECT_EQ(r.completed, orders.size());
+  EXPECT_GE(r.overall_min_distance, 0.6 - 1e-9) << r.min_pair << " at " << r.min_time;
+  EXPECT_TRUE(r.too_close.empty()) << r.too_close.front();
+  EXPECT_TRUE(r.blocked.empty()) << r.blocked.front();
+  EXPECT_GT(r.traffic.grants, 0u);
+}
+
+TEST(CoreStreamTest, TaskTablesCompleteOnTheCoreWithClearance) {
+  const World w = Chu();
+  for (const char* table : {"chu2024-table1.csv", "chu2024-table2.csv"}) {
+    SCOPED_TRACE(table);
+    const std::vector<Order> orders = TaskTable(w, table);
+    ASSERT_FALSE(orders.empty());
+    const StreamConfig c = Config();
+    auto r = SimulateOnCore(w.map, w.routes, Fleet(w, 18), orders, c);
+    ASSERT_TRUE(r.ok()) << r.error().message;
+    ExpectCompleteAndClear(w, orders, *r, c);
+  }
+}
+
+TEST(CoreStreamTest, RandomStreamAuctionBeatsGreedyOnTheCore) {
+  const World w = Chu();
+  const Stream s = ChuStream(w, 200, 1);
+  double makespan[3] = {0, 0, 0};
+  int k = 0;
+  for (auto [strategy, zeta] : {std::pair{AllocationStrategy::kAuction, 100.0}, std::pair{AllocationStrategy::kAuction, 0.0},
+                                std::pair{AllocationStrategy::kGreedy, 0.0}}) {
+    SCOPED_TRACE(k);
+    const StreamConfig c = Config(strategy, zeta);
+    auto r = SimulateOnCore(w.map, w.routes, s.robots, s.orders, c);
+    ASSERT_TRUE(r.ok()) << r.error().message;
+    ExpectCompleteAndClear(w, s.orders, *r, c);
+    std::set<std::string> used;
+    for (const StreamOrderOutcome& o : r->orders) used.insert(o.robot);
+    EXPECT_EQ(used.size(), s.robots.size());  // the whole fleet works
+    makespan[k++] = r->makespan;
+  }
+  // The auction (with and without the traffic term) finishes the stream before greedy.
+  EXPECT_LT(makespan[0], makespan[2]);
+  EXPECT_LT(makespan[1], makespan[2]);
+}
+
+TEST(CoreStreamTest, RunsAreDeterministic) {
+  const World w = Chu();
+  const Stream s = ChuStream(w, 40, 3);
+  const StreamConfig c = Config();
+  auto a = SimulateOnCore(w.map, w.routes, s.robots, s.orders, c);
+  auto b = SimulateOnCore(w.map, w.routes, s.robots, s.orders, c);
+  ASSERT_TRUE(a.ok() && b.ok());
+  ASSERT_EQ(a->orders.size(), b->orders.size());
+  for (std::size_t i = 0; i < a->orders.size(); ++i) {
+    EXPECT_EQ(a->orders[i].robot, b->orders[i].robot);
+    EXPECT_EQ(a->orders[i].completion_time, b->orders[i].completion_time);
+  }
+  EXPECT_EQ(a->traffic.grants, b->traffic.grants);
+  EXPECT_EQ(a->total_distance, b->total_distance);
+}
+
+TEST(CoreStreamTest, RejectsWhatItCannotRun) {
+  const World w = Chu();
+  const Stream s = ChuStream(w, 5, 1);
+  StreamConfig pre = Config(AllocationStrategy::kPreassigned);
+  EXPECT_FALSE(SimulateOnCore(w.map, w.routes, s.robots, s.orders, pre).ok());
+  EXPECT_FALSE(SimulateOnCore(w.map, w.routes, {}, s.orders, Config()).ok());
+  StreamConfig zero = Config();
+  zero.time_step = 0;
+  EXPECT_FALSE(SimulateOnCore(w.map, w.routes, s.robots, s.orders, zero).ok());
+  EXPECT_FALSE(SimulateOnCore(nullptr, w.routes, s.robots, s.orders, Config()).ok());
+
+  std::vector<FleetRobot> shared = {s.robots[0], s.robots[1]};
+  shared[1].start = shared[0].start;
+  auto same = SimulateOnCore(w.map, w.routes, shared, s.orders, Config());
+  ASSERT_FALSE(same.ok());
+  EXPECT_NE(same.error().message.find("starts where another robot stands"), std::string::npos);
+
+  std::vector<Order> formation = {s.orders[0]};
+  formation[0].formation = true;
+  auto two = SimulateOnCore(w.map, w.routes, {s.robots[0], s.robots[1]}, formation, Config());
+  ASSERT_FALSE(two.ok());
+  EXPECT_NE(two.error().message.find("needs 3 robots"), std::string::npos) << two.error().message;
+}
+
+}  // namespace
+}  // namespace dispatch::engine::testing
