@@ -2,7 +2,7 @@
 //   dispatch-sim plan --table ../shared/scenarios/chu2024-table1.csv --rules both --csv fig8.csv
 //       allocate a task table with the auction on the Chu2024 floor (R1..R18), execute the
 //       timed plans with the Chu2024 rules off and/or on (seed 000 Fig. 8, Tables 3-4).
-//   dispatch-sim stream --map chu2024 --robots 18 (--orders FILE | --random 200 --seed 1
+//   dispatch-sim stream --map chu2024 --robots 18 (--orders FILE... [--repeat N] | --random 200 --seed 1
 //       [--formations 0.2]) [--strategy auction|greedy] [--zeta 100] [--csv series.csv]
 //       [--orders-csv out.csv] [--check-safety]
 //       an order stream with release times (formation orders too) under the online traffic
@@ -144,8 +144,9 @@ int RunPlan(const PlanArgs& args) {
 }
 
 struct StreamArgs {
-  std::string map = "chu2024", orders, csv, orders_csv, strategy = "auction";
-  std::size_t robots = 18, random = 0;
+  std::string map = "chu2024", csv, orders_csv, strategy = "auction";
+  std::vector<std::string> orders;  // task tables, submitted together
+  std::size_t robots = 18, random = 0, repeat = 1;
   std::uint64_t seed = 1;
   double interval = 2.0, zeta = 100.0, dt = 0.1, max_time = 36000.0, formations = 0.0;
   bool check_safety = false;
@@ -173,9 +174,20 @@ Result<Setup> Prepare(const StreamArgs& a) {
   if (!robots.ok()) return robots.error();
   s.robots = std::move(robots).value();
   if (!a.orders.empty()) {
-    auto orders = LoadTaskTableOrders(*s.map, a.orders);
-    if (!orders.ok()) return orders.error();
-    s.orders = std::move(orders).value();
+    // Every table `repeat` times, all at once: with two tables, copy k of table 2's task T3
+    // is T3.2-k.
+    for (std::size_t k = 1; k <= a.repeat; ++k) {
+      for (std::size_t i = 0; i < a.orders.size(); ++i) {
+        auto loaded = LoadTaskTableOrders(*s.map, a.orders[i]);
+        if (!loaded.ok()) return loaded.error();
+        for (Order& o : loaded.value()) {
+          if (a.orders.size() > 1) o.id += "." + std::to_string(i + 1);
+          if (a.repeat > 1) o.id += "-" + std::to_string(k);
+          o.client_id = o.id;
+          s.orders.push_back(std::move(o));
+        }
+      }
+    }
   } else {
     RandomOrderOptions ro;
     ro.count = a.random;
@@ -197,6 +209,14 @@ StreamConfig ConfigOf(const StreamArgs& a, const std::string& strategy, double z
   c.allocation.zeta = zeta;
   c.check_safety = a.check_safety;
   return c;
+}
+
+// "t1.csv + t2.csv x 10"
+std::string TablesLabel(const StreamArgs& a) {
+  std::string out;
+  for (const std::string& t : a.orders) out += (out.empty() ? "" : " + ") + t;
+  if (a.repeat > 1) out += " x " + std::to_string(a.repeat);
+  return out;
 }
 
 Result<StreamResult> Simulate(const StreamArgs& a, const Setup& s, const StreamConfig& c) {
@@ -242,7 +262,7 @@ int RunStream(const StreamArgs& a) {
   if (!r.ok()) return Fail(r.error().message);
   char label[1024];
   std::snprintf(label, sizeof label, "%s on %s, %zu robots, %s (zeta %g)",
-                a.orders.empty() ? "random stream" : a.orders.c_str(), a.map.c_str(),
+                a.orders.empty() ? "random stream" : TablesLabel(a).c_str(), a.map.c_str(),
                 setup->robots.size(), a.strategy.c_str(), a.zeta);
   PrintSummary(label, *r);
   if (!a.orders_csv.empty()) {
@@ -276,7 +296,7 @@ int RunCompare(StreamArgs a) {
   if (!setup.ok()) return Fail(setup.error().message);
   std::printf("%zu orders (%s), %zu robots on %s, dt %g s\n", setup->orders.size(),
               a.orders.empty() ? ("random, seed " + std::to_string(a.seed)).c_str()
-                               : a.orders.c_str(),
+                               : TablesLabel(a).c_str(),
               setup->robots.size(), a.map.c_str(), a.dt);
   std::printf("%-18s %9s %10s %12s %10s %10s %9s %8s %9s\n", "strategy", "completed",
               "makespan", "throughput/h", "mean compl", "waiting s", "distance", "replans",
@@ -330,7 +350,9 @@ int Main(int argc, char** argv) {
   auto add_stream = [](CLI::App* c, StreamArgs& a) {
     c->add_option("--map", a.map, "chu2024, a JSON map file or a MovingAI .map")->capture_default_str();
     c->add_option("--robots", a.robots, "Robots (stations first, then lane points)")->capture_default_str();
-    c->add_option("--orders", a.orders, "Task table CSV (optional release column)");
+    c->add_option("--orders", a.orders, "Task table CSVs (optional release column), submitted together");
+    c->add_option("--repeat", a.repeat, "Submit the task tables this many times at once")
+        ->capture_default_str()->check(CLI::PositiveNumber);
     c->add_option("--random", a.random, "Random orders instead of a table");
     c->add_option("--seed", a.seed, "Seed of the random orders")->capture_default_str();
     c->add_option("--interval", a.interval, "Mean seconds between random releases")->capture_default_str();

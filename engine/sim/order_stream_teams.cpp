@@ -76,8 +76,16 @@ void StreamSim::SyncGroup(std::size_t r) {
 
 void StreamSim::KeepFormer(Bot& b, int team) {
   // One former team at a time (the controller has two groups: the current team and this
-  // one). An older one whose members are not apart yet stays: they may still be close.
-  if (b.former < 0 || teams_[static_cast<std::size_t>(b.former)].apart) b.former = team;
+  // one). An older one whose members are not apart yet stays while b is still near one of
+  // them; else the team it leaves now, whose members stand right beside it, takes its place.
+  if (b.former >= 0 && !teams_[static_cast<std::size_t>(b.former)].apart) {
+    const std::size_t me = static_cast<std::size_t>(&b - bots_.data());
+    for (std::size_t m : teams_[static_cast<std::size_t>(b.former)].members) {
+      if (m == me || bots_[m].removed || bots_[m].former != b.former) continue;
+      if ((Position(m) - Position(me)).norm() < clearance_ - 1e-9) return;
+    }
+  }
+  b.former = team;
 }
 
 void StreamSim::MemberStart(std::size_t r, double t, PointId& start, double& ready) const {

@@ -102,6 +102,11 @@ struct TrafficController::Impl {
     const int pa = Priority(a), pb = Priority(b);
     return pa != pb ? pa < pb : a > b;
   }
+  // Robots of one formation (a shared group) may come closer than eps1.
+  static bool Mates(const RobotState& a, const RobotState& b) {
+    return (a.group > 0 && (b.group == a.group || b.group2 == a.group)) ||
+           (a.group2 > 0 && (b.group == a.group2 || b.group2 == a.group2));
+  }
   std::string Name(PointId p) const { return "'" + M().point(p).name + "'"; }
 
   // Points, corridors, grants and waits (traffic_controller_requests.cpp).
@@ -120,6 +125,14 @@ struct TrafficController::Impl {
   TrafficDecision HeadOn(std::size_t r, int c, int oncoming, double t);
   TrafficDecision Request(std::size_t r, double t);
   TrafficDecision Check(std::size_t r, PointId q, double t);
+  // The agent at work that r would stand behind with no way around it if it drove on: along
+  // r's route from index `from` (while each point has no other way out), an agent standing at
+  // work on a point r needs, working beyond blocked_after from t - or, with box_exit, at all on
+  // the point at `from` (the exit of the intersection r would enter). -1: none.
+  int WorkAhead(std::size_t r, std::size_t from, bool box_exit, double t) const;
+  // True when a robot at p may leave it other than to `next`: by an arc to a point that is not
+  // a dead end leading only back to p (a dock beside an aisle is no way around).
+  bool TurnOff(PointId p, PointId next) const;
   void Arrived(std::size_t r);
   void Remove(std::size_t r);
 

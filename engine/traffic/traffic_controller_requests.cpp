@@ -20,10 +20,7 @@ int TrafficController::Impl::PointBlocker(PointId q, std::size_t r) const {
   // Chu2024 eqs. (10)-(12): eps1 between singles, eps1 + D_f single-formation, eps1 + 2 D_f
   // between formations: each agent's envelope adds to the clearance.
   const RobotState& me = robots[r];
-  auto mates = [&](const RobotState& o) {
-    return (me.group > 0 && (o.group == me.group || o.group2 == me.group)) ||
-           (me.group2 > 0 && (o.group == me.group2 || o.group2 == me.group2));
-  };
+  auto mates = [&](const RobotState& o) { return Mates(me, o); };
   const double own = config.point_clearance + robots[r].envelope - 1e-9;
   for (const auto& [n, d] : near[static_cast<std::size_t>(q)]) {
     const int hn = holder[static_cast<std::size_t>(n)];
@@ -206,7 +203,7 @@ TrafficDecision TrafficController::Impl::Request(std::size_t r, double t) {
                         ? TryDetour(r, kNoPoint, x.wait_corridor, -1, false)
                         : x.wait == WaitKind::kGrant
                               ? TryDetour(r, kNoPoint, -1, M().IntersectionOf(q), false)
-                              : TryDetour(r, q, -1, -1, false);
+                              : TryDetour(r, x.wait_point != kNoPoint ? x.wait_point : q, -1, -1, false);
     if (ok) return TrafficDecision::kReplanned;
   }
   if (waited >= config.blocked_after) {
@@ -217,6 +214,32 @@ TrafficDecision TrafficController::Impl::Request(std::size_t r, double t) {
     return TrafficDecision::kBlocked;
   }
   return TrafficDecision::kWait;
+}
+
+int TrafficController::Impl::WorkAhead(std::size_t r, std::size_t from, bool box_exit, double t) const {
+  const RobotState& x = robots[r];
+  for (std::size_t k = from; k < x.route.size(); ++k) {
+    const PointId p = x.route[k];
+    if (const int w = PointBlocker(p, r); w >= 0 && k > x.pos + 1) {
+      const RobotState& o = robots[static_cast<std::size_t>(w)];
+      const bool long_work = o.work_end > t + config.blocked_after;
+      if (o.working && o.next == kNoPoint && !Mates(x, o) && ((box_exit && k == from) || long_work)) return w;
+    }
+    if (k + 1 >= x.route.size() || TurnOff(p, x.route[k + 1])) break;
+    if (k >= 1 && x.route[k + 1] == x.route[k - 1]) break;  // it turns back here (a back-off)
+  }
+  return -1;
+}
+
+bool TrafficController::Impl::TurnOff(PointId p, PointId next) const {
+  for (ArcId a : M().out_arcs(p)) {
+    const PointId q = M().arc(a).to;
+    if (q == next) continue;
+    for (ArcId b : M().out_arcs(q)) {
+      if (M().arc(b).to != p) return true;  // not a dead end (a dock) that only leads back
+    }
+  }
+  return false;
 }
 
 TrafficDecision TrafficController::Impl::Check(std::size_t r, PointId q, double t) {
@@ -236,12 +259,27 @@ TrafficDecision TrafficController::Impl::Check(std::size_t r, PointId q, double 
     return HeadOn(r, c, on, t);
   }
   const int g = config.intersection_grants ? M().IntersectionOf(q) : -1;
-  if (g >= 0 && M().IntersectionOf(x.at) != g) {
+  const bool entering = g >= 0 && M().IntersectionOf(x.at) != g;
+  std::size_t k = x.pos + 1;  // entering: the last route point inside the intersection
+  while (entering && k + 1 < x.route.size() && M().IntersectionOf(x.route[k + 1]) == g) ++k;
+  const PointId exit = entering && k + 1 < x.route.size() ? x.route[k + 1] : kNoPoint;
+  // Do not block the box, nor an aisle: it does not drive into an intersection whose exit is
+  // taken by an agent standing at work, nor onto points with no turn-off before an agent that
+  // works longer than anyone may wait (a formation assembling). It waits where it can still
+  // be passed: inside, it would hold the grant or the aisle for as long as the work lasts, and
+  // the robots the work waits for may need them.
+  if (const int w = WorkAhead(r, entering ? k + 1 : x.pos + 1, entering, t); w >= 0) {
+    ReleaseGuard(r);
+    const RobotState& o = robots[static_cast<std::size_t>(w)];
+    x.wait_point = o.at;
+    return Wait(r, WaitKind::kPoint, w, t,
+                (entering && o.at == exit ? "exit of " + M().intersections()[static_cast<std::size_t>(g)].name + ": "
+                                          : std::string("no turn-off before ")) +
+                    Name(o.at) + " held by " + o.id + " at work");
+  }
+  if (entering) {
     if (x.guard != g) {
       ReleaseGuard(r);
-      std::size_t k = x.pos + 1;
-      while (k + 1 < x.route.size() && M().IntersectionOf(x.route[k + 1]) == g) ++k;
-      const PointId exit = k + 1 < x.route.size() ? x.route[k + 1] : kNoPoint;
       (void)grants.Request(static_cast<std::size_t>(g),
                            {x.id, {x.at, exit}, t, Priority(r)});
       x.guard = g;
