@@ -185,6 +185,9 @@ Status TrafficController::Place(std::size_t r, PointId at) {
 }
 bool TrafficController::removed(std::size_t r) const { return impl_->robots.at(r).removed; }
 int TrafficController::HolderOf(PointId p) const { return impl_->holder.at(static_cast<std::size_t>(p)); }
+int TrafficController::BlockerOf(PointId p, std::size_t r, double envelope) const {
+  return impl_->PointBlocker(p, r, envelope);
+}
 int TrafficController::WaitsOn(std::size_t r) const {
   const RobotState& x = impl_->robots.at(r);
   return x.wait == WaitKind::kNone ? -1 : x.waits_on;

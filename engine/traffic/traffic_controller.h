@@ -152,6 +152,9 @@ class TrafficController {
   bool removed(std::size_t r) const;
   // The robot holding point p (standing there, driving to it, or not yet clear of it), or -1.
   int HolderOf(PointId p) const;
+  // The robot that keeps r (in its group, with envelope `envelope`) off point p: holding it or
+  // a point within the pair's clearance; -1 when none.
+  int BlockerOf(PointId p, std::size_t r, double envelope) const;
   // The robot r waits on (see ResolveDeadlocks), or -1 when it does not wait.
   int WaitsOn(std::size_t r) const;
   // A wait the owner sees and the controller cannot: robot r (standing, no route: e.g. a

@@ -110,7 +110,9 @@ struct TrafficController::Impl {
   std::string Name(PointId p) const { return "'" + M().point(p).name + "'"; }
 
   // Points, corridors, grants and waits (traffic_controller_requests.cpp).
-  int PointBlocker(PointId q, std::size_t r) const;
+  int PointBlocker(PointId q, std::size_t r) const { return PointBlocker(q, r, robots[r].envelope); }
+  // With r's envelope taken as `envelope` (an agent about to be placed with another one).
+  int PointBlocker(PointId q, std::size_t r, double envelope) const;
   int CorridorBlocker(int c, int d, std::size_t r) const;
   void HoldCorridor(int c, int d, std::size_t r);
   void DropCorridor(int c, std::size_t r);

@@ -14,14 +14,14 @@
 
 namespace dispatch::engine {
 
-int TrafficController::Impl::PointBlocker(PointId q, std::size_t r) const {
+int TrafficController::Impl::PointBlocker(PointId q, std::size_t r, double envelope) const {
   const int h = holder[static_cast<std::size_t>(q)];
   if (h >= 0 && static_cast<std::size_t>(h) != r) return h;
   // Chu2024 eqs. (10)-(12): eps1 between singles, eps1 + D_f single-formation, eps1 + 2 D_f
   // between formations: each agent's envelope adds to the clearance.
   const RobotState& me = robots[r];
   auto mates = [&](const RobotState& o) { return Mates(me, o); };
-  const double own = config.point_clearance + robots[r].envelope - 1e-9;
+  const double own = config.point_clearance + std::clamp(envelope, 0.0, config.max_envelope) - 1e-9;
   for (const auto& [n, d] : near[static_cast<std::size_t>(q)]) {
     const int hn = holder[static_cast<std::size_t>(n)];
     if (hn < 0 || static_cast<std::size_t>(hn) == r) continue;

@@ -105,9 +105,15 @@ void GateImpl::JoinTeam(GateBot& b, const std::string& order, double t, std::vec
     if (on_p) ctl.Remove(r);  // it stands on the rendezvous point itself: the team takes it over
     if (!PlaceTeamAgent(team, p, t)) {
       if (on_p) (void)ctl.Place(r, p);
-      Hold(b, "formation " + order + ": rendezvous point '" + map->point(p).name + "' is occupied", out);
+      // The controller sees the wait: if whoever is in the way waits on b in turn (it needs
+      // the point b stands on), that is a cycle it breaks.
+      const int blocker = ctl.BlockerOf(p, r, FormationRadius());
+      const std::string why = "formation " + order + ": rendezvous point '" + map->point(p).name + "' is occupied";
+      ctl.WaitOn(r, blocker, t, blocker >= 0 ? why + " by " + ctl.robot_id(static_cast<std::size_t>(blocker)) : why);
+      Hold(b, why, out);
       return;
     }
+    ctl.WaitOn(r, -1, t, {});
   }
   // Into its slot: the rendezvous run up to the formation's first pick. It keeps its point
   // until it is clear of it (StepTeams), then the team agent stands for it.
@@ -298,9 +304,20 @@ void GateImpl::StepTeams(double t, std::vector<GateEffect>& out) {
       bool ready = team.joined.size() == team.members.size();
       for (const MemberView& v : m) ready = ready && v.first_pick >= 0 && v.bot->idx >= v.first_pick;
       if (!ready) {
+        // The assembling agent waits on a member still on its way: a robot that holds that
+        // member up while it waits for the team's point closes a cycle the controller breaks.
+        if (TeamAgentOnFloor(team)) {
+          int awaited = -1;
+          for (const MemberView& v : m) {
+            if (awaited < 0 && v.bot->team != team.order && OnFloor(*v.bot)) awaited = v.bot->ctl;
+          }
+          ctl.WaitOn(static_cast<std::size_t>(team.ctl), awaited, t,
+                     awaited >= 0 ? "formation " + team.order + " waits for " + ctl.robot_id(static_cast<std::size_t>(awaited)) : "");
+        }
         ++it;
         continue;
       }
+      if (TeamAgentOnFloor(team)) ctl.WaitOn(static_cast<std::size_t>(team.ctl), -1, t, {});
       team.phase = GateTeam::Phase::kMoving;
       // From the first pick (formed again after a restart: where the last member is).
       team.k = m[0].bot->idx - m[0].first_pick;

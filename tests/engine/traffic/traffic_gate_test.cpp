@@ -269,6 +269,30 @@ TEST_F(TrafficGateTest, AFormationMovesAsOneAgentAndHoldsItsGrantsTogether) {
   ExpectEps1Kept();
 }
 
+TEST_F(TrafficGateTest, AnAssemblingFormationWaitsOnItsMissingMembersInTheControllersGraph) {
+  // The team's agent holds the rendezvous while members are still on their way: the controller
+  // must see that wait, or a robot holding a member up while it waits for the team's point is a
+  // cycle nobody breaks (the service froze so with formations, issue 15).
+  AddFormation({"park-P1", "park-P2", "park-P3"}, "K3-2-3N", "D-B2", "f1");
+  std::string joined, describe;
+  ASSERT_TRUE(Run(40000, {}, [&] {
+    int in_team = 0;
+    for (const auto& id : team_) {
+      if (gate_->RobotState(id).formation == "f1") {
+        ++in_team;
+        joined = id;
+      }
+    }
+    if (in_team > 0 && in_team < 3) describe = gate_->Describe(joined);
+    return in_team == 3;
+  })) << DescribeAll();
+  ASSERT_FALSE(describe.empty()) << "the members all joined at once";
+  EXPECT_NE(describe.find("waiting on"), std::string::npos) << describe;
+  EXPECT_NE(describe.find("(formation f1 waits for F"), std::string::npos) << describe;
+  ASSERT_TRUE(Run(40000)) << DescribeAll();  // and it still completes
+  ExpectEps1Kept();
+}
+
 TEST_F(TrafficGateTest, AFormationMovingWhenTheServerRestartsIsFormedAgainWhereItIs) { RestartWhileMoving(false); }
 
 TEST_F(TrafficGateTest, AFormationAPointApartInLockstepIsFormedAgainDrivingOn) { RestartWhileMoving(true); }
