@@ -3,6 +3,7 @@
 // are in traffic_gate_teams.cpp, the public interface in traffic_gate.cpp, the shared state in
 // traffic_gate_impl.h.
 #include <algorithm>
+#include <optional>
 #include <cmath>
 #include <unordered_map>
 
@@ -380,13 +381,20 @@ std::pair<std::string, std::string> GateImpl::TeamKeys(const GateBot& b) const {
 }
 
 void GateImpl::SampleDistances(double t) {
+  // Team keys only for pairs closer than the minimum so far (rare once it is near eps1).
   struct Item {
     const GateBot* bot;
-    std::pair<std::string, std::string> keys;
+    mutable std::optional<std::pair<std::string, std::string>> keys;
   };
-  auto same_agent = [](const Item& a, const Item& b) {
-    for (const std::string* x : {&a.keys.first, &a.keys.second}) {
-      if (!x->empty() && (*x == b.keys.first || *x == b.keys.second)) return true;
+  auto keys_of = [this](const Item& i) -> const std::pair<std::string, std::string>& {
+    if (!i.keys) i.keys = TeamKeys(*i.bot);
+    return *i.keys;
+  };
+  auto same_agent = [&](const Item& a, const Item& b) {
+    const auto& ka = keys_of(a);
+    const auto& kb = keys_of(b);
+    for (const std::string* x : {&ka.first, &ka.second}) {
+      if (!x->empty() && (*x == kb.first || *x == kb.second)) return true;
     }
     return false;
   };
@@ -396,15 +404,15 @@ void GateImpl::SampleDistances(double t) {
     if (!b.has_xy || !b.connected) continue;
     const long long cx = static_cast<long long>(std::floor(b.xy.x()));
     const long long cy = static_cast<long long>(std::floor(b.xy.y()));
-    const Item me{&b, TeamKeys(b)};
+    const Item me{&b, std::nullopt};
     for (long long dx = -1; dx <= 1; ++dx) {
       for (long long dy = -1; dy <= 1; ++dy) {
         auto it = cells.find(key(cx + dx, cy + dy));
         if (it == cells.end()) continue;
         for (const Item& o : it->second) {
-          if (same_agent(o, me)) continue;
           const double d = (o.bot->xy - b.xy).norm();
-          if (d < min_distance.distance) min_distance = {d, o.bot->id, b.id, t};
+          if (d >= min_distance.distance || same_agent(o, me)) continue;
+          min_distance = {d, o.bot->id, b.id, t};
         }
       }
     }

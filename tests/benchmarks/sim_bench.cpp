@@ -1,5 +1,6 @@
-// sim_bench: the order-stream simulator (engine/sim/order_stream.h) under the online traffic
-// controller on a large generated floor, as fast as the CPU allows (issue 4 §5).
+// sim_bench: order streams under the online traffic controller on a large generated floor, as
+// fast as the CPU allows (issue 4 §5): the order-stream model (engine/sim/order_stream.h) and
+// the dispatch core driven by in-process robots (engine/sim/core_stream.h, issue 15 §3).
 //
 //   BM_Simulate/R   R robots on a 20 x 20-shelf grid floor (engine/map/grid_floor.h: 4 x 2
 //                   cell shelves, 2-cell aisles, 122 x 82 cells, ~6800 points, lazy route
@@ -8,6 +9,9 @@
 //                   order per robot per task duration), 300 simulated seconds, dt = 0.1 s.
 //   BM_SimulateFormations/R   the same with 10% of the orders formation orders (3 robots each,
 //                   Chu2024 §3.2: gathering, one agent with the formation's envelope, leaving).
+//   BM_SimulateOnCore/R, BM_SimulateFormationsOnCore/R   the same streams on SimulateOnCore:
+//                   the service's DispatchCore, its TrafficGate and robots following its
+//                   messages (a round whenever one is due, at most every 10 s).
 // Counter `speedup` = simulated seconds per wall second (target: R = 500 at >= 100x).
 // The map, the route table (warmed on every pick and drop) and the orders are built once,
 // outside the timing. Run from a Release build:
@@ -19,6 +23,7 @@
 
 #include "engine/map/grid_floor.h"
 #include "engine/routing/route_table.h"
+#include "engine/sim/core_stream.h"
 #include "engine/sim/fleet_placement.h"
 #include "engine/sim/order_stream.h"
 #include "engine/sim/random_orders.h"
@@ -54,7 +59,7 @@ const Floor& LargeFloor() {
   return floor;
 }
 
-void Simulate(benchmark::State& state, double formation_share) {
+void Simulate(benchmark::State& state, double formation_share, bool on_core = false) {
   const Floor& f = LargeFloor();
   const auto robots_count = static_cast<std::size_t>(state.range(0));
   auto robots = PlaceRobots(*f.map, robots_count);
@@ -73,7 +78,8 @@ void Simulate(benchmark::State& state, double formation_share) {
   double simulated = 0;
   std::size_t completed = 0, total = 0, deadlocks = 0, replans = 0, blocked = 0;
   for (auto _ : state) {
-    auto r = SimulateOrderStream(f.map, f.routes, *robots, *orders, config);
+    auto r = on_core ? SimulateOnCore(f.map, f.routes, *robots, *orders, config)
+                     : SimulateOrderStream(f.map, f.routes, *robots, *orders, config);
     if (!r.ok()) throw std::runtime_error(r.error().message);
     simulated += r->end_time;
     completed += r->completed;
@@ -92,9 +98,15 @@ void Simulate(benchmark::State& state, double formation_share) {
 
 void BM_Simulate(benchmark::State& state) { Simulate(state, 0.0); }
 void BM_SimulateFormations(benchmark::State& state) { Simulate(state, 0.1); }
+void BM_SimulateOnCore(benchmark::State& state) { Simulate(state, 0.0, true); }
+void BM_SimulateFormationsOnCore(benchmark::State& state) { Simulate(state, 0.1, true); }
 BENCHMARK(BM_Simulate)->Arg(18)->Arg(100)->Arg(500)->Unit(benchmark::kMillisecond)
     ->UseRealTime()->Iterations(2);
 BENCHMARK(BM_SimulateFormations)->Arg(100)->Arg(500)->Unit(benchmark::kMillisecond)
+    ->UseRealTime()->Iterations(2);
+BENCHMARK(BM_SimulateOnCore)->Arg(18)->Arg(100)->Arg(500)->Unit(benchmark::kMillisecond)
+    ->UseRealTime()->Iterations(2);
+BENCHMARK(BM_SimulateFormationsOnCore)->Arg(100)->Arg(500)->Unit(benchmark::kMillisecond)
     ->UseRealTime()->Iterations(2);
 
 }  // namespace
