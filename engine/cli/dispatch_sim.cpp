@@ -176,12 +176,16 @@ Result<Setup> Prepare(const StreamArgs& a) {
   if (!a.orders.empty()) {
     // Every table `repeat` times, all at once: with two tables, copy k of table 2's task T3
     // is T3.2-k.
+    std::vector<std::vector<Order>> tables;
+    for (const std::string& path : a.orders) {
+      auto loaded = LoadTaskTableOrders(*s.map, path);
+      if (!loaded.ok()) return loaded.error();
+      tables.push_back(std::move(loaded).value());
+    }
     for (std::size_t k = 1; k <= a.repeat; ++k) {
-      for (std::size_t i = 0; i < a.orders.size(); ++i) {
-        auto loaded = LoadTaskTableOrders(*s.map, a.orders[i]);
-        if (!loaded.ok()) return loaded.error();
-        for (Order& o : loaded.value()) {
-          if (a.orders.size() > 1) o.id += "." + std::to_string(i + 1);
+      for (std::size_t i = 0; i < tables.size(); ++i) {
+        for (Order o : tables[i]) {
+          if (tables.size() > 1) o.id += "." + std::to_string(i + 1);
           if (a.repeat > 1) o.id += "-" + std::to_string(k);
           o.client_id = o.id;
           s.orders.push_back(std::move(o));

@@ -117,7 +117,7 @@ void WaypointRobot::Step(double now, std::vector<RobotEvent>& out) {
       stops_.pop_front();
       continue;
     }
-    if (stalled_ || (held_ && hold_at_ == 0) || !Released(front)) break;
+    if ((held_ && hold_at_ == 0) || !Released(front)) break;
     const Eigen::Vector2d d = front.wp.xy - xy_;
     const double dist = d.norm();
     if (dist <= kArriveEps) {

@@ -10,8 +10,6 @@
 // Grant and Resume raise the release horizon; Hold stops it at once (or at a waypoint) until
 // Resume; Cancel voids the named orders' waypoints (it stops at its next waypoint).
 //
-// Fault model: a stalled robot stands still (it still reports).
-//
 // The same rules as the wire robot of fleet-sim (clients/sim_robot.h), on the engine's values
 // and in process. Not thread-safe: one owner.
 #pragma once
@@ -47,7 +45,6 @@ class WaypointRobot {
   // No plan left: standing on its last waypoint (or never given one), not working.
   bool idle() const;
   double driven() const { return driven_; }  // metres so far
-  void set_stalled(bool stalled) { stalled_ = stalled; }
 
   void Apply(const RobotMessage& message);
   // Advances to `now` (>= the previous call's), appending what happened to `out`.
@@ -80,7 +77,6 @@ class WaypointRobot {
   bool dwelling_ = false;
   double dwell_until_ = 0.0;
   Stop dwell_stop_;
-  bool stalled_ = false;
 };
 
 }  // namespace dispatch::engine

@@ -1,6 +1,7 @@
 // TrafficGate's state, shared by traffic_gate.cpp (plans, effects, interface),
-// traffic_gate_solo.cpp (solo agents) and traffic_gate_teams.cpp (formations). Internal to
-// the gate; see traffic_gate.h for the model.
+// traffic_gate_solo.cpp (solo agents), traffic_gate_teams.cpp (formations) and
+// traffic_gate_rejoin.cpp (formations formed again after a restart). Internal to the gate; see
+// traffic_gate.h for the model.
 #pragma once
 
 #include <algorithm>
@@ -138,6 +139,7 @@ struct GateImpl {
   bool TeamAgentOnFloor(const GateTeam& team) const;
   // Puts the team's agent (pooled or new) on `p`; false when the point is taken.
   bool PlaceTeamAgent(GateTeam& team, PointId p, double t);
+  // After a restart (traffic_gate_rejoin.cpp).
   // The formation order whose segment b is inside (from the rendezvous run to the drop)
   // while its team is still forming and b is not in it: after a restart, where the gate's
   // teams are gone but the members' plans and positions are not.
@@ -149,6 +151,7 @@ struct GateImpl {
   // another until they have driven off) and b goes on alone: false.
   bool RejoinTeam(GateBot& b, const std::string& order, const TeamSpan& span, double t,
                   std::vector<GateEffect>& out);
+  // Teams' phases (traffic_gate_teams.cpp).
   void StepTeams(double t, std::vector<GateEffect>& out);
   void StepTeamsAfterDeadlocks(double t, std::vector<GateEffect>& out);
   void BreakTeam(GateTeam& team);
