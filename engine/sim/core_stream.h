@@ -34,7 +34,7 @@
 namespace dispatch::engine {
 
 // Errors: bad config, null map/routes, no robots, the preassigned strategy, robots that cannot
-// be placed (unknown or shared start points).
+// be placed (unknown or shared start points), a formation order with fewer than 3 robots.
 Result<StreamResult> SimulateOnCore(std::shared_ptr<const WarehouseMap> map, std::shared_ptr<const RouteTable> routes,
                                     const std::vector<FleetRobot>& robots, std::vector<Order> orders,
                                     const StreamConfig& config = {});
