@@ -51,6 +51,8 @@ std::vector<Key> Keys() {
       MakeKey("blocked_after", &ServerConfig::blocked_after),
       MakeKey("route_cache_mb", &ServerConfig::route_cache_mb),
       MakeKey("finished_retained", &ServerConfig::finished_retained),
+      MakeKey("journal_runs", &ServerConfig::journal_runs),
+      MakeKey("journal_max_mb", &ServerConfig::journal_max_mb),
       MakeKey("web_root", &ServerConfig::web_root),
       MakeKey("ports_file", &ServerConfig::ports_file),
       MakeKey("ready_fd", &ServerConfig::ready_fd),
@@ -121,6 +123,8 @@ engine::Status ValidateServerConfig(const ServerConfig& c) {
   }
   if (c.route_cache_mb < 1) return InvalidArgument("route_cache_mb must be >= 1");
   if (c.finished_retained < 0) return InvalidArgument("finished_retained must be >= 0");
+  if (c.journal_runs < 0) return InvalidArgument("journal_runs must be >= 0 (0: no journal)");
+  if (c.journal_max_mb < 0) return InvalidArgument("journal_max_mb must be >= 0 (0: no limit)");
   if (!c.web_root.empty() && !std::filesystem::is_directory(c.web_root)) {
     return InvalidArgument("web_root '" + c.web_root + "' is not a folder");
   }
@@ -164,6 +168,11 @@ engine::Result<ParsedCommandLine> ParseCommandLine(int argc, char** argv) {
   app.add_option("--finished-retained", flags.finished_retained,
                  "Finished orders kept in memory (the newest); older ones are read from the database")
       ->capture_default_str();
+  app.add_option("--journal-runs", flags.journal_runs,
+                 "Runs of the dispatch core's journal kept in the database for replay (0: no journal)")
+      ->capture_default_str();
+  app.add_option("--journal-max-mb", flags.journal_max_mb,
+                 "Recording of a run stops after this many MiB of journal (0: no limit)")->capture_default_str();
   app.add_option("--web-root", flags.web_root,
                  "Serve the web map from this folder instead of the built-in copy");
   app.add_option("--ports-file", flags.ports_file, "Write the chosen ports as JSON here");

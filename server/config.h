@@ -37,6 +37,12 @@ struct ServerConfig {
   // Finished orders (completed, cancelled, failed) kept in memory beyond the open ones: the
   // newest this many; older ones are read from the database when asked for (issue 15 §3b).
   int finished_retained = 1000;
+  // The dispatch core's journal (issue 15 §4, `dispatch-sim replay --db`): every core input of
+  // a run in the database, the newest journal_runs runs kept (0: no journal); recording of a
+  // run stops after journal_max_mb MiB (0: no limit). About 0.3 MB per minute per 18 robots
+  // reporting at 10 Hz (README "Replay").
+  int journal_runs = 5;
+  int journal_max_mb = 512;
   // Serve the web map's files from this folder instead of the copy built into the binary
   // ("" = built-in; for working on the page without rebuilding).
   std::string web_root;

@@ -52,8 +52,10 @@ engine::Result<std::unique_ptr<Dispatcher>> Dispatcher::Create(
   core_options.traffic = options.traffic;
   auto core = engine::DispatchCore::Create(map, routes, core_options);
   if (!core.ok()) return core.error();
-  std::unique_ptr<Dispatcher> d(new Dispatcher(std::move(map), std::move(routes), store, std::move(options),
-                                               std::move(rounds), std::move(core).value()));
+  const bool journaled = options.journal != nullptr;
+  std::unique_ptr<Dispatcher> d(new Dispatcher(
+      std::move(map), std::move(routes), store, std::move(options), std::move(rounds),
+      std::make_unique<engine::JournaledCore>(std::move(core).value(), journaled)));
   if (auto recovered = d->Recover(); !recovered.ok()) return recovered.error();
   d->Publish();
   return d;
@@ -62,7 +64,7 @@ engine::Result<std::unique_ptr<Dispatcher>> Dispatcher::Create(
 Dispatcher::Dispatcher(std::shared_ptr<const engine::WarehouseMap> map,
                        std::shared_ptr<const engine::RouteTable> routes, storage::Store& store,
                        DispatcherOptions options, std::unique_ptr<engine::RoundRunner> rounds,
-                       std::unique_ptr<engine::DispatchCore> core)
+                       std::unique_ptr<engine::JournaledCore> core)
     : map_(std::move(map)),
       routes_(std::move(routes)),
       store_(store),
@@ -72,13 +74,15 @@ Dispatcher::Dispatcher(std::shared_ptr<const engine::WarehouseMap> map,
       wall_start_(Clock::now()),
       // Below the loop's priority: traffic control first when the cores are busy.
       route_worker_(std::make_unique<WorkerThread>(kWorkerNice)),
-      allocation_worker_(std::make_unique<WorkerThread>(kWorkerNice)) {}
+      allocation_worker_(std::make_unique<WorkerThread>(kWorkerNice)),
+      journal_worker_(std::make_unique<WorkerThread>(kWorkerNice)) {}
 
 Dispatcher::~Dispatcher() {
   // The workers post to the loop: they stop before anything is torn down.
   route_worker_->Stop();
   allocation_worker_->Stop();
   Stop();
+  journal_worker_->Stop();
 }
 
 engine::Status Dispatcher::Recover() {
@@ -210,6 +214,8 @@ void Dispatcher::Stop() {
   }
   queue_cv_.notify_all();
   if (thread_.joinable()) thread_.join();
+  WriteJournal();  // the last batch's entries
+  journal_worker_->Stop();
 }
 
 void Dispatcher::Post(std::function<void()> fn) {
@@ -283,6 +289,7 @@ void Dispatcher::Flush() {
   std::vector<std::function<void()>> effects;
   effects.swap(deferred_);
   for (auto& effect : effects) effect();
+  WriteJournal();
 }
 
 void Dispatcher::Publish() {

@@ -71,6 +71,7 @@
 
 #include "engine/dispatch/allocation_round.h"
 #include "engine/dispatch/dispatch_core.h"
+#include "engine/dispatch/journaled_core.h"
 #include "engine/dispatch/robot_progress.h"
 #include "engine/fleet/order.h"
 #include "engine/routing/route_table.h"
@@ -82,6 +83,7 @@
 #include "server/snapshot.h"
 #include "server/watch_hub.h"
 #include "server/worker_thread.h"
+#include "storage/journal_store.h"
 #include "storage/store.h"
 
 namespace dispatch::server {
@@ -106,6 +108,13 @@ struct DispatcherOptions {
   // Where allocation latency and grant waits are observed (optional; must outlive the
   // dispatcher).
   ServiceMetrics* metrics = nullptr;
+  // The core's journal (issue 15 §4; optional, must outlive the dispatcher): every core call
+  // of this run (journal_run, begun by the owner), written after every loop batch on a worker
+  // of its own. Recording stops, and the run is marked truncated, once journal_max_bytes of
+  // entries are written (0: no limit).
+  storage::JournalStore* journal = nullptr;
+  std::int64_t journal_run = 0;
+  std::uint64_t journal_max_bytes = 0;
 };
 
 struct SubmitReply {
@@ -204,7 +213,7 @@ class Dispatcher {
   Dispatcher(std::shared_ptr<const engine::WarehouseMap> map,
              std::shared_ptr<const engine::RouteTable> routes, storage::Store& store,
              DispatcherOptions options, std::unique_ptr<engine::RoundRunner> rounds,
-             std::unique_ptr<engine::DispatchCore> core);
+             std::unique_ptr<engine::JournaledCore> core);
   engine::Status Recover();
   void Loop();
   double Now() const;
@@ -274,6 +283,10 @@ class Dispatcher {
   // Traffic control (dispatcher_traffic.cpp).
   void StepTraffic();
 
+  // The core's journal (dispatcher_journal.cpp): hands the batch's entries to the journal
+  // worker; at the size limit, recording stops.
+  void WriteJournal();
+
   const std::shared_ptr<const engine::WarehouseMap> map_;
   const std::shared_ptr<const engine::RouteTable> routes_;
   storage::Store& store_;
@@ -293,7 +306,7 @@ class Dispatcher {
   // Allocation worker state (only rounds on allocation_worker_ touch it).
   std::unique_ptr<engine::RoundRunner> rounds_;
   // Loop-thread state (no lock: only the loop touches it after Start).
-  std::unique_ptr<engine::DispatchCore> core_;  // the dispatch book and its rules
+  std::unique_ptr<engine::JournaledCore> core_;  // the dispatch book and its rules, journaled
   Clock::time_point wall_start_;
   double time_base_ = 0.0;  // dispatcher seconds at wall_start_
   // The book: every open order and the newest finished ones, by position (submission order).
@@ -332,6 +345,11 @@ class Dispatcher {
   // Stopped first (Stop, destructor): what they still hold reaches the loop's queue.
   std::unique_ptr<WorkerThread> route_worker_;
   std::unique_ptr<WorkerThread> allocation_worker_;
+  // Journal writes (options_.journal), in batch order; stopped last.
+  std::unique_ptr<WorkerThread> journal_worker_;
+  std::uint64_t journal_bytes_ = 0;         // journal worker only
+  std::atomic<bool> journal_full_{false};   // set by the worker at journal_max_bytes
+  bool journal_stopped_ = false;            // loop: recording stopped, marker written
 };
 
 }  // namespace dispatch::server

@@ -31,7 +31,11 @@ void Dispatcher::AllocatePending() {
   allocation_worker_->Run([this, input, keys](bool cancelled) {
     auto round = cancelled ? std::make_shared<ServerRound>() : RunRound(*input);
     round->commit.keys = std::move(keys->keys);
-    Post([this, round] { CommitNext(round); });
+    round->commit.origin = keys->origin;
+    Post([this, round, cancelled] {
+      core_->RoundResult(round->commit, cancelled);
+      CommitNext(round);
+    });
   });
 }
 

@@ -4,6 +4,8 @@
 #include <nlohmann/json.hpp>
 #include <spdlog/spdlog.h>
 
+#include <chrono>
+
 #include <unistd.h>
 
 #include <cerrno>
@@ -15,6 +17,8 @@
 #include "engine/io/map_source.h"
 #include "engine/io/map_json.h"
 #include "engine/routing/route_table.h"
+#include "storage/journal_json.h"
+#include "storage/journal_store.h"
 #include "server/dispatcher.h"
 #include "server/fleet_service.h"
 #include "server/metered_store.h"
@@ -59,6 +63,35 @@ engine::Status WritePortsFile(const std::string& path, const ServerPorts& ports)
     return engine::IoError("cannot rename '" + tmp + "' to '" + path + "'");
   }
   return engine::Ok{};
+}
+
+// The core's journal in config.db, with a new run for this start (issue 15 §4).
+struct StartedJournal {
+  std::unique_ptr<storage::JournalStore> store;
+  std::int64_t run = 0;
+};
+engine::Result<StartedJournal> StartJournal(const ServerConfig& config, const DispatcherOptions& options,
+                                            const std::string& map_json, const std::string& map_source) {
+  auto opened = storage::JournalStore::Open(config.db);
+  if (!opened.ok()) return opened.error();
+  storage::RunSetup setup;
+  setup.map_json = map_json;
+  setup.map_source = map_source;
+  setup.strategy = options.strategy;
+  setup.allocation = options.allocation;
+  setup.core.robot_snap_tolerance = options.robot_snap_tolerance;
+  setup.core.traffic_control = options.traffic_control;
+  setup.core.traffic = options.traffic;
+  setup.route_cache_bytes = static_cast<std::size_t>(config.route_cache_mb) << 20;
+  setup.time_scale = options.time_scale;
+  auto encoded = storage::EncodeRunSetup(setup);
+  if (!encoded.ok()) return encoded.error();
+  const double unix_now = std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count();
+  auto run = (*opened)->StartRun(unix_now, *encoded, config.journal_runs);
+  if (!run.ok()) return run.error();
+  spdlog::info("journal: run {} in {} (the newest {} runs kept; dispatch-sim replay --db {})", *run, config.db,
+               config.journal_runs, config.db);
+  return StartedJournal{std::move(opened).value(), *run};
 }
 
 }  // namespace
@@ -126,6 +159,14 @@ engine::Result<std::unique_ptr<DispatchServer>> DispatchServer::Start(const Serv
   options.traffic.blocked_after = config.blocked_after;
   options.map_version = recorded->content_hash;
   options.metrics = s->metrics_.get();
+  if (!store && config.journal_runs > 0) {
+    auto journal = StartJournal(config, options, map_json, version.source);
+    if (!journal.ok()) return journal.error();
+    s->journal_ = std::move(journal.value().store);
+    options.journal = s->journal_.get();
+    options.journal_run = journal->run;
+    options.journal_max_bytes = static_cast<std::uint64_t>(config.journal_max_mb) << 20;
+  }
   auto dispatcher = Dispatcher::Create(map, shared_routes, *s->store_, options);
   if (!dispatcher.ok()) return dispatcher.error();
   s->dispatcher_ = std::move(dispatcher).value();

@@ -16,6 +16,7 @@
 
 #include "engine/common/result.h"
 #include "server/config.h"
+#include "storage/journal_store.h"
 #include "storage/store.h"
 
 namespace grpc {
@@ -39,7 +40,8 @@ struct ServerPorts {
 
 class DispatchServer {
  public:
-  // `store` (optional, must outlive the server) replaces the SQLite file of config.db.
+  // `store` (optional, must outlive the server) replaces the SQLite file of config.db (and then
+  // no core journal is kept).
   static engine::Result<std::unique_ptr<DispatchServer>> Start(const ServerConfig& config,
                                                                storage::Store* store = nullptr);
   ~DispatchServer();
@@ -57,6 +59,7 @@ class DispatchServer {
   std::unique_ptr<ServiceMetrics> metrics_;
   std::unique_ptr<MeteredStore> metered_store_;  // wraps the store; store_ points here
   storage::Store* store_ = nullptr;
+  std::unique_ptr<storage::JournalStore> journal_;  // the core's journal (config.db), if kept
   std::unique_ptr<Dispatcher> dispatcher_;
   std::unique_ptr<OrderServiceImpl> order_service_;
   std::unique_ptr<FleetServiceImpl> fleet_service_;

@@ -11,6 +11,10 @@
 //       auction zeta=100, auction zeta=0 and greedy on one random stream (issue 4 §4).
 //   dispatch-sim headon
 //       seed 004 §4.3: a head-on conflict resolved by waiting vs. re-planning.
+//   dispatch-sim replay --db dispatch.db [--run N | --list] [--what-if [--strategy S] [--zeta Z]
+//       [--robots N]]
+//       a run dispatchd recorded, through a fresh dispatch core again (exit 0: it matched);
+//       with --what-if its orders re-run on the motion model, side by side (journal_replay.h).
 #include <CLI/CLI.hpp>
 
 #include <cmath>
@@ -25,6 +29,7 @@
 #include <vector>
 
 #include "engine/allocation/auction_allocator.h"
+#include "engine/cli/journal_replay.h"
 #include "engine/cli/scenario.h"
 #include "engine/dispatch/strategy.h"
 #include "engine/io/map_source.h"
@@ -385,7 +390,20 @@ int Main(int argc, char** argv) {
   auto* c = app.add_subcommand("compare", "Auction zeta=100 / zeta=0 / greedy on one stream");
   add_stream(c, compare);
   auto* h = app.add_subcommand("headon", "Seed 004 §4.3: wait vs. re-plan on a head-on conflict");
+  ReplayArgs replay;
+  auto* r = app.add_subcommand("replay", "A run dispatchd recorded, through the dispatch core again; --what-if");
+  r->add_option("--db", replay.db, "dispatchd's SQLite file")->required();
+  r->add_option("--run", replay.run, "Run number (default: the newest; --list shows them)");
+  r->add_flag("--list", replay.list, "List the recorded runs");
+  r->add_flag("--what-if", replay.what_if, "Also re-run the orders on the motion model, as recorded and changed");
+  r->add_option("--strategy", replay.strategy, "What-if strategy (default: the recorded one)")
+      ->check(CLI::IsMember(AllocatorNames()));
+  r->add_option("--zeta", replay.zeta, "What-if traffic weight (default: the recorded one)");
+  r->add_option("--robots", replay.robots, "What-if fleet: the first N robots of the run (default: all)");
+  r->add_option("--dt", replay.dt, "What-if time step, s")->capture_default_str()->check(CLI::PositiveNumber);
+  r->add_option("--max-time", replay.max_time, "What-if simulated seconds before giving up")->capture_default_str();
   CLI11_PARSE(app, argc, argv);
+  if (*r) return RunReplay(replay);
   if (*p) return RunPlan(plan);
   if (*s) return RunStream(stream);
   if (*c) return RunCompare(compare);

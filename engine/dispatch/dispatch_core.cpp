@@ -100,7 +100,7 @@ Result<Change> DispatchCore::PlanCancel(const std::string& order_id, const std::
 
 Change DispatchCore::PlanLoss(const std::string& id, const std::string& why, double now) {
   const BookRobot* r = robot(id);
-  if (!r || !r->has_assignment || r->assignment.order_ids.empty()) return Change{now, {}, {}, {}, {}};
+  if (!r || !r->has_assignment || r->assignment.order_ids.empty()) return Change{now, {}, {}, {}, {}, 0};
   return PlanReleaseOf(r->assignment.order_ids, StateAfterRobotLoss, why, now);
 }
 

@@ -98,6 +98,7 @@ struct Change {
   std::map<std::string, Assignment> plans;  // robot -> its new plan (stored whole)
   std::vector<PlanSend> sends;
   std::map<std::string, std::set<std::string>> dropped_by;  // order -> members that dropped now
+  std::uint64_t origin = 0;  // the journal entry of the call that made it (JournaledCore); 0: none
   bool empty() const { return orders.empty() && plans.empty() && sends.empty() && dropped_by.empty(); }
   // Messages per robot once applied (the owner reserves their sequence numbers with the change).
   std::map<std::string, std::uint64_t> MessageCounts() const;
@@ -121,6 +122,7 @@ struct RoundKey {
 
 // A round on its way back into the book, a few awards at a time (PlanAwards).
 struct RoundCommit {
+  std::uint64_t origin = 0;  // the journal entry of its MakeRound (JournaledCore); 0: none
   std::map<std::string, RoundKey> keys;  // as the round saw them; then as committed
   std::vector<RoundAward> awards;
   std::size_t next = 0;            // the first award not looked at yet

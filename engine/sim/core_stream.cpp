@@ -8,6 +8,7 @@
 #include <unordered_map>
 
 #include "engine/dispatch/dispatch_core.h"
+#include "engine/dispatch/journaled_core.h"
 #include "engine/dispatch/strategy.h"
 #include "engine/sim/waypoint_robot.h"
 
@@ -20,9 +21,11 @@ double ReleaseOf(const Order& o) { return o.release_time.value_or(o.created_time
 
 class CoreRun {
  public:
-  CoreRun(std::shared_ptr<const WarehouseMap> map, const StreamConfig& config, std::unique_ptr<DispatchCore> core,
+  CoreRun(std::shared_ptr<const WarehouseMap> map, const StreamConfig& config, std::unique_ptr<JournaledCore> core,
           std::unique_ptr<RoundRunner> rounds)
       : map_(std::move(map)), config_(config), core_(std::move(core)), rounds_(std::move(rounds)) {}
+
+  std::vector<JournalEntry> TakeJournal() { return core_->TakeEntries(); }
 
   Status Init(const std::vector<FleetRobot>& robots, std::vector<Order> orders) {
     if (robots.empty()) return InvalidArgument("order stream: no robots");
@@ -101,6 +104,7 @@ class CoreRun {
     if (!input) return;
     RoundResult round = rounds_->Run(*input);
     commit.awards = std::move(round.awards);
+    core_->RoundResult(commit, false);
     const Change change = core_->PlanAwards(commit, commit.awards.size(), t);
     again_ = commit.again;
     Commit(change);
@@ -220,7 +224,7 @@ class CoreRun {
 
   std::shared_ptr<const WarehouseMap> map_;
   const StreamConfig& config_;
-  std::unique_ptr<DispatchCore> core_;
+  std::unique_ptr<JournaledCore> core_;
   std::unique_ptr<RoundRunner> rounds_;
   std::vector<WaypointRobot> bots_;
   std::unordered_map<std::string, std::size_t> index_;
@@ -240,7 +244,7 @@ class CoreRun {
 
 Result<StreamResult> SimulateOnCore(std::shared_ptr<const WarehouseMap> map, std::shared_ptr<const RouteTable> routes,
                                     const std::vector<FleetRobot>& robots, std::vector<Order> orders,
-                                    const StreamConfig& config) {
+                                    const StreamConfig& config, std::vector<JournalEntry>* journal) {
   if (!map || !routes) return InvalidArgument("order stream: no map or route table");
   if (!(config.time_step > 0) || !std::isfinite(config.time_step) || !(config.max_time > 0) ||
       !(config.allocation_period >= 0)) {
@@ -258,9 +262,12 @@ Result<StreamResult> SimulateOnCore(std::shared_ptr<const WarehouseMap> map, std
   options.traffic.speed = config.allocation.speed;
   auto core = DispatchCore::Create(map, routes, options);
   if (!core.ok()) return core.error();
-  CoreRun run(map, config, std::move(core).value(), std::move(rounds));
+  CoreRun run(map, config, std::make_unique<JournaledCore>(std::move(core).value(), journal != nullptr),
+              std::move(rounds));
   if (auto init = run.Init(robots, std::move(orders)); !init.ok()) return init.error();
-  return run.Run();
+  StreamResult result = run.Run();
+  if (journal) *journal = run.TakeJournal();
+  return result;
 }
 
 }  // namespace dispatch::engine

@@ -29,14 +29,17 @@
 #include <memory>
 #include <vector>
 
+#include "engine/dispatch/core_journal.h"
 #include "engine/sim/order_stream.h"
 
 namespace dispatch::engine {
 
+// With `journal`, every call the run made on the core is journaled there (the service's format,
+// engine/dispatch/core_journal.h): CoreReplay reproduces the run from it.
 // Errors: bad config, null map/routes, no robots, the preassigned strategy, robots that cannot
 // be placed (unknown or shared start points), a formation order with fewer than 3 robots.
 Result<StreamResult> SimulateOnCore(std::shared_ptr<const WarehouseMap> map, std::shared_ptr<const RouteTable> routes,
                                     const std::vector<FleetRobot>& robots, std::vector<Order> orders,
-                                    const StreamConfig& config = {});
+                                    const StreamConfig& config = {}, std::vector<JournalEntry>* journal = nullptr);
 
 }  // namespace dispatch::engine

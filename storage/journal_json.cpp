@@ -1,0 +1,288 @@
+#include "storage/journal_json.h"
+
+#include <nlohmann/json.hpp>
+
+#include <cmath>
+#include <stdexcept>
+
+#include "storage/record_json.h"
+
+namespace dispatch::storage {
+namespace {
+
+using nlohmann::json;
+using engine::CoreInput;
+
+Error Corrupt(const char* what, const std::string& detail) {
+  return engine::IoError(std::string("stored ") + what + " is corrupt: " + detail);
+}
+
+// Runs `fn` (which may throw json errors) and maps them to `error`.
+template <class T, class F>
+Result<T> Guard(const char* what, bool decoding, F&& fn) {
+  try {
+    return fn();
+  } catch (const std::exception& e) {  // json errors, and Embedded's
+    if (decoding) return Corrupt(what, e.what());
+    return engine::InvalidArgument(std::string(what) + ": " + e.what());
+  }
+}
+
+json Embedded(const Result<std::string>& text) {
+  if (!text.ok()) throw std::invalid_argument(text.error().message);
+  return json::parse(*text);
+}
+
+Result<json> OrderJson(const engine::Order& o) {
+  auto body = EncodeOrderBody(o);
+  if (!body.ok()) return body.error();
+  json j;
+  j["id"] = o.id;
+  j["client_id"] = o.client_id;
+  j["priority"] = o.priority;
+  j["formation"] = o.formation;
+  j["created"] = o.created_time;
+  j["state"] = engine::OrderStateName(o.state);
+  j["body"] = json::parse(*body);
+  return j;
+}
+
+Result<engine::Order> OrderOf(const json& j) {
+  engine::Order o;
+  o.id = j.at("id").get<std::string>();
+  o.client_id = j.at("client_id").get<std::string>();
+  o.priority = j.at("priority").get<int>();
+  o.formation = j.at("formation").get<bool>();
+  o.created_time = j.at("created").get<double>();
+  auto state = engine::ParseOrderState(j.at("state").get<std::string>());
+  if (!state) return Corrupt("journal order", "unknown state");
+  o.state = *state;
+  if (auto s = DecodeOrderBody(j.at("body").dump(), o); !s.ok()) return s.error();
+  return o;
+}
+
+Result<json> RobotJson(const engine::Robot& r) {
+  auto body = EncodeRobotBody(r);
+  if (!body.ok()) return body.error();
+  return json{{"id", r.id}, {"state", engine::RobotStateName(r.state)}, {"body", json::parse(*body)}};
+}
+
+Result<engine::Robot> RobotOf(const json& j) {
+  engine::Robot r;
+  r.id = j.at("id").get<std::string>();
+  auto state = engine::ParseRobotState(j.at("state").get<std::string>());
+  if (!state) return Corrupt("journal robot", "unknown state");
+  r.state = *state;
+  if (auto s = DecodeRobotBody(j.at("body").dump(), r); !s.ok()) return s.error();
+  return r;
+}
+
+json PoseJson(const engine::Pose& p) { return json{p.position.x(), p.position.y(), p.heading}; }
+engine::Pose PoseOf(const json& j) {
+  engine::Pose p;
+  p.position = {j.at(0).get<double>(), j.at(1).get<double>()};
+  p.heading = j.at(2).get<double>();
+  return p;
+}
+
+const char* HeadOnName(engine::HeadOnPolicy p) {
+  switch (p) {
+    case engine::HeadOnPolicy::kChooseFaster: return "choose_faster";
+    case engine::HeadOnPolicy::kAlwaysWait: return "always_wait";
+    case engine::HeadOnPolicy::kAlwaysReplan: return "always_replan";
+  }
+  return "?";
+}
+
+}  // namespace
+
+Result<std::string> EncodeRunSetup(const RunSetup& s) {
+  return Guard<std::string>("run setup", false, [&]() -> Result<std::string> {
+    const engine::AllocationConfig& a = s.allocation;
+    const engine::TrafficControllerConfig& t = s.core.traffic;
+    json j;
+    j["version"] = s.version;
+    j["map_source"] = s.map_source;
+    j["map"] = json::parse(s.map_json);
+    j["strategy"] = s.strategy;
+    j["allocation"] = {{"alpha", a.alpha},
+                       {"beta", a.beta},
+                       {"zeta", a.zeta},
+                       {"sample_step", a.sample_step},
+                       {"speed", a.speed},
+                       {"hold_seconds", a.hold_seconds},
+                       {"price_every_bid_up_to", a.price_every_bid_up_to},
+                       {"work_time_override", a.work_time_override ? json(*a.work_time_override) : json(nullptr)},
+                       {"bucket_seconds", a.traffic.bucket_seconds},
+                       {"origin_time", a.traffic.origin_time},
+                       {"zone_cell_size", a.traffic.zone_cell_size},
+                       {"formation_side", a.formation.side},
+                       {"formation_base_angle", a.formation.base_angle},
+                       {"formation_max_rotation_step", a.formation.max_rotation_step}};
+    j["core"] = {{"robot_snap_tolerance", s.core.robot_snap_tolerance},
+                 {"traffic_control", s.core.traffic_control},
+                 {"speed", t.speed},
+                 {"point_clearance", t.point_clearance},
+                 {"t_w1", t.t_w1},
+                 {"t_w2", t.t_w2},
+                 {"blocked_after", t.blocked_after},
+                 {"max_envelope", t.max_envelope},
+                 {"intersection_grants", t.intersection_grants},
+                 {"head_on", HeadOnName(t.head_on)}};
+    j["route_cache_bytes"] = s.route_cache_bytes;
+    j["time_scale"] = s.time_scale;
+    return j.dump();
+  });
+}
+
+Result<RunSetup> DecodeRunSetup(const std::string& text) {
+  return Guard<RunSetup>("run setup", true, [&]() -> Result<RunSetup> {
+    const json j = json::parse(text);
+    RunSetup s;
+    s.version = j.at("version").get<std::string>();
+    if (s.version != "1") return Corrupt("run setup", "unknown version " + s.version);
+    s.map_source = j.at("map_source").get<std::string>();
+    s.map_json = j.at("map").dump();
+    s.strategy = j.at("strategy").get<std::string>();
+    const json& a = j.at("allocation");
+    engine::AllocationConfig& c = s.allocation;
+    c.alpha = a.at("alpha").get<double>();
+    c.beta = a.at("beta").get<double>();
+    c.zeta = a.at("zeta").get<double>();
+    c.sample_step = a.at("sample_step").get<double>();
+    c.speed = a.at("speed").get<double>();
+    c.hold_seconds = a.at("hold_seconds").get<double>();
+    c.price_every_bid_up_to = a.at("price_every_bid_up_to").get<std::size_t>();
+    if (!a.at("work_time_override").is_null()) c.work_time_override = a.at("work_time_override").get<double>();
+    c.traffic.bucket_seconds = a.at("bucket_seconds").get<double>();
+    c.traffic.origin_time = a.at("origin_time").get<double>();
+    c.traffic.zone_cell_size = a.at("zone_cell_size").get<double>();
+    c.formation.side = a.at("formation_side").get<double>();
+    c.formation.base_angle = a.at("formation_base_angle").get<double>();
+    c.formation.max_rotation_step = a.at("formation_max_rotation_step").get<double>();
+    const json& k = j.at("core");
+    s.core.robot_snap_tolerance = k.at("robot_snap_tolerance").get<double>();
+    s.core.traffic_control = k.at("traffic_control").get<bool>();
+    engine::TrafficControllerConfig& t = s.core.traffic;
+    t.speed = k.at("speed").get<double>();
+    t.point_clearance = k.at("point_clearance").get<double>();
+    t.t_w1 = k.at("t_w1").get<double>();
+    t.t_w2 = k.at("t_w2").get<double>();
+    t.blocked_after = k.at("blocked_after").get<double>();
+    t.max_envelope = k.at("max_envelope").get<double>();
+    t.intersection_grants = k.at("intersection_grants").get<bool>();
+    const std::string head_on = k.at("head_on").get<std::string>();
+    bool known = false;
+    for (auto p : {engine::HeadOnPolicy::kChooseFaster, engine::HeadOnPolicy::kAlwaysWait,
+                   engine::HeadOnPolicy::kAlwaysReplan}) {
+      if (head_on == HeadOnName(p)) t.head_on = p, known = true;
+    }
+    if (!known) return Corrupt("run setup", "unknown head-on policy " + head_on);
+    s.route_cache_bytes = j.at("route_cache_bytes").get<std::size_t>();
+    s.time_scale = j.at("time_scale").get<double>();
+    return s;
+  });
+}
+
+Result<std::string> EncodeCoreInput(const CoreInput& in) {
+  return Guard<std::string>("journal entry", false, [&]() -> Result<std::string> {
+    json j = json::object();
+    if (!in.robot_id.empty()) j["r"] = in.robot_id;
+    if (!in.order_id.empty()) j["o"] = in.order_id;
+    if (!in.reason.empty()) j["why"] = in.reason;
+    if (in.order) {
+      auto o = OrderJson(*in.order);
+      if (!o.ok()) return o.error();
+      j["order"] = *o;
+    }
+    if (!in.robots.empty()) j["robots"] = in.robots;
+    if (in.robot) {
+      auto r = RobotJson(*in.robot);
+      if (!r.ok()) return r.error();
+      j["robot"] = *r;
+    }
+    if (in.plan) {
+      const engine::Assignment& a = *in.plan;
+      j["plan"] = {{"robot", a.robot_id}, {"id", a.plan_id}, {"orders", a.order_ids},
+                   {"released", a.released_up_to}, {"updated", a.updated_time},
+                   {"waypoints", Embedded(EncodeWaypoints(a.plan.waypoints))}};
+    }
+    if (in.place) j["place"] = true;
+    if (in.pose) {
+      const engine::Pose& p = *in.pose;
+      if (!std::isfinite(p.position.x()) || !std::isfinite(p.position.y()) || !std::isfinite(p.heading)) {
+        return engine::InvalidArgument("journal entry: non-finite pose");
+      }
+      j["p"] = PoseJson(p);
+    }
+    if (in.arc_id) j["a"] = *in.arc_id;
+    if (in.state) j["s"] = engine::RobotStateName(*in.state);
+    if (in.battery && std::isfinite(*in.battery)) j["b"] = *in.battery;
+    if (in.sequence) j["n"] = in.sequence;
+    if (in.kind == CoreInput::Kind::kPlanTask) j["task"] = {in.task.order_id, in.task.dropped};
+    if (in.ref) j["ref"] = in.ref;
+    if (in.change) j["change"] = in.change;
+    if (in.max) j["max"] = in.max;
+    if (in.cancelled) j["cancelled"] = true;
+    return j.dump();
+  });
+}
+
+Result<CoreInput> DecodeCoreInput(CoreInput::Kind kind, double time, const std::string& text) {
+  return Guard<CoreInput>("journal entry", true, [&]() -> Result<CoreInput> {
+    const json j = json::parse(text);
+    if (!j.is_object()) return Corrupt("journal entry", "not an object");
+    CoreInput in;
+    in.kind = kind;
+    in.time = time;
+    in.robot_id = j.value("r", "");
+    in.order_id = j.value("o", "");
+    in.reason = j.value("why", "");
+    if (j.contains("order")) {
+      auto o = OrderOf(j.at("order"));
+      if (!o.ok()) return o.error();
+      in.order = std::move(*o);
+    }
+    if (j.contains("robots")) in.robots = j.at("robots").get<std::vector<std::string>>();
+    if (j.contains("robot")) {
+      auto r = RobotOf(j.at("robot"));
+      if (!r.ok()) return r.error();
+      in.robot = std::move(*r);
+    }
+    if (j.contains("plan")) {
+      const json& p = j.at("plan");
+      engine::Assignment a;
+      a.robot_id = p.at("robot").get<std::string>();
+      a.plan_id = p.at("id").get<std::uint64_t>();
+      a.order_ids = p.at("orders").get<std::vector<std::string>>();
+      a.released_up_to = p.at("released").get<std::int64_t>();
+      a.updated_time = p.at("updated").get<double>();
+      auto waypoints = DecodeWaypoints(p.at("waypoints").dump());
+      if (!waypoints.ok()) return waypoints.error();
+      a.plan.robot_id = a.robot_id;
+      a.plan.waypoints = std::move(*waypoints);
+      in.plan = std::move(a);
+    }
+    in.place = j.value("place", false);
+    if (j.contains("p")) in.pose = PoseOf(j.at("p"));
+    if (j.contains("a")) in.arc_id = j.at("a").get<int>();
+    if (j.contains("s")) {
+      auto s = engine::ParseRobotState(j.at("s").get<std::string>());
+      if (!s) return Corrupt("journal entry", "unknown robot state");
+      in.state = *s;
+    }
+    if (j.contains("b")) in.battery = j.at("b").get<double>();
+    in.sequence = j.value("n", std::uint64_t{0});
+    if (j.contains("task")) {
+      in.task.order_id = j.at("task").at(0).get<std::string>();
+      in.task.dropped = j.at("task").at(1).get<bool>();
+    }
+    in.ref = j.value("ref", std::uint64_t{0});
+    in.change = j.value("change", std::uint64_t{0});
+    in.max = j.value("max", std::size_t{0});
+    in.cancelled = j.value("cancelled", false);
+    return in;
+  });
+}
+
+}  // namespace dispatch::storage

@@ -1,0 +1,288 @@
+// The core's journal in SQLite (storage/journal_store.h, storage/journal_json.h): inputs of
+// every kind read back exactly as written, runs are kept by the retention, paging, the
+// truncated mark, a run's setup round trip, and the errors.
+#include "storage/journal_store.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include "engine/io/map_json.h"
+#include "engine/map/chu2024_floor.h"
+#include "storage/journal_json.h"
+#include "temp_dir.h"
+
+namespace dispatch::storage::testing {
+namespace {
+
+using engine::CoreInput;
+using engine::JournalEntry;
+
+std::vector<JournalEntry> SampleEntries() {
+  std::vector<JournalEntry> out;
+  auto add = [&](CoreInput in, std::string output) {
+    out.push_back(JournalEntry{out.size() + 1, std::move(in), std::move(output)});
+  };
+  CoreInput order;
+  order.kind = CoreInput::Kind::kAddOrder;
+  engine::Order o;
+  o.id = "ord-7";
+  o.client_id = "wms \"A\"-7";
+  o.priority = 2;
+  o.picks = {3, 9};
+  o.drop = 12;
+  o.formation = true;
+  o.work_time = 4.5;
+  o.created_time = 0.1 + 0.2;  // not exactly 0.3
+  o.release_time = 1.0 / 3.0;
+  order.order = o;
+  order.robots = {"R2", "R10"};
+  add(order, "");
+  CoreInput restore;
+  restore.kind = CoreInput::Kind::kRestoreRobot;
+  engine::Robot r;
+  r.id = "R2";
+  r.state = engine::RobotState::kWorking;
+  r.pose.position = {1.25, std::sqrt(2.0)};
+  r.pose.heading = -std::acos(-1.0) / 7;
+  r.current_point = 3;
+  r.task_queue = {"ord-7"};
+  r.battery = 0.875;
+  restore.robot = r;
+  engine::Assignment a;
+  a.robot_id = "R2";
+  a.plan_id = 4;
+  a.order_ids = {"ord-7"};
+  a.plan.robot_id = "R2";
+  a.plan.waypoints = {{5, 3, {1.25, 1.5}, 0.7, engine::WaypointAction::kPick, 5.0},
+                      {6, 12, {2.0, 1.5}, 6.4, engine::WaypointAction::kDrop, 5.0}};
+  a.released_up_to = 5;
+  a.updated_time = 0.7;
+  restore.plan = a;
+  restore.place = true;
+  add(restore, "");
+  CoreInput report;
+  report.kind = CoreInput::Kind::kReport;
+  report.time = 12.000000000000002;
+  report.robot_id = "R2";
+  report.pose = r.pose;
+  report.arc_id = 17;
+  report.state = engine::RobotState::kMoving;
+  report.battery = 0.5;
+  report.sequence = 6;
+  add(report, "ord-7 -> in_progress [R2]");
+  CoreInput task;
+  task.kind = CoreInput::Kind::kPlanTask;
+  task.time = 13.5;
+  task.robot_id = "R2";
+  task.task = {"ord-7", true};
+  add(task, "ord-7 -> completed [R2]; R2 plan p5 1 wp #0");
+  CoreInput cancel;
+  cancel.kind = CoreInput::Kind::kPlanCancel;
+  cancel.time = 14;
+  cancel.order_id = "ord-8";
+  cancel.reason = "operator: \u00fcberf\u00e4llig";
+  add(cancel, "error: no order ord-8");
+  CoreInput awards;
+  awards.kind = CoreInput::Kind::kPlanAwards;
+  awards.time = 15;
+  awards.ref = 2;
+  awards.max = 4;
+  add(awards, "");
+  CoreInput committed;
+  committed.kind = CoreInput::Kind::kCommitted;
+  committed.ref = 2;
+  committed.change = 6;
+  add(committed, "");
+  CoreInput result;
+  result.kind = CoreInput::Kind::kRoundResult;
+  result.ref = 2;
+  result.cancelled = true;
+  add(result, "");
+  CoreInput reached;
+  reached.kind = CoreInput::Kind::kReached;
+  reached.time = 16;
+  reached.robot_id = "R2";
+  reached.sequence = 5;
+  add(reached, "");  // without a pose
+  return out;
+}
+
+void ExpectSameInput(const CoreInput& a, const CoreInput& b) {
+  EXPECT_EQ(a.kind, b.kind);
+  EXPECT_EQ(a.time, b.time);  // bit for bit
+  EXPECT_EQ(a.robot_id, b.robot_id);
+  EXPECT_EQ(a.order_id, b.order_id);
+  EXPECT_EQ(a.reason, b.reason);
+  ASSERT_EQ(a.order.has_value(), b.order.has_value());
+  if (a.order) {
+    EXPECT_EQ(a.order->id, b.order->id);
+    EXPECT_EQ(a.order->client_id, b.order->client_id);
+    EXPECT_EQ(a.order->priority, b.order->priority);
+    EXPECT_EQ(a.order->picks, b.order->picks);
+    EXPECT_EQ(a.order->drop, b.order->drop);
+    EXPECT_EQ(a.order->formation, b.order->formation);
+    EXPECT_EQ(a.order->work_time, b.order->work_time);
+    EXPECT_EQ(a.order->created_time, b.order->created_time);
+    EXPECT_EQ(a.order->release_time, b.order->release_time);
+    EXPECT_EQ(a.order->state, b.order->state);
+  }
+  EXPECT_EQ(a.robots, b.robots);
+  ASSERT_EQ(a.robot.has_value(), b.robot.has_value());
+  if (a.robot) {
+    EXPECT_EQ(a.robot->id, b.robot->id);
+    EXPECT_EQ(a.robot->state, b.robot->state);
+    EXPECT_EQ(a.robot->pose.position, b.robot->pose.position);
+    EXPECT_EQ(a.robot->pose.heading, b.robot->pose.heading);
+    EXPECT_EQ(a.robot->current_point, b.robot->current_point);
+    EXPECT_EQ(a.robot->task_queue, b.robot->task_queue);
+    EXPECT_EQ(a.robot->battery, b.robot->battery);
+  }
+  ASSERT_EQ(a.plan.has_value(), b.plan.has_value());
+  if (a.plan) {
+    EXPECT_EQ(a.plan->plan_id, b.plan->plan_id);
+    EXPECT_EQ(a.plan->order_ids, b.plan->order_ids);
+    EXPECT_EQ(a.plan->released_up_to, b.plan->released_up_to);
+    ASSERT_EQ(a.plan->plan.waypoints.size(), b.plan->plan.waypoints.size());
+    for (std::size_t i = 0; i < a.plan->plan.waypoints.size(); ++i) {
+      EXPECT_EQ(a.plan->plan.waypoints[i].eta, b.plan->plan.waypoints[i].eta);
+      EXPECT_EQ(a.plan->plan.waypoints[i].point, b.plan->plan.waypoints[i].point);
+      EXPECT_EQ(a.plan->plan.waypoints[i].action, b.plan->plan.waypoints[i].action);
+    }
+  }
+  EXPECT_EQ(a.place, b.place);
+  ASSERT_EQ(a.pose.has_value(), b.pose.has_value());
+  if (a.pose) {
+    EXPECT_EQ(a.pose->position, b.pose->position);
+    EXPECT_EQ(a.pose->heading, b.pose->heading);
+  }
+  EXPECT_EQ(a.arc_id, b.arc_id);
+  EXPECT_EQ(a.state, b.state);
+  EXPECT_EQ(a.battery, b.battery);
+  EXPECT_EQ(a.sequence, b.sequence);
+  EXPECT_EQ(a.task.order_id, b.task.order_id);
+  EXPECT_EQ(a.task.dropped, b.task.dropped);
+  EXPECT_EQ(a.ref, b.ref);
+  EXPECT_EQ(a.change, b.change);
+  EXPECT_EQ(a.max, b.max);
+  EXPECT_EQ(a.cancelled, b.cancelled);
+}
+
+TEST(JournalStoreTest, EntriesOfEveryKindReadBackExactly) {
+  TempDir dir;
+  const std::string path = (dir.path() / "j.db").string();
+  auto store = JournalStore::Open(path);
+  ASSERT_TRUE(store.ok()) << store.error().message;
+  auto run = (*store)->StartRun(1.5, "{}", 3);
+  ASSERT_TRUE(run.ok()) << run.error().message;
+  const std::vector<JournalEntry> entries = SampleEntries();
+  auto written = (*store)->Append(*run, entries);
+  ASSERT_TRUE(written.ok()) << written.error().message;
+  EXPECT_GT(*written, 0u);
+  // Read back in pages of 4.
+  std::vector<JournalEntry> read;
+  for (std::uint64_t after = 0;;) {
+    auto page = (*store)->Read(*run, after, 4);
+    ASSERT_TRUE(page.ok()) << page.error().message;
+    if (page->empty()) break;
+    after = page->back().seq;
+    read.insert(read.end(), page->begin(), page->end());
+  }
+  ASSERT_EQ(read.size(), entries.size());
+  for (std::size_t i = 0; i < entries.size(); ++i) {
+    SCOPED_TRACE(engine::CoreInputKindName(entries[i].input.kind));
+    EXPECT_EQ(read[i].seq, entries[i].seq);
+    EXPECT_EQ(read[i].output, entries[i].output);
+    ExpectSameInput(read[i].input, entries[i].input);
+  }
+  auto runs = (*store)->Runs();
+  ASSERT_TRUE(runs.ok());
+  ASSERT_EQ(runs->size(), 1u);
+  EXPECT_EQ((*runs)[0].entries, entries.size());
+  EXPECT_EQ((*runs)[0].bytes, *written);
+  EXPECT_FALSE((*runs)[0].truncated);
+  ASSERT_TRUE((*store)->Append(*run, {}, /*truncated=*/true).ok());
+  EXPECT_TRUE((*(*store)->Runs())[0].truncated);
+  EXPECT_EQ((*store)->Append(*run + 1, entries).error().code, engine::ErrorCode::kNotFound);
+}
+
+TEST(JournalStoreTest, StartRunKeepsTheNewestRuns) {
+  TempDir dir;
+  const std::string path = (dir.path() / "j.db").string();
+  auto store = JournalStore::Open(path);
+  ASSERT_TRUE(store.ok());
+  std::vector<std::int64_t> runs;
+  for (int i = 0; i < 4; ++i) {
+    auto run = (*store)->StartRun(i, "{}", 2);
+    ASSERT_TRUE(run.ok());
+    ASSERT_TRUE((*store)->Append(*run, SampleEntries()).ok());
+    runs.push_back(*run);
+  }
+  auto kept = (*store)->Runs();
+  ASSERT_TRUE(kept.ok());
+  ASSERT_EQ(kept->size(), 2u);
+  EXPECT_EQ((*kept)[0].run, runs[2]);
+  EXPECT_EQ((*kept)[1].run, runs[3]);
+  auto gone = (*store)->Read(runs[0], 0, 100);
+  ASSERT_TRUE(gone.ok());
+  EXPECT_TRUE(gone->empty()) << "a deleted run's entries go with it";
+  EXPECT_FALSE((*store)->StartRun(9, "{}", 0).ok());
+}
+
+TEST(JournalStoreTest, ReadOnlyNeedsAJournalAndCorruptRowsAreErrors) {
+  TempDir dir;
+  const std::string path = (dir.path() / "j.db").string();
+  EXPECT_FALSE(JournalStore::Open(path, /*read_only=*/true).ok()) << "no such file";
+  {
+    auto store = JournalStore::Open(path);
+    ASSERT_TRUE(store.ok());
+  }
+  auto read_only = JournalStore::Open(path, true);
+  ASSERT_TRUE(read_only.ok()) << read_only.error().message;
+  EXPECT_TRUE((*read_only)->Runs()->empty());
+  EXPECT_FALSE(engine::ParseCoreInputKind("teleport").has_value());
+  auto bad = DecodeCoreInput(CoreInput::Kind::kReport, 1.0, "{\"p\": \"here\"}");
+  ASSERT_FALSE(bad.ok());
+  EXPECT_EQ(bad.error().code, engine::ErrorCode::kIoError);
+  EXPECT_FALSE(DecodeCoreInput(CoreInput::Kind::kStep, 1.0, "[1, 2]").ok());
+  CoreInput nan;
+  nan.kind = CoreInput::Kind::kReport;
+  nan.pose = engine::Pose{{std::nan(""), 0.0}, 0.0};
+  EXPECT_EQ(EncodeCoreInput(nan).error().code, engine::ErrorCode::kInvalidArgument);
+}
+
+TEST(JournalStoreTest, ARunSetupRoundTrips) {
+  auto floor = engine::BuildChu2024Floor();
+  ASSERT_TRUE(floor.ok());
+  RunSetup s;
+  s.map_json = engine::WriteMapJson(*floor);
+  s.map_source = "builtin:chu2024";
+  s.strategy = "greedy";
+  s.allocation.zeta = 0.0;
+  s.allocation.work_time_override = 7.5;
+  s.core.traffic.t_w1 = 3.25;
+  s.core.traffic.head_on = engine::HeadOnPolicy::kAlwaysWait;
+  s.core.traffic_control = false;
+  s.route_cache_bytes = 1 << 20;
+  s.time_scale = 10;
+  auto text = EncodeRunSetup(s);
+  ASSERT_TRUE(text.ok()) << text.error().message;
+  auto back = DecodeRunSetup(*text);
+  ASSERT_TRUE(back.ok()) << back.error().message;
+  EXPECT_EQ(back->strategy, "greedy");
+  EXPECT_EQ(back->allocation.zeta, 0.0);
+  EXPECT_EQ(back->allocation.work_time_override, 7.5);
+  EXPECT_EQ(back->core.traffic.t_w1, 3.25);
+  EXPECT_EQ(back->core.traffic.head_on, engine::HeadOnPolicy::kAlwaysWait);
+  EXPECT_FALSE(back->core.traffic_control);
+  EXPECT_EQ(back->route_cache_bytes, std::size_t{1} << 20);
+  auto map = engine::ParseMapJson(back->map_json);
+  ASSERT_TRUE(map.ok()) << map.error().message;
+  EXPECT_EQ(engine::WriteMapJson(*map), s.map_json) << "the map reads back as written";
+  EXPECT_FALSE(DecodeRunSetup("{\"version\": \"9\"}").ok());
+}
+
+}  // namespace
+}  // namespace dispatch::storage::testing
