@@ -47,8 +47,25 @@ stop() {
   [ -n "$server_pid" ] && kill "$server_pid" 2>/dev/null || true
   wait 2>/dev/null || true
 }
+# dispatchd journals every call of its dispatch core (README "Replay"): once it has stopped,
+# the run is fed through a fresh core again and must give the same awards, grants, holds and
+# order states.
+replay() {
+  stop
+  server_pid="" fleet_pid=""
+  echo
+  echo "== Replay: the recorded run through a fresh dispatch core (dispatch-sim replay --db $run/dispatch.db) =="
+  local out rc=0
+  out=$("$bin/engine/cli/dispatch-sim" replay --db "$run/dispatch.db") || rc=$?
+  if [ "$rc" -ne 0 ]; then
+    echo "$out"
+    echo "demo: the replay did not match (exit $rc)" >&2
+    return 1
+  fi
+  tail -n 1 <<<"$out"
+}
 trap stop EXIT
-trap 'echo; echo "demo: stopping"; exit 0' INT TERM
+trap 'echo; echo "demo: stopping"; replay; exit $?' INT TERM
 mkfifo "$run/ready" "$run/fleet-ready"
 "$bin/server/dispatchd" --bind "${BIND:-127.0.0.1}" --grpc-port "${GRPC_PORT:-0}" --http-port "${HTTP_PORT:-0}" \
   --db "$run/dispatch.db" --map chu2024 --time-scale "${TIME_SCALE:-5}" \
@@ -103,6 +120,9 @@ echo "Live web map: http://$http/  (metrics: http://$http/metrics)"
 echo "Orders, robots, traffic and the service status: curl http://$http/api/v1/orders, http://$http/api/v1/robots,"
 echo "  http://$http/api/v1/traffic, http://$http/api/v1/zones, http://$http/api/v1/intersections, http://$http/api/v1/status"
 echo "An allocation's reasons: $bin/clients/wmsctl --server $grpc explain <order id>"
-if [ "${DEMO_EXIT:-0}" = 1 ]; then exit 0; fi
-echo "Serving the web map until Ctrl-C."
+if [ "${DEMO_EXIT:-0}" = 1 ]; then
+  replay
+  exit $?
+fi
+echo "Serving the web map until Ctrl-C (then the run is replayed)."
 wait "$server_pid"

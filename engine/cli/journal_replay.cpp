@@ -77,8 +77,8 @@ void PrintColumns(const std::vector<Column>& cols) {
   row("makespan (s)", [&](const Column& c) { return num(c.makespan, "%.1f"); });
   row("orders/h", [&](const Column& c) { return num(c.per_hour, "%.1f"); });
   row("waiting (robot-s)", [&](const Column& c) { return num(c.waiting, "%.1f"); });
-  row("re-plans", [](const Column& c) { return std::to_string(c.replans); });
-  row("grants", [](const Column& c) { return std::to_string(c.grants); });
+  row("detours", [](const Column& c) { return std::to_string(c.replans); });
+  row("intersection grants", [](const Column& c) { return std::to_string(c.grants); });
 }
 
 struct Loaded {
@@ -198,8 +198,10 @@ int RunReplay(const ReplayArgs& a) {
   recorded.makespan = last;
   recorded.per_hour = last > 0 ? recorded.completed / last * 3600.0 : 0.0;
   recorded.waiting = core.hold_seconds();
-  recorded.replans = core.core().counts().replans;
-  recorded.grants = core.core().counts().grants;
+  if (const TrafficGate* gate = core.core().gate()) {  // the counters the simulations report
+    recorded.replans = gate->stats().replans;
+    recorded.grants = gate->stats().grants;
+  }
   std::printf("replay of run %lld matched: %llu entries, %zu orders (%zu completed), %zu robots%s\n",
               static_cast<long long>(loaded->run.run), static_cast<unsigned long long>(matched),
               recorded.orders, recorded.completed, robots.size(),
