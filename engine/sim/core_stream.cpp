@@ -46,6 +46,7 @@ class CoreRun {
       index_.emplace(fr.id, bots_.size());
       bots_.emplace_back(fr.id, r.pose.position, config_.allocation.speed);
       was_waiting_.push_back(false);
+      reported_.emplace_back();
       Deliver(core_->Connect(std::move(r), 0.0));
     }
     std::stable_sort(orders.begin(), orders.end(),
@@ -132,6 +133,16 @@ class CoreRun {
                                : bot.moving() ? RobotState::kMoving
                                : waiting      ? RobotState::kWaiting
                                               : RobotState::kIdle;
+      // The same report again (pose, state, progress) changes nothing in the core (only the
+      // core's Disconnect and a block change a robot's state, and neither happens to a robot
+      // that stands still here before it reports again): a robot standing still is not
+      // reported again.
+      LastReport& last = reported_[i];
+      if (last.sent && last.pose.position == pose.position && last.pose.heading == pose.heading &&
+          last.state == state && last.reached == bot.last_reached()) {
+        continue;
+      }
+      last = {true, pose, state, bot.last_reached()};
       Progressed(bot.id(), core_->Report(bot.id(), pose, std::nullopt, state, std::nullopt, bot.last_reached(), t), t);
     }
   }
@@ -229,6 +240,13 @@ class CoreRun {
   std::vector<WaypointRobot> bots_;
   std::unordered_map<std::string, std::size_t> index_;
   std::vector<bool> was_waiting_;
+  struct LastReport {
+    bool sent = false;
+    Pose pose;
+    RobotState state = RobotState::kIdle;
+    std::uint64_t reached = 0;
+  };
+  std::vector<LastReport> reported_;  // each robot's last state report
   std::vector<Order> orders_;  // by release time
   std::size_t next_release_ = 0;
   double next_allocation_ = 0.0;

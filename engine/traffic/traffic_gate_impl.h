@@ -89,6 +89,20 @@ struct GateImpl {
   std::vector<std::size_t> team_pool;     // removed team agents, reusable
   std::size_t team_agents = 0;            // team agents ever added (their ids)
   MinDistance min_distance;
+  // SampleDistances' scratch, kept between calls (no allocation per sample): per robot its
+  // position (clamped onto the grid), 1 m cell, index and team keys once needed; the grid over
+  // the floor (built on first use) with a list head per cell and a next link per robot.
+  struct DistanceItem {
+    Eigen::Vector2d xy;
+    long long cell;
+    std::size_t order;
+    const GateBot* bot;
+    mutable std::optional<std::pair<std::string, std::string>> keys;
+  };
+  std::vector<DistanceItem> distance_items;
+  Eigen::Vector2d distance_origin = Eigen::Vector2d::Zero();
+  std::size_t distance_cols = 0, distance_rows = 0;
+  std::vector<int> distance_head, distance_next;
   std::vector<std::string> notes;  // TrafficGate::TakeNotes
   // The earliest planned departure (dispatcher seconds) a standing robot or team waits for,
   // seen by the last Step: nothing else may change by then (+inf: none).

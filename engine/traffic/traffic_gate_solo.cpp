@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <optional>
 #include <cmath>
+#include <limits>
 #include <unordered_map>
 
 #include "engine/fleet/formation.h"
@@ -381,10 +382,31 @@ std::pair<std::string, std::string> GateImpl::TeamKeys(const GateBot& b) const {
 }
 
 void GateImpl::SampleDistances(double t) {
-  // Team keys only for pairs closer than the minimum so far (rare once it is near eps1).
-  struct Item {
-    const GateBot* bot;
-    mutable std::optional<std::pair<std::string, std::string>> keys;
+  // Robots in 1 m cells of a grid over the floor (linked lists through `distance_next`, no
+  // allocation per sample); every pair in neighbouring cells is measured once, the earlier
+  // robot in id order first. Team keys only for pairs closer than the minimum so far (rare
+  // once it is near eps1).
+  using Item = DistanceItem;
+  if (distance_cols == 0) {  // the grid, once: the floor's bounds and a cell's margin
+    Eigen::Vector2d lo = Eigen::Vector2d::Constant(std::numeric_limits<double>::infinity());
+    Eigen::Vector2d hi = -lo;
+    for (const auto& p : map->points()) {
+      lo = lo.cwiseMin(p.position);
+      hi = hi.cwiseMax(p.position);
+    }
+    if (!std::isfinite(lo.x())) lo = hi = Eigen::Vector2d::Zero();
+    distance_origin = lo - Eigen::Vector2d::Constant(2.0);
+    distance_cols = static_cast<std::size_t>(std::ceil(hi.x() - distance_origin.x())) + 3;
+    distance_rows = static_cast<std::size_t>(std::ceil(hi.y() - distance_origin.y())) + 3;
+    distance_head.assign(distance_cols * distance_rows, -1);
+  }
+  auto cell_of = [&](const Eigen::Vector2d& xy, long long dx, long long dy) -> long long {
+    const long long cx = static_cast<long long>(std::floor(xy.x() - distance_origin.x())) + dx;
+    const long long cy = static_cast<long long>(std::floor(xy.y() - distance_origin.y())) + dy;
+    if (cx < 0 || cy < 0 || cx >= static_cast<long long>(distance_cols) || cy >= static_cast<long long>(distance_rows)) {
+      return -1;
+    }
+    return cy * static_cast<long long>(distance_cols) + cx;
   };
   auto keys_of = [this](const Item& i) -> const std::pair<std::string, std::string>& {
     if (!i.keys) i.keys = TeamKeys(*i.bot);
@@ -398,26 +420,35 @@ void GateImpl::SampleDistances(double t) {
     }
     return false;
   };
-  std::unordered_map<long long, std::vector<Item>> cells;
-  auto key = [](long long x, long long y) { return (x << 32) ^ (y & 0xffffffffLL); };
+  std::vector<Item>& items = distance_items;
+  items.clear();
   for (auto& [id, b] : bots) {
     if (!b.has_xy || !b.connected) continue;
-    const long long cx = static_cast<long long>(std::floor(b.xy.x()));
-    const long long cy = static_cast<long long>(std::floor(b.xy.y()));
-    const Item me{&b, std::nullopt};
+    // Off the grid (a pose the floor's margin does not cover): the nearest border cell.
+    const Eigen::Vector2d xy = b.xy.cwiseMax(distance_origin).cwiseMin(
+        distance_origin + Eigen::Vector2d(static_cast<double>(distance_cols) - 1e-6, static_cast<double>(distance_rows) - 1e-6));
+    items.push_back({xy, cell_of(xy, 0, 0), items.size(), &b, std::nullopt});
+  }
+  distance_next.assign(items.size(), -1);
+  for (const Item& me : items) {
+    const auto c = static_cast<std::size_t>(me.cell);
+    const Eigen::Vector2d& xy = me.xy;
     for (long long dx = -1; dx <= 1; ++dx) {
       for (long long dy = -1; dy <= 1; ++dy) {
-        auto it = cells.find(key(cx + dx, cy + dy));
-        if (it == cells.end()) continue;
-        for (const Item& o : it->second) {
-          const double d = (o.bot->xy - b.xy).norm();
+        const long long n = cell_of(xy, dx, dy);
+        if (n < 0) continue;
+        for (int j = distance_head[static_cast<std::size_t>(n)]; j >= 0; j = distance_next[static_cast<std::size_t>(j)]) {
+          const Item& o = items[static_cast<std::size_t>(j)];
+          const double d = (o.bot->xy - me.bot->xy).norm();
           if (d >= min_distance.distance || same_agent(o, me)) continue;
-          min_distance = {d, o.bot->id, b.id, t};
+          min_distance = {d, o.bot->id, me.bot->id, t};
         }
       }
     }
-    cells[key(cx, cy)].push_back(me);
+    distance_next[me.order] = distance_head[c];  // the earlier robots only: each pair once
+    distance_head[c] = static_cast<int>(me.order);
   }
+  for (const Item& me : items) distance_head[static_cast<std::size_t>(me.cell)] = -1;
 }
 
 }  // namespace dispatch::engine
