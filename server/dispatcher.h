@@ -348,6 +348,7 @@ class Dispatcher {
   // Journal writes (options_.journal), in batch order; stopped last.
   std::unique_ptr<WorkerThread> journal_worker_;
   std::uint64_t journal_bytes_ = 0;         // journal worker only
+  bool journal_failed_ = false;             // journal worker only: a write failed
   std::atomic<bool> journal_full_{false};   // set by the worker at journal_max_bytes
   bool journal_stopped_ = false;            // loop: recording stopped, marker written
 };

@@ -21,11 +21,15 @@ void Dispatcher::WriteJournal() {
   const std::uint64_t limit = options_.journal_max_bytes;
   journal_worker_->Run([this, journal, run, limit, full, entries = std::move(entries)](bool) {
     // Written even when the worker stops (cancelled): the journal must hold the run's end.
-    auto written = journal->Append(run, entries, full);
+    // After a failed write nothing more is (a gap would make the rest unreplayable); the run
+    // is marked truncated.
+    auto written = journal_failed_ ? journal->Append(run, {}, true) : journal->Append(run, entries, full);
+    if (journal_failed_) return;
     if (!written.ok()) {
-      spdlog::error("journal run {}: {} entries not written, a replay ends before them: {}", run, entries.size(),
-                    written.error().message);
-      journal_full_ = true;  // a gap would make the rest unreplayable: stop here
+      spdlog::error("journal run {}: {} entries not written, recording stops (a replay ends before them): {}", run,
+                    entries.size(), written.error().message);
+      journal_failed_ = true;
+      journal_full_ = true;
       return;
     }
     journal_bytes_ += *written;

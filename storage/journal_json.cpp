@@ -3,6 +3,7 @@
 #include <nlohmann/json.hpp>
 
 #include <cmath>
+#include <limits>
 #include <stdexcept>
 
 #include "storage/record_json.h"
@@ -77,11 +78,27 @@ Result<engine::Robot> RobotOf(const json& j) {
   return r;
 }
 
-json PoseJson(const engine::Pose& p) { return json{p.position.x(), p.position.y(), p.heading}; }
+// A robot may report anything (NaN, infinities: the core ignores such poses), and the journal
+// keeps what the core was given: non-finite numbers as the strings "nan", "inf", "-inf".
+json Num(double v) {
+  if (std::isnan(v)) return "nan";
+  if (std::isinf(v)) return v > 0 ? "inf" : "-inf";
+  return v;
+}
+double NumOf(const json& j) {
+  if (!j.is_string()) return j.get<double>();
+  const std::string s = j.get<std::string>();
+  if (s == "nan") return std::numeric_limits<double>::quiet_NaN();
+  if (s == "inf") return std::numeric_limits<double>::infinity();
+  if (s == "-inf") return -std::numeric_limits<double>::infinity();
+  throw std::invalid_argument("not a number: " + s);
+}
+
+json PoseJson(const engine::Pose& p) { return json{Num(p.position.x()), Num(p.position.y()), Num(p.heading)}; }
 engine::Pose PoseOf(const json& j) {
   engine::Pose p;
-  p.position = {j.at(0).get<double>(), j.at(1).get<double>()};
-  p.heading = j.at(2).get<double>();
+  p.position = {NumOf(j.at(0)), NumOf(j.at(1))};
+  p.heading = NumOf(j.at(2));
   return p;
 }
 
@@ -208,16 +225,10 @@ Result<std::string> EncodeCoreInput(const CoreInput& in) {
                    {"waypoints", Embedded(EncodeWaypoints(a.plan.waypoints))}};
     }
     if (in.place) j["place"] = true;
-    if (in.pose) {
-      const engine::Pose& p = *in.pose;
-      if (!std::isfinite(p.position.x()) || !std::isfinite(p.position.y()) || !std::isfinite(p.heading)) {
-        return engine::InvalidArgument("journal entry: non-finite pose");
-      }
-      j["p"] = PoseJson(p);
-    }
+    if (in.pose) j["p"] = PoseJson(*in.pose);
     if (in.arc_id) j["a"] = *in.arc_id;
     if (in.state) j["s"] = engine::RobotStateName(*in.state);
-    if (in.battery && std::isfinite(*in.battery)) j["b"] = *in.battery;
+    if (in.battery) j["b"] = Num(*in.battery);
     if (in.sequence) j["n"] = in.sequence;
     if (in.kind == CoreInput::Kind::kPlanTask) j["task"] = {in.task.order_id, in.task.dropped};
     if (in.ref) j["ref"] = in.ref;
@@ -271,7 +282,7 @@ Result<CoreInput> DecodeCoreInput(CoreInput::Kind kind, double time, const std::
       if (!s) return Corrupt("journal entry", "unknown robot state");
       in.state = *s;
     }
-    if (j.contains("b")) in.battery = j.at("b").get<double>();
+    if (j.contains("b")) in.battery = NumOf(j.at("b"));
     in.sequence = j.value("n", std::uint64_t{0});
     if (j.contains("task")) {
       in.task.order_id = j.at("task").at(0).get<std::string>();

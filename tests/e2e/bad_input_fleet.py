@@ -27,6 +27,7 @@ acknowledged, also after a restart on the same database.
     bad_input_fleet.py --stubs DIR --dispatchd BIN --fleet-sim BIN --wmsctl BIN --scenarios DIR
 """
 import math
+import os
 import queue
 import sys
 import threading
@@ -290,6 +291,9 @@ def main():
         check_intact(h, server, book, "after a restart on the same database")
         check_serving(h, server, book, "fleet-restarted")
         cases.finish()
+        # Both runs, attacks included, replay through a fresh dispatch core.
+        for run in (1, 2):
+            h.replay(args.dispatch_sim, os.path.join(h.work, "dispatch.db"), run)
 
 
 if __name__ == "__main__":

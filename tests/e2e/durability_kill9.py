@@ -9,9 +9,12 @@ fleet-sim (which reconnects by itself) finds it again. Then:
   - submitting the same file again returns the same orders (idempotent on client ids);
   - every robot reconnects and every order completes;
   - traffic control released nothing until every robot had reported back, and no two robots
-    came closer than eps1 after the restart.
+    came closer than eps1 after the restart;
+  - both runs replay through a fresh dispatch core (dispatch-sim replay): the killed one up to
+    the last batch its journal holds, the restarted one from its recovery on.
 
     durability_kill9.py --stubs DIR --dispatchd BIN --fleet-sim BIN --wmsctl BIN --scenarios DIR
+                        --dispatch-sim BIN
 """
 import os
 import sys
@@ -128,6 +131,10 @@ def main():
         check(closest["distance"] >= EPS1 - 1e-6,
               f"after the restart robots {closest['robot_ids']} came {closest['distance']:.6f} m close "
               f"(eps1 = {EPS1} m)")
+
+        # The journal: the killed run up to what it had written, the restarted run whole.
+        for run in (1, 2):
+            h.replay(args.dispatch_sim, db, run)
 
 
 if __name__ == "__main__":

@@ -67,6 +67,7 @@ def common_arguments(description):
     p.add_argument("--fleet-sim", required=True)
     p.add_argument("--wmsctl", required=True)
     p.add_argument("--scenarios", required=True, help="folder of the seed CSV tables")
+    p.add_argument("--dispatch-sim", required=True, help="for `dispatch-sim replay` of the recorded runs")
     return p
 
 
@@ -326,6 +327,20 @@ class Harness(contextlib.AbstractContextManager):
                 return last
             time.sleep(interval)  # poll interval of a condition, not a synchronisation
         raise TestFailure(f"timed out after {timeout} s waiting for {what} (last: {last!r})")
+
+    # --- the dispatch core's journal ---------------------------------------------------
+    def replay(self, dispatch_sim, db, run, *extra):
+        """Stops every process, then `dispatch-sim replay --db DB --run N [extra]`; fails
+        unless it exits 0 (the run matched). Returns its output."""
+        for p in self.processes:
+            p.stop()
+        cmd = [dispatch_sim, "replay", "--db", db, "--run", str(run)] + list(extra)
+        self.log("run " + " ".join(cmd))
+        r = subprocess.run(cmd, capture_output=True, text=True, timeout=600)
+        lines = r.stdout.strip().splitlines()
+        self.log(f"replay of run {run}: exit {r.returncode}: {lines[-1] if lines else ''} {r.stderr.strip()}")
+        check(r.returncode == 0, f"run {run} did not replay (exit {r.returncode}): {r.stdout[-3000:]} {r.stderr}")
+        return r.stdout
 
     # --- lifetime -----------------------------------------------------------------------
     def __exit__(self, exc_type, exc, tb):

@@ -14,6 +14,7 @@ and R1 stays offline. Finally a new order goes to a live robot and completes.
 
     heartbeat_loss.py --stubs DIR --dispatchd BIN --fleet-sim BIN --wmsctl BIN --scenarios DIR
 """
+import os
 import sys
 import time
 import uuid
@@ -133,6 +134,9 @@ def main():
         c_order = server.orders.GetOrder(orders_pb2.GetOrderRequest(order_id=c), timeout=10)
         check(final[c].state == COMPLETED and "R1" not in c_order.robot_ids,
               f"C ended {state_name(final[c].state)} on {list(c_order.robot_ids)}")
+
+        # The run (a robot lost, its orders re-allocated) replays through a fresh core.
+        h.replay(args.dispatch_sim, os.path.join(h.work, "dispatch.db"), 1)
 
 
 if __name__ == "__main__":

@@ -64,6 +64,8 @@ def main():
         check(closed >= 1 and connects > ROBOTS,
               "dispatchd did not see the drops and reconnections (log lines "
               "'offline: stream closed' / 'connected at')")
+        # The run, drops and reconnections included, replays through a fresh dispatch core.
+        h.replay(args.dispatch_sim, os.path.join(h.work, "dispatch.db"), 1)
 
 
 if __name__ == "__main__":

@@ -18,7 +18,6 @@ import csv
 import os
 import random
 import re
-import subprocess
 import sys
 
 sys.dont_write_bytecode = True  # no __pycache__ in the source tree
@@ -61,14 +60,6 @@ def serve(h, server, path):
     return {i: e.state for i, e in final.items()}
 
 
-def run(cmd):
-    print("[e2e] run " + " ".join(cmd), flush=True)
-    r = subprocess.run(cmd, capture_output=True, text=True, timeout=600)
-    sys.stdout.write(r.stdout)
-    sys.stdout.write(r.stderr)
-    return r
-
-
 def row(output, name):
     """The cells of a row of the what-if table."""
     for line in output.splitlines():
@@ -78,9 +69,7 @@ def row(output, name):
 
 
 def main():
-    parser = common_arguments(__doc__)
-    parser.add_argument("--dispatch-sim", required=True)
-    args = parser.parse_args()
+    args = common_arguments(__doc__).parse_args()
     tables = [os.path.join(args.scenarios, t) for t in ("chu2024-table1.csv", "chu2024-table2.csv")]
     with Harness(args, "replay") as h:
         db = os.path.join(h.work, "recorded.db")
@@ -109,17 +98,15 @@ def main():
         check(server.stop() == 0, "dispatchd did not stop cleanly")
 
         for run_number, orders in ((1, 18), (2, 36)):
-            r = run([args.dispatch_sim, "replay", "--db", db, "--run", str(run_number)])
-            check(r.returncode == 0, f"the replay of run {run_number} did not match (exit {r.returncode})")
-            check(re.search(rf"replay of run {run_number} matched: \d+ entries, {orders} orders", r.stdout),
+            out = h.replay(args.dispatch_sim, db, run_number)
+            check(re.search(rf"replay of run {run_number} matched: \d+ entries, {orders} orders", out),
                   f"the replay of run {run_number} did not report {orders} matched orders")
 
-        # Run 2's orders with the whole fleet and with 3 robots fewer.
-        r = run([args.dispatch_sim, "replay", "--db", db, "--run", "2", "--what-if", "--robots", "15"])
-        check(r.returncode == 0, f"the what-if with 15 robots did not complete every order (exit {r.returncode})")
-        completed = row(r.stdout, "completed")
-        makespan = [float(x) for x in row(r.stdout, "makespan (s)")]
-        robots = row(r.stdout, "robots")
+        # Run 2's orders with the whole fleet and with 3 robots fewer (exit 0: all completed).
+        out = h.replay(args.dispatch_sim, db, 2, "--what-if", "--robots", "15")
+        completed = row(out, "completed")
+        makespan = [float(x) for x in row(out, "makespan (s)")]
+        robots = row(out, "robots")
         check(robots[1:] == ["18", "15"], f"robots row {robots}")
         check(completed[1] == completed[2] and completed[2].split("/")[0] == completed[2].split("/")[1],
               f"completed row {completed}")

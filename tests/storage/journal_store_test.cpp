@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -247,10 +248,20 @@ TEST(JournalStoreTest, ReadOnlyNeedsAJournalAndCorruptRowsAreErrors) {
   ASSERT_FALSE(bad.ok());
   EXPECT_EQ(bad.error().code, engine::ErrorCode::kIoError);
   EXPECT_FALSE(DecodeCoreInput(CoreInput::Kind::kStep, 1.0, "[1, 2]").ok());
-  CoreInput nan;
-  nan.kind = CoreInput::Kind::kReport;
-  nan.pose = engine::Pose{{std::nan(""), 0.0}, 0.0};
-  EXPECT_EQ(EncodeCoreInput(nan).error().code, engine::ErrorCode::kInvalidArgument);
+  // What a robot may send (the core ignores it) is journaled as sent.
+  CoreInput odd;
+  odd.kind = CoreInput::Kind::kReport;
+  odd.pose = engine::Pose{{std::nan(""), std::numeric_limits<double>::infinity()}, -1e300 * 1e300};
+  odd.battery = std::nan("");
+  auto text = EncodeCoreInput(odd);
+  ASSERT_TRUE(text.ok()) << text.error().message;
+  auto back = DecodeCoreInput(CoreInput::Kind::kReport, 0.0, *text);
+  ASSERT_TRUE(back.ok()) << back.error().message;
+  EXPECT_TRUE(std::isnan(back->pose->position.x()));
+  EXPECT_EQ(back->pose->position.y(), std::numeric_limits<double>::infinity());
+  EXPECT_EQ(back->pose->heading, -std::numeric_limits<double>::infinity());
+  EXPECT_TRUE(std::isnan(*back->battery));
+  EXPECT_FALSE(DecodeCoreInput(CoreInput::Kind::kReport, 0.0, "{\"p\": [\"big\", 0, 0]}").ok());
 }
 
 TEST(JournalStoreTest, ARunSetupRoundTrips) {
