@@ -72,6 +72,7 @@ Dispatcher::Dispatcher(std::shared_ptr<const engine::WarehouseMap> map,
       rounds_(std::move(rounds)),
       core_(std::move(core)),
       wall_start_(Clock::now()),
+      book_(options_.finished_retained),
       // Below the loop's priority: traffic control first when the cores are busy.
       route_worker_(std::make_unique<WorkerThread>(kWorkerNice)),
       allocation_worker_(std::make_unique<WorkerThread>(kWorkerNice)),
@@ -90,10 +91,8 @@ engine::Status Dispatcher::Recover() {
   // submission order) and trimmed to the newest finished_retained after every page, so a long
   // history never passes through memory whole.
   auto keep_newest = [this](std::size_t slack) {
-    std::stable_sort(finished_.begin(), finished_.end(), [this](const std::string& a, const std::string& b) {
-      return Find(a)->finished_time.value_or(0.0) < Find(b)->finished_time.value_or(0.0);
-    });
-    Retire(slack);
+    book_.SortFinished();
+    book_.Retire(slack);
   };
   storage::OrderQuery query;
   query.page_size = storage::kMaxPageSize;
@@ -109,7 +108,7 @@ engine::Status Dispatcher::Recover() {
       if (id.rfind("ord-", 0) == 0) {
         last_order_number_ = std::max<std::int64_t>(last_order_number_, std::atoll(id.c_str() + 4));
       }
-      Put(std::move(view));
+      book_.Put(std::move(view));
     }
     if (page->next_page_token.empty()) break;
     query.page_token = page->next_page_token;
@@ -126,16 +125,16 @@ engine::Status Dispatcher::Recover() {
       events.after_id = event.id;
       auto explanation = ParseAllocationDetail(event.detail);
       if (!explanation) continue;
-      if (auto view = Find(event.order_id)) {
+      if (auto view = book_.Find(event.order_id)) {
         auto copy = std::make_shared<OrderView>(*view);
         copy->explanation = std::move(*explanation);
-        Put(std::move(copy));
+        book_.Put(std::move(copy));
       }
     }
     if (batch->size() < static_cast<std::size_t>(events.limit)) break;
   }
   // The open orders enter the core with their robots.
-  for (const auto& view : orders_) {
+  for (const auto& view : book_.all()) {
     const storage::OrderRecord& rec = view->record;
     if (!engine::IsTerminal(rec.order.state)) core_->AddOrder(rec.order, rec.robots);
   }
@@ -167,9 +166,9 @@ engine::Status Dispatcher::Recover() {
                         !was_on_line);
   }
   std::uint64_t retired = 0;
-  for (const auto& [state, n] : finished_in_store_) retired += n;
+  for (const auto& [state, n] : book_.finished_in_store()) retired += n;
   spdlog::info("recovered {} orders ({} finished ones left in the store), {} robots, {} assignments; "
-               "dispatcher time {:.1f} s", orders_.size(), retired, sessions_.size(), plans.size(), time_base_);
+               "dispatcher time {:.1f} s", book_.all().size(), retired, sessions_.size(), plans.size(), time_base_);
   if (!awaiting_reconnect_.empty()) {
     spdlog::info("traffic control waits up to {:.1f} s for the {} robots that were on line to report",
                  options_.heartbeat_timeout, awaiting_reconnect_.size());
@@ -283,7 +282,7 @@ void Dispatcher::Flush() {
   // it in the snapshot. Changes nobody is told about yet (robot reports, grants) are
   // published at most every kPublishEvery: a snapshot copies every robot and order, and 500
   // robots reporting at 10 Hz make hundreds of batches a second.
-  Retire(std::min(kRetireSlack, options_.finished_retained / 16));  // small retentions trim exactly
+  if (book_.Retire(std::min(kRetireSlack, options_.finished_retained / 16))) dirty_ = true;  // small ones: exactly
   if (dirty_ && (deferred_need_publish_ || Clock::now() - last_publish_ >= kPublishEvery)) Publish();
   deferred_need_publish_ = false;
   std::vector<std::function<void()>> effects;
@@ -300,13 +299,9 @@ void Dispatcher::Publish() {
   snap->map_version = options_.map_version;
   snap->strategy = options_.strategy;
   snap->time_scale = options_.time_scale;
-  snap->orders = orders_;
-  snap->finished_in_store = finished_in_store_;
-  if (!published_index_ || published_generation_ != book_generation_) {
-    published_index_ = std::make_shared<const Snapshot::OrderIndex>(Snapshot::OrderIndex{by_id_, by_client_id_});
-    published_generation_ = book_generation_;
-  }
-  snap->index = published_index_;
+  snap->orders = book_.all();
+  snap->finished_in_store = book_.finished_in_store();
+  snap->index = book_.Index();
   const engine::TrafficGate* gate = core_->gate();
   for (const auto& [id, r] : core_->robots()) {
     RobotView view;

@@ -78,6 +78,7 @@
 #include "engine/traffic/traffic_controller.h"
 #include "engine/traffic/traffic_gate.h"
 #include "server/metrics.h"
+#include "server/order_views.h"
 #include "server/robot_link.h"
 #include "server/service_status.h"
 #include "server/snapshot.h"
@@ -222,13 +223,6 @@ class Dispatcher {
   void DoSubmit(const engine::OrderRequest& request, const std::function<void(SubmitReply)>& done);
   void DoCancel(const std::string& order_id, const std::string& reason,
                 const std::function<void(OrderReply)>& done);
-  std::shared_ptr<const OrderView> Find(const std::string& order_id) const;
-  // Replaces (or adds, at the end) an order in the book; a finished one joins the finished
-  // list that Retire trims.
-  void Put(std::shared_ptr<OrderView> view);
-  // Once more than finished_retained + slack finished orders are in memory, the oldest
-  // finished ones leave it (they stay in the store) down to finished_retained.
-  void Retire(std::size_t slack);
   std::string NextOrderId();
 
   // Carrying out the core's changes (dispatcher_commit.cpp). Commit stores `change` in one
@@ -309,15 +303,7 @@ class Dispatcher {
   std::unique_ptr<engine::JournaledCore> core_;  // the dispatch book and its rules, journaled
   Clock::time_point wall_start_;
   double time_base_ = 0.0;  // dispatcher seconds at wall_start_
-  // The book: every open order and the newest finished ones, by position (submission order).
-  std::vector<std::shared_ptr<const OrderView>> orders_;
-  std::unordered_map<std::string, std::size_t> by_id_;
-  std::unordered_map<std::string, std::size_t> by_client_id_;
-  std::deque<std::string> finished_;  // the finished orders in memory, in finish order
-  std::map<engine::OrderState, std::uint64_t> finished_in_store_;  // retired, by state
-  std::uint64_t book_generation_ = 0;  // changes when orders join or leave the book
-  std::uint64_t published_generation_ = 0;
-  std::shared_ptr<const Snapshot::OrderIndex> published_index_;  // copy of the two maps above
+  OrderViews book_;  // every open order and the newest finished ones, as operators read them
   std::map<std::string, RobotSession> sessions_;  // every robot the core knows
   std::unordered_map<const RobotLink*, std::string> link_robot_;
   std::int64_t last_order_number_ = 0;

@@ -70,7 +70,7 @@ bool Dispatcher::Commit(const engine::Change& change, const ServerRound* round, 
   std::vector<engine::RobotCommand> commands = core_->Apply(change);
   // The order views follow the same lines.
   for (const engine::OrderChange& line : change.orders) {
-    auto found = Find(line.order_id);
+    auto found = book_.Find(line.order_id);
     if (!found) continue;
     auto view = std::make_shared<OrderView>(*found);
     if (auto d = change.dropped_by.find(line.order_id); d != change.dropped_by.end()) view->dropped_by = d->second;
@@ -89,7 +89,7 @@ bool Dispatcher::Commit(const engine::Change& change, const ServerRound* round, 
       if (to == engine::OrderState::kAssigned) spdlog::info("order {} assigned: {}", line.order_id, line.detail);
       if (to == engine::OrderState::kCompleted) spdlog::info("order {} completed", line.order_id);
     }
-    Put(std::move(view));
+    book_.Put(std::move(view));
   }
   for (const auto& e : events) Journal(e);
   Send(std::move(commands));

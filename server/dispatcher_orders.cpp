@@ -1,5 +1,5 @@
-// Dispatcher: the order book (open orders and the newest finished ones in memory, the rest in
-// the store: DispatcherOptions::finished_retained) and the order commands (submit, cancel).
+// Dispatcher: the order commands (submit, cancel) and finding an order anywhere (the book,
+// server/order_views.h, else the store).
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
@@ -9,55 +9,6 @@
 #include "server/json_convert.h"
 
 namespace dispatch::server {
-
-std::shared_ptr<const OrderView> Dispatcher::Find(const std::string& order_id) const {
-  auto it = by_id_.find(order_id);
-  return it == by_id_.end() ? nullptr : orders_[it->second];
-}
-
-void Dispatcher::Put(std::shared_ptr<OrderView> view) {
-  const std::string id = view->record.order.id;
-  const bool finished = engine::IsTerminal(view->record.order.state);
-  auto it = by_id_.find(id);
-  if (it == by_id_.end()) {
-    by_id_.emplace(id, orders_.size());
-    by_client_id_.emplace(view->record.order.client_id, orders_.size());
-    orders_.push_back(std::move(view));
-    ++book_generation_;
-    if (finished) finished_.push_back(id);
-  } else {
-    if (finished && !engine::IsTerminal(orders_[it->second]->record.order.state)) finished_.push_back(id);
-    orders_[it->second] = std::move(view);
-  }
-  dirty_ = true;
-}
-
-void Dispatcher::Retire(std::size_t slack) {
-  if (finished_.size() <= options_.finished_retained + slack) return;
-  std::unordered_set<std::string> leaving;
-  while (finished_.size() > options_.finished_retained) {
-    leaving.insert(std::move(finished_.front()));
-    finished_.pop_front();
-  }
-  std::vector<std::shared_ptr<const OrderView>> kept;
-  kept.reserve(orders_.size() - leaving.size());
-  for (auto& view : orders_) {
-    if (leaving.count(view->record.order.id)) {
-      ++finished_in_store_[view->record.order.state];
-    } else {
-      kept.push_back(std::move(view));
-    }
-  }
-  orders_ = std::move(kept);
-  by_id_.clear();
-  by_client_id_.clear();
-  for (std::size_t i = 0; i < orders_.size(); ++i) {
-    by_id_.emplace(orders_[i]->record.order.id, i);
-    by_client_id_.emplace(orders_[i]->record.order.client_id, i);
-  }
-  ++book_generation_;
-  dirty_ = true;
-}
 
 engine::Result<std::shared_ptr<const OrderView>> Dispatcher::FindAnywhere(const std::string& key, bool by_client_id,
                                                                           bool explain) const {
@@ -131,8 +82,7 @@ void Dispatcher::DoSubmit(const engine::OrderRequest& request,
     return done(std::move(reply));
   }
   engine::Order order = std::move(admitted).value();
-  if (auto it = by_client_id_.find(order.client_id); it != by_client_id_.end()) {
-    const auto& existing = orders_[it->second];
+  if (auto existing = book_.FindClient(order.client_id)) {
     if (storage::OrderContentHash(order) == existing->record.content_hash) {
       reply.order = existing;
       reply.created = false;
@@ -166,7 +116,8 @@ void Dispatcher::DoSubmit(const engine::OrderRequest& request,
     return done(std::move(reply));
   }
   ++last_order_number_;
-  Put(view);
+  book_.Put(view);
+  dirty_ = true;
   core_->AddOrder(std::move(order));
   reply.order = view;
   reply.created = inserted->created;
@@ -183,7 +134,7 @@ void Dispatcher::DoSubmit(const engine::OrderRequest& request,
 void Dispatcher::DoCancel(const std::string& order_id, const std::string& reason,
                           const std::function<void(OrderReply)>& done) {
   OrderReply reply;
-  auto view = Find(order_id);
+  auto view = book_.Find(order_id);
   if (!view) {  // retired (finished) or unknown
     auto stored = FindAnywhere(order_id, false, false);
     if (!stored.ok()) {
@@ -214,7 +165,7 @@ void Dispatcher::DoCancel(const std::string& order_id, const std::string& reason
     return done(std::move(reply));
   }
   if (!Commit(*change, nullptr, &reply.status)) return done(std::move(reply));
-  reply.order = Find(order_id);
+  reply.order = book_.Find(order_id);
   done(std::move(reply));
 }
 

@@ -1,0 +1,55 @@
+// OrderViews: the dispatcher's order book as operators read it - every open order and the
+// newest `retained` finished ones, in submission order, indexed by server id and client id
+// (the rest stay in the store: DispatcherOptions::finished_retained). The dispatch core keeps
+// the open orders' dispatch state; these are the views the snapshot publishes.
+//
+// Not thread-safe: the dispatcher's loop owns it.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <deque>
+#include <map>
+#include <memory>
+#include <string>
+#include <unordered_map>
+#include <vector>
+
+#include "engine/fleet/order.h"
+#include "server/snapshot.h"
+
+namespace dispatch::server {
+
+class OrderViews {
+ public:
+  explicit OrderViews(std::size_t retained) : retained_(retained) {}
+
+  std::shared_ptr<const OrderView> Find(const std::string& order_id) const;
+  std::shared_ptr<const OrderView> FindClient(const std::string& client_id) const;
+  // Replaces (or adds, at the end) an order; a finished one joins the finished list.
+  void Put(std::shared_ptr<OrderView> view);
+  // Once more than retained + slack finished orders are in memory, the oldest finished ones
+  // leave it down to `retained` (counted in finished_in_store). True when some left.
+  bool Retire(std::size_t slack);
+  // Recovery loads orders in submission order: the finished list is put in finish order.
+  void SortFinished();
+
+  const std::vector<std::shared_ptr<const OrderView>>& all() const { return orders_; }
+  // Finished orders that left memory, by state.
+  const std::map<engine::OrderState, std::uint64_t>& finished_in_store() const { return finished_in_store_; }
+  // The indexes as the snapshot shares them (a new copy only after orders joined or left).
+  std::shared_ptr<const Snapshot::OrderIndex> Index();
+
+ private:
+  const std::size_t retained_;
+  std::vector<std::shared_ptr<const OrderView>> orders_;
+  std::unordered_map<std::string, std::size_t> by_id_;
+  std::unordered_map<std::string, std::size_t> by_client_id_;
+  std::deque<std::string> finished_;  // the finished orders in memory, in finish order
+  std::map<engine::OrderState, std::uint64_t> finished_in_store_;
+  std::uint64_t generation_ = 0;  // changes when orders join or leave
+  std::uint64_t published_generation_ = static_cast<std::uint64_t>(-1);
+  std::shared_ptr<const Snapshot::OrderIndex> published_;
+};
+
+}  // namespace dispatch::server
