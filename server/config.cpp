@@ -38,6 +38,8 @@ std::vector<Key> Keys() {
       MakeKey("db", &ServerConfig::db),
       MakeKey("map", &ServerConfig::map),
       MakeKey("strategy", &ServerConfig::strategy),
+      MakeKey("max_queue", &ServerConfig::max_queue),
+      MakeKey("one_formation_per_pick", &ServerConfig::one_formation_per_pick),
       MakeKey("zeta", &ServerConfig::zeta),
       MakeKey("alpha", &ServerConfig::alpha),
       MakeKey("beta", &ServerConfig::beta),
@@ -123,6 +125,7 @@ engine::Status ValidateServerConfig(const ServerConfig& c) {
   }
   if (c.route_cache_mb < 1) return InvalidArgument("route_cache_mb must be >= 1");
   if (c.finished_retained < 0) return InvalidArgument("finished_retained must be >= 0");
+  if (c.max_queue < 0) return InvalidArgument("max_queue must be >= 0 (0: no limit)");
   if (c.journal_runs < 0) return InvalidArgument("journal_runs must be >= 0 (0: no journal)");
   if (c.journal_max_mb < 0) return InvalidArgument("journal_max_mb must be >= 0 (0: no limit)");
   if (!c.web_root.empty() && !std::filesystem::is_directory(c.web_root)) {
@@ -168,6 +171,10 @@ engine::Result<ParsedCommandLine> ParseCommandLine(int argc, char** argv) {
   app.add_option("--finished-retained", flags.finished_retained,
                  "Finished orders kept in memory (the newest); older ones are read from the database")
       ->capture_default_str();
+  app.add_option("--max-queue", flags.max_queue, "Orders a robot may hold and still bid for another (0: no limit)")
+      ->capture_default_str();
+  app.add_option("--one-formation-per-pick", flags.one_formation_per_pick,
+                 "Allocate a formation only while no other is heading for its first pick")->capture_default_str();
   app.add_option("--journal-runs", flags.journal_runs,
                  "Runs of the dispatch core's journal kept in the database for replay (0: no journal)")
       ->capture_default_str();

@@ -17,6 +17,11 @@ struct ServerConfig {
   std::string db = "dispatch.db"; // SQLite file
   std::string map = "chu2024";    // chu2024 | <file>.json | <file>.map
   std::string strategy = "auction";  // auction | greedy
+  // Orders a robot may hold and still bid for another (0: no limit, the paper's auction), and
+  // one formation at a time heading for a first pick: see AllocationConfig::max_queue and
+  // CoreOptions::one_formation_per_pick (README "Formations on the dispatch core").
+  int max_queue = 0;
+  bool one_formation_per_pick = false;
   double zeta = 100.0;            // Chu2024 eq. (5) traffic weight
   double alpha = 0.5;             // Chu2024 eq. (1) weight of T_t
   double beta = 0.5;              // Chu2024 eq. (1) weight of T_d

@@ -50,6 +50,7 @@ engine::Result<std::unique_ptr<Dispatcher>> Dispatcher::Create(
   core_options.robot_snap_tolerance = options.robot_snap_tolerance;
   core_options.traffic_control = options.traffic_control;
   core_options.traffic = options.traffic;
+  core_options.one_formation_per_pick = options.one_formation_per_pick;
   auto core = engine::DispatchCore::Create(map, routes, core_options);
   if (!core.ok()) return core.error();
   const bool journaled = options.journal != nullptr;

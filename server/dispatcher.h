@@ -106,6 +106,7 @@ struct DispatcherOptions {
   // through the engine's TrafficController. Off: every waypoint is sent released (no grants or holds).
   bool traffic_control = true;
   engine::TrafficControllerConfig traffic;
+  bool one_formation_per_pick = false;  // engine::CoreOptions::one_formation_per_pick
   // Where allocation latency and grant waits are observed (optional; must outlive the
   // dispatcher).
   ServiceMetrics* metrics = nullptr;

@@ -82,6 +82,7 @@ engine::Result<StartedJournal> StartJournal(const ServerConfig& config, const Di
   setup.core.robot_snap_tolerance = options.robot_snap_tolerance;
   setup.core.traffic_control = options.traffic_control;
   setup.core.traffic = options.traffic;
+  setup.core.one_formation_per_pick = options.one_formation_per_pick;
   setup.route_cache_bytes = static_cast<std::size_t>(config.route_cache_mb) << 20;
   setup.time_scale = options.time_scale;
   auto encoded = storage::EncodeRunSetup(setup);
@@ -115,6 +116,7 @@ engine::Result<std::unique_ptr<DispatchServer>> DispatchServer::Start(const Serv
   allocation.alpha = config.alpha;
   allocation.beta = config.beta;
   allocation.zeta = config.zeta;
+  allocation.max_queue = static_cast<std::size_t>(config.max_queue);
   engine::RouteTableOptions route_options;
   route_options.speed = allocation.speed;
   route_options.lazy_cache_bytes = static_cast<std::size_t>(config.route_cache_mb) << 20;
@@ -153,6 +155,7 @@ engine::Result<std::unique_ptr<DispatchServer>> DispatchServer::Start(const Serv
   options.offline_grace = config.offline_grace;
   options.finished_retained = static_cast<std::size_t>(config.finished_retained);
   options.traffic_control = config.traffic_control;
+  options.one_formation_per_pick = config.one_formation_per_pick;
   options.traffic.speed = allocation.speed;
   options.traffic.t_w1 = config.t_w1;
   options.traffic.t_w2 = config.t_w2;

@@ -129,6 +129,7 @@ Result<std::string> EncodeRunSetup(const RunSetup& s) {
                        {"speed", a.speed},
                        {"hold_seconds", a.hold_seconds},
                        {"price_every_bid_up_to", a.price_every_bid_up_to},
+                       {"max_queue", a.max_queue},
                        {"work_time_override", a.work_time_override ? json(*a.work_time_override) : json(nullptr)},
                        {"bucket_seconds", a.traffic.bucket_seconds},
                        {"origin_time", a.traffic.origin_time},
@@ -138,6 +139,7 @@ Result<std::string> EncodeRunSetup(const RunSetup& s) {
                        {"formation_max_rotation_step", a.formation.max_rotation_step}};
     j["core"] = {{"robot_snap_tolerance", s.core.robot_snap_tolerance},
                  {"traffic_control", s.core.traffic_control},
+                 {"one_formation_per_pick", s.core.one_formation_per_pick},
                  {"speed", t.speed},
                  {"point_clearance", t.point_clearance},
                  {"t_w1", t.t_w1},
@@ -170,6 +172,7 @@ Result<RunSetup> DecodeRunSetup(const std::string& text) {
     c.speed = a.at("speed").get<double>();
     c.hold_seconds = a.at("hold_seconds").get<double>();
     c.price_every_bid_up_to = a.at("price_every_bid_up_to").get<std::size_t>();
+    c.max_queue = a.value("max_queue", std::size_t{0});
     if (!a.at("work_time_override").is_null()) c.work_time_override = a.at("work_time_override").get<double>();
     c.traffic.bucket_seconds = a.at("bucket_seconds").get<double>();
     c.traffic.origin_time = a.at("origin_time").get<double>();
@@ -180,6 +183,7 @@ Result<RunSetup> DecodeRunSetup(const std::string& text) {
     const json& k = j.at("core");
     s.core.robot_snap_tolerance = k.at("robot_snap_tolerance").get<double>();
     s.core.traffic_control = k.at("traffic_control").get<bool>();
+    s.core.one_formation_per_pick = k.value("one_formation_per_pick", false);
     engine::TrafficControllerConfig& t = s.core.traffic;
     t.speed = k.at("speed").get<double>();
     t.point_clearance = k.at("point_clearance").get<double>();

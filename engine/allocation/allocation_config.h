@@ -24,6 +24,10 @@
 //    of B_i, since x_i >= 0) and stops once that bound exceeds the bids that decide the award
 //    (winner and runner-up; for formations the companions and the next one): the same award,
 //    without sampling routes that could not win.
+//  - max_queue = 0: no limit, as in the paper. With a limit, orders wait (accepted) until a
+//    robot has room, so a formation gets members that are nearly free instead of members
+//    that reach its rendezvous one by one behind long queues (the service froze with seed
+//    Tables 1 and 2 submitted ten times at once; README "Formations on the dispatch core").
 //  - work_time_override: unset = every order's own t_w (Order::work_time, 5 s by default,
 //    see kDefaultWorkTime); set = one t_w for every order, as in the paper.
 // Plain value; validate with ValidateAllocationConfig. Thread-safe to share.
@@ -47,6 +51,9 @@ struct AllocationConfig {
   double hold_seconds = 300.0;  // predicted stay at a plan's end, seconds; >= 0
   std::size_t price_every_bid_up_to = 64;  // robots; larger fleets skip bids that cannot win
   std::optional<double> work_time_override;  // t_w for every order, seconds; unset = per order
+  // Orders a robot may hold (its current one included) and still bid for another; 0 = no
+  // limit (the paper's auction: every order is awarded at once, queues grow without bound).
+  std::size_t max_queue = 0;
   TrafficPredictionConfig traffic;
   FormationOptions formation;
 };

@@ -24,6 +24,12 @@ Bid UnreachableBid(const std::string& robot, double ready_time) {
   return b;
 }
 
+Bid FullQueueBid(const std::string& robot, double ready_time) {
+  Bid b = UnreachableBid(robot, ready_time);
+  b.queue_full = true;
+  return b;
+}
+
 void FillBid(const AllocationConfig& c, const DensityTerm& density, Bid& b) {
   b.t_t = b.t_d + b.t_w;                      // Chu2024 eq. (2)
   b.flow = density.flow;                      // Chu2024 eqs. (6)-(8)
@@ -238,6 +244,10 @@ std::vector<Bid> AuctionAllocator::ComputeBids(const FleetState& state, const Pl
   bids.reserve(state.robot_count());
   for (std::size_t i = 0; i < state.robot_count(); ++i) {
     const QueueSummary& s = state.summary(i);
+    if (!state.HasRoom(i)) {
+      bids.push_back(FullQueueBid(state.robot_id(i), s.end_time));
+      continue;
+    }
     const double leg = routes.Cost(s.end_point, first);
     if (!std::isfinite(leg) || !std::isfinite(task_travel)) {
       bids.push_back(UnreachableBid(state.robot_id(i), s.end_time));
@@ -287,6 +297,10 @@ std::vector<Bid> AuctionAllocator::ComputeReachBids(const FleetState& state, Poi
   bids.reserve(state.robot_count());
   for (std::size_t i = 0; i < state.robot_count(); ++i) {
     const QueueSummary& s = state.summary(i);
+    if (!state.HasRoom(i)) {
+      bids.push_back(FullQueueBid(state.robot_id(i), s.end_time));
+      continue;
+    }
     const double leg = routes.Cost(s.end_point, first_pick);
     if (!std::isfinite(leg)) {
       bids.push_back(UnreachableBid(state.robot_id(i), s.end_time));

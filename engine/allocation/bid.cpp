@@ -5,6 +5,7 @@
 namespace dispatch::engine {
 
 std::string DescribeBid(const Bid& bid) {
+  if (bid.queue_full) return bid.robot + " has a full queue";
   if (!bid.reachable) return bid.robot + " cannot reach the order";
   char buf[200];
   if (!bid.priced) {

@@ -22,6 +22,7 @@ namespace dispatch::engine {
 struct Bid {
   std::string robot;
   bool reachable = true;
+  bool queue_full = false;  // not bidding: its queue is full (AllocationConfig::max_queue); reachable = false
   bool priced = true;  // F_i evaluated; false: flow, x and bid are lower bounds
   double t_d = 0.0;   // T_d,i: travel time of the whole queue + this order, s (eq. (3))
   double t_w = 0.0;   // T_w,i: work time n_c * t_w of the whole queue + this order, s (eq. (3))

@@ -84,6 +84,10 @@ class FleetState {
   const FleetRobot& robot(std::size_t robot) const { return robots_.at(robot).info; }
   const QueueSummary& summary(std::size_t robot) const { return robots_.at(robot).summary; }
   const std::vector<QueuedTask>& queue(std::size_t robot) const { return robots_.at(robot).queue; }
+  // False when the robot's queue holds AllocationConfig::max_queue orders: it does not bid.
+  bool HasRoom(std::size_t robot) const {
+    return config().max_queue == 0 || queue(robot).size() < config().max_queue;
+  }
   const Plan& plan(std::size_t robot) const { return robots_.at(robot).plan; }
 
   const WarehouseMap& map() const { return *map_; }

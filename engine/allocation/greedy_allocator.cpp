@@ -22,7 +22,8 @@ Result<AwardExplanation> GreedyAllocator::Allocate(const Order& order, FleetStat
     b.robot = state.robot_id(i);
     b.ready_time = s.end_time;
     b.t_d = state.routes().Cost(s.end_point, first);
-    b.reachable = std::isfinite(b.t_d);
+    b.queue_full = !state.HasRoom(i);
+    b.reachable = std::isfinite(b.t_d) && !b.queue_full;
     b.bid = b.t_d;
     if (b.reachable) ranked.push_back(i);
     ex.bids.push_back(std::move(b));

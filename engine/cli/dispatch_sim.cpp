@@ -4,7 +4,8 @@
 //       timed plans with the Chu2024 rules off and/or on (seed 000 Fig. 8, Tables 3-4).
 //   dispatch-sim stream --map chu2024 --robots 18 (--orders FILE... [--repeat N] | --random 200 --seed 1
 //       [--formations 0.2]) [--strategy auction|greedy] [--zeta 100] [--csv series.csv]
-//       [--orders-csv out.csv] [--check-safety]
+//       [--orders-csv out.csv] [--check-safety] [--journal run.db] [--max-queue N]
+//       [--one-formation-per-pick]
 //       an order stream with release times (formation orders too) under the online traffic
 //       controller.
 //   dispatch-sim compare [--random 200 --seed 1 --robots 18 --map chu2024]
@@ -149,12 +150,12 @@ int RunPlan(const PlanArgs& args) {
 }
 
 struct StreamArgs {
-  std::string map = "chu2024", csv, orders_csv, strategy = "auction";
+  std::string map = "chu2024", csv, orders_csv, strategy = "auction", journal;
   std::vector<std::string> orders;  // task tables, submitted together
-  std::size_t robots = 18, random = 0, repeat = 1;
+  std::size_t robots = 18, random = 0, repeat = 1, max_queue = 0;
   std::uint64_t seed = 1;
   double interval = 2.0, zeta = 100.0, dt = 0.1, max_time = 36000.0, formations = 0.0;
-  bool check_safety = false;
+  bool check_safety = false, one_formation_per_pick = false;
   // "core": the service's dispatch core with robots following its messages (core_stream.h);
   // "stream": the order-stream model (order_stream.h).
   std::string model = "core";
@@ -216,6 +217,8 @@ StreamConfig ConfigOf(const StreamArgs& a, const std::string& strategy, double z
   c.max_time = a.max_time;
   c.strategy = strategy == "greedy" ? AllocationStrategy::kGreedy : AllocationStrategy::kAuction;
   c.allocation.zeta = zeta;
+  c.allocation.max_queue = a.max_queue;
+  c.one_formation_per_pick = a.one_formation_per_pick;
   c.check_safety = a.check_safety;
   return c;
 }
@@ -233,8 +236,18 @@ Result<StreamResult> Simulate(const StreamArgs& a, const Setup& s, const StreamC
     return InvalidArgument("--check-safety runs on the order-stream model (add --model stream); the core "
                            "reports the closest pair and every pair below eps1 instead");
   }
-  if (a.model == "core") return SimulateOnCore(s.map, s.routes, s.robots, s.orders, c);
-  return SimulateOrderStream(s.map, s.routes, s.robots, s.orders, c);
+  if (a.model != "core") {
+    if (!a.journal.empty()) return InvalidArgument("--journal records the dispatch core's calls: --model core");
+    return SimulateOrderStream(s.map, s.routes, s.robots, s.orders, c);
+  }
+  if (a.journal.empty()) return SimulateOnCore(s.map, s.routes, s.robots, s.orders, c);
+  std::vector<JournalEntry> journal;
+  auto r = SimulateOnCore(s.map, s.routes, s.robots, s.orders, c, &journal);
+  if (!r.ok()) return r;
+  if (auto written = WriteSimulationJournal(a.journal, a.map, *s.map, c, journal); !written.ok()) {
+    return written.error();
+  }
+  return r;
 }
 
 void PrintSummary(const std::string& label, const StreamResult& r) {
@@ -376,6 +389,10 @@ int Main(int argc, char** argv) {
     c->add_option("--model", a.model, "core (the service's dispatch core, robots following its messages) "
                                       "or stream (the order-stream model)")
         ->capture_default_str()->check(CLI::IsMember({"core", "stream"}));
+    c->add_option("--max-queue", a.max_queue, "Orders a robot may hold and still bid (0: no limit)")
+        ->capture_default_str();
+    c->add_flag("--one-formation-per-pick", a.one_formation_per_pick,
+                "Allocate a formation only while no other is heading for its first pick (core model)");
     c->add_flag("--check-safety", a.check_safety,
                 "Run CheckSafety over every step (eps1 spacing, crossings in intersections)");
   };
@@ -386,6 +403,8 @@ int Main(int argc, char** argv) {
   s->add_option("--zeta", stream.zeta, "Traffic weight of the auction")->capture_default_str();
   s->add_option("--csv", stream.csv, "Write t,min_distance here");
   s->add_option("--orders-csv", stream.orders_csv, "Write per-order results here");
+  s->add_option("--journal", stream.journal,
+                "Journal the core's calls as a run of this SQLite file (dispatch-sim replay --db, SQL)");
   StreamArgs compare;
   auto* c = app.add_subcommand("compare", "Auction zeta=100 / zeta=0 / greedy on one stream");
   add_stream(c, compare);

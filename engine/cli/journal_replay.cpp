@@ -133,6 +133,31 @@ int List(storage::JournalStore& journal) {
 
 }  // namespace
 
+Status WriteSimulationJournal(const std::string& db, const std::string& map_source, const WarehouseMap& map,
+                              const StreamConfig& config, const std::vector<JournalEntry>& journal) {
+  auto opened = storage::JournalStore::Open(db);
+  if (!opened.ok()) return opened.error();
+  storage::RunSetup setup;
+  setup.map_json = WriteMapJson(map);
+  setup.map_source = map_source;
+  setup.strategy = AllocationStrategyName(config.strategy);
+  setup.allocation = config.allocation;
+  setup.core.traffic = config.traffic;  // as SimulateOnCore builds its core
+  setup.core.one_formation_per_pick = config.one_formation_per_pick;
+  setup.core.traffic.speed = config.allocation.speed;
+  auto encoded = storage::EncodeRunSetup(setup);
+  if (!encoded.ok()) return encoded.error();
+  auto run = (*opened)->StartRun(0.0, *encoded, 5);
+  if (!run.ok()) return run.error();
+  constexpr std::size_t kChunk = 10000;
+  for (std::size_t i = 0; i < journal.size(); i += kChunk) {
+    const std::vector<JournalEntry> chunk(journal.begin() + static_cast<std::ptrdiff_t>(i),
+                                          journal.begin() + static_cast<std::ptrdiff_t>(std::min(journal.size(), i + kChunk)));
+    if (auto written = (*opened)->Append(*run, chunk); !written.ok()) return written.error();
+  }
+  return Ok{};
+}
+
 int RunReplay(const ReplayArgs& a) {
   auto opened = storage::JournalStore::Open(a.db, /*read_only=*/true);
   if (!opened.ok()) return Fail(opened.error().message);
@@ -234,6 +259,7 @@ int RunReplay(const ReplayArgs& a) {
     c.allocation = loaded->setup.allocation;
     c.allocation.zeta = zeta;
     c.traffic = loaded->setup.core.traffic;
+    c.one_formation_per_pick = loaded->setup.core.one_formation_per_pick;
     c.check_safety = false;
     c.record_series = false;
     return SimulateOnCore(loaded->replay.map, loaded->replay.routes,

@@ -11,6 +11,12 @@
 #include <cstdint>
 #include <optional>
 #include <string>
+#include <vector>
+
+#include "engine/common/result.h"
+#include "engine/dispatch/core_journal.h"
+#include "engine/map/warehouse_map.h"
+#include "engine/sim/order_stream.h"
 
 namespace dispatch::engine {
 
@@ -25,6 +31,12 @@ struct ReplayArgs {
   double dt = 0.1;             // what-if time step, s
   double max_time = 36000.0;   // what-if: simulated seconds before unfinished orders fail
 };
+
+// Writes a SimulateOnCore run's journal (SimulateOnCore's `journal`) as a new run of the SQLite
+// file at `db`, with the setup it ran with, so `replay --db` and SQL over core_journal read it
+// as they read dispatchd's (`dispatch-sim stream --journal FILE`).
+Status WriteSimulationJournal(const std::string& db, const std::string& map_source, const WarehouseMap& map,
+                              const StreamConfig& config, const std::vector<JournalEntry>& journal);
 
 // Exit status: 0 matched (and, with what_if, every order completed in the what-if run); 1 an
 // error or a divergence (named on stdout); 2 the what-if left orders unfinished.

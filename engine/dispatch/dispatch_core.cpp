@@ -190,6 +190,22 @@ std::optional<RoundInput> DispatchCore::MakeRound(double now, RoundCommit& commi
   std::sort(ids.begin(), ids.end(), NaturalLess);
   std::sort(input.pending.begin(), input.pending.end(),
             [](const auto& a, const auto& b) { return AllocationOrderLess(*a, *b); });
+  if (options_.one_formation_per_pick) {
+    // One formation at a time on its way to a first pick: teams converging on one pick wait
+    // for each other at the rendezvous, in the aisles around it, and lock up (README
+    // "Formations on the dispatch core"). A formation order whose first pick another one is
+    // still heading for waits (accepted) until that one has started.
+    std::set<PointId> heading;
+    for (const auto& [id, o] : orders_) {
+      if (o.order->formation && o.order->state == OrderState::kAssigned) heading.insert(o.order->picks.front());
+    }
+    std::vector<std::shared_ptr<const Order>> kept;
+    for (auto& o : input.pending) {
+      if (!o->formation || heading.insert(o->picks.front()).second) kept.push_back(std::move(o));
+    }
+    input.pending = std::move(kept);
+    if (input.pending.empty()) return std::nullopt;
+  }
   for (const auto& id : ids) {
     const BookRobot& r = robots_.at(id);
     RoundRobot rr;
@@ -287,6 +303,8 @@ void DispatchCore::ApplyOrder(const OrderChange& line) {
   b.order = std::move(copy);
   if (line.robots) b.robots = *line.robots;
   if (*line.to == OrderState::kAccepted) allocation_due_ = true;  // back for re-allocation
+  // A formation at its first pick: the next formation to that pick may be allocated (MakeRound).
+  if (*line.to == OrderState::kInProgress && b.order->formation) allocation_due_ = true;
 }
 
 std::vector<RobotCommand> DispatchCore::Apply(const Change& change) {

@@ -53,6 +53,9 @@ struct CoreOptions {
   // released (no grants or holds).
   bool traffic_control = true;
   TrafficControllerConfig traffic;
+  // A formation order is allocated only while no other formation is still heading for its
+  // first pick (MakeRound).
+  bool one_formation_per_pick = false;
 };
 
 // An open order as the core dispatches it.

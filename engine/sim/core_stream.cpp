@@ -278,6 +278,7 @@ Result<StreamResult> SimulateOnCore(std::shared_ptr<const WarehouseMap> map, std
   CoreOptions options;
   options.traffic = config.traffic;
   options.traffic.speed = config.allocation.speed;
+  options.one_formation_per_pick = config.one_formation_per_pick;
   auto core = DispatchCore::Create(map, routes, options);
   if (!core.ok()) return core.error();
   CoreRun run(map, config, std::make_unique<JournaledCore>(std::move(core).value(), journal != nullptr),

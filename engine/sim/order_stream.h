@@ -84,6 +84,8 @@ struct StreamConfig {
   bool check_safety = kCheckSafetyByDefault;
   // Every step's robot positions (with their agents and groups) in StreamResult::frames.
   bool record_frames = false;
+  // SimulateOnCore: CoreOptions::one_formation_per_pick (the stream model ignores it).
+  bool one_formation_per_pick = false;
 };
 
 struct StreamOrderOutcome {

@@ -6,6 +6,8 @@
 #include <set>
 
 #include "allocation_test_util.h"
+#include "engine/allocation/auction_allocator.h"
+#include "engine/allocation/bid.h"
 
 namespace dispatch::engine {
 namespace {
@@ -69,6 +71,42 @@ TEST_F(GreedyTest, FormationTakesTheThreeFirstByTheSameRule) {
   EXPECT_EQ(a->winners, (std::vector<std::string>{"R4", "R2", "R3"}));
   EXPECT_TRUE(s.queue(0).empty());
   for (std::size_t r = 1; r < 4; ++r) EXPECT_EQ(s.queue(r).size(), 1u);
+}
+
+// AllocationConfig::max_queue: a robot whose queue is full does not bid, for either strategy,
+// single or formation orders; with nobody left with room the order is not allocated.
+TEST_F(GreedyTest, ARobotWithAFullQueueDoesNotBid) {
+  AllocationConfig config;
+  config.max_queue = 1;
+  const PointId p2 = Pt(*map_, "2,0"), p3 = Pt(*map_, "3,0"), d0 = Pt(*map_, "0,0");
+  GreedyAllocator greedy;
+  AuctionAllocator auction;
+  for (Allocator* strategy : {static_cast<Allocator*>(&greedy), static_cast<Allocator*>(&auction)}) {
+    SCOPED_TRACE(std::string(strategy->name()));
+    FleetState s = MakeFleet(map_, routes_, {{"R1", Pt(*map_, "1,0"), 0.0}, {"R2", Pt(*map_, "6,0"), 0.0},
+                                             {"R3", Pt(*map_, "9,0"), 0.0}, {"R4", Pt(*map_, "8,0"), 0.0}},
+                             config);
+    auto a = strategy->Allocate(MakeOrder("a", {p2}, d0), s);
+    ASSERT_TRUE(a.ok()) << a.error().message;
+    EXPECT_EQ(a->winners, std::vector<std::string>{"R1"});
+    // R1 is full: the next order near it goes to another robot, and R1's bid says why.
+    auto b = strategy->Allocate(MakeOrder("b", {p3}, d0), s);
+    ASSERT_TRUE(b.ok()) << b.error().message;
+    EXPECT_NE(b->winners.front(), "R1");
+    EXPECT_TRUE(b->bids[0].queue_full);
+    EXPECT_FALSE(b->bids[0].reachable);
+    EXPECT_EQ(DescribeBid(b->bids[0]), "R1 has a full queue");
+    // Two robots left with room: a formation cannot be formed, and nothing changes.
+    auto f = strategy->Allocate(MakeOrder("f", {p3}, d0, true), s);
+    EXPECT_FALSE(f.ok());
+    std::size_t queued = 0;
+    for (std::size_t r = 0; r < s.robot_count(); ++r) queued += s.queue(r).size();
+    EXPECT_EQ(queued, 2u);
+    // One more single order, then every robot is full.
+    ASSERT_TRUE(strategy->Allocate(MakeOrder("c", {p3}, d0), s).ok());
+    ASSERT_TRUE(strategy->Allocate(MakeOrder("d", {p3}, d0), s).ok());
+    EXPECT_FALSE(strategy->Allocate(MakeOrder("e", {p3}, d0), s).ok());
+  }
 }
 
 TEST_F(GreedyTest, TooFewRobotsForAFormation) {

@@ -22,8 +22,9 @@ using testing_util::PointsOfKind;
 
 class DispatchCoreTest : public ::testing::Test {
  protected:
-  void SetUp() override {
-    CoreOptions options;
+  void SetUp() override { Build(CoreOptions{}); }
+
+  void Build(CoreOptions options) {
     options.traffic_control = false;  // every waypoint released at once: the test drives them
     auto core = DispatchCore::Create(Chu2024(), Chu2024Routes(), options);
     ASSERT_TRUE(core.ok()) << core.error().message;
@@ -186,6 +187,43 @@ TEST_F(DispatchCoreTest, ALostRobotsAssignedOrderGoesBackAndItsStartedOneFails) 
   EXPECT_TRUE(core_->order("O2")->robots.empty());
   EXPECT_TRUE(core_->TakeAllocationDue());
   EXPECT_TRUE(core_->PlanLoss("R9", "unknown", now_).empty());
+}
+
+TEST_F(DispatchCoreTest, OneFormationAtATimeHeadsForAFirstPick) {
+  CoreOptions options;
+  options.one_formation_per_pick = true;
+  Build(options);
+  const auto parks = PointsOfKind(*Chu2024(), PointKind::kPark);
+  for (int i = 0; i < 6; ++i) ConnectRobot("R" + std::to_string(i + 1), parks.at(static_cast<std::size_t>(i)));
+  Order f1 = MakeOrder("F1"), f2 = MakeOrder("F2"), single = MakeOrder("S1");
+  f1.formation = f2.formation = true;
+  Order other = MakeOrder("F3");  // another first pick
+  other.formation = true;
+  other.picks = {PointsOfKind(*Chu2024(), PointKind::kPick).at(7)};
+  for (const Order& o : {f1, f2, single, other}) core_->AddOrder(o);
+  RoundCommit commit;
+  std::optional<RoundInput> input = core_->MakeRound(now_, commit);
+  ASSERT_TRUE(input.has_value());
+  std::vector<std::string> pending;
+  for (const auto& o : input->pending) pending.push_back(o->id);
+  // F2 shares F1's first pick: it waits; a single order and another pick's formation do not.
+  EXPECT_EQ(pending, (std::vector<std::string>{"F1", "F3", "S1"}));
+  commit.awards = rounds_->Run(*input).awards;
+  (void)core_->Apply(core_->PlanAwards(commit, commit.awards.size(), now_));
+  ASSERT_EQ(StateOf("F1"), OrderState::kAssigned);
+  // While F1 is heading for its pick, F2 is not in any round.
+  RoundCommit again;
+  std::optional<RoundInput> next = core_->MakeRound(now_, again);
+  EXPECT_FALSE(next.has_value()) << "F2 only is pending, and it waits";
+  // F1's leader reaches the pick: F1 has started, F2 may be allocated.
+  DriveToPick(core_->order("F1")->robots.front(), "F1");
+  ASSERT_EQ(StateOf("F1"), OrderState::kInProgress);
+  EXPECT_TRUE(core_->TakeAllocationDue());
+  RoundCommit third;
+  next = core_->MakeRound(now_, third);
+  ASSERT_TRUE(next.has_value());
+  ASSERT_EQ(next->pending.size(), 1u);
+  EXPECT_EQ(next->pending[0]->id, "F2");
 }
 
 }  // namespace

@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <set>
 #include <string>
 #include <vector>
@@ -120,6 +121,33 @@ TEST(CoreStreamTest, RejectsWhatItCannotRun) {
   auto two = SimulateOnCore(w.map, w.routes, {s.robots[0], s.robots[1]}, formation, Config());
   ASSERT_FALSE(two.ok());
   EXPECT_NE(two.error().message.find("needs 3 robots"), std::string::npos) << two.error().message;
+}
+
+// The formation freeze (README "Formations on the dispatch core"): seed Table 1 submitted three
+// times at once (9 formation orders, three teams to each first pick). With every order awarded
+// at once the queued teams lock up; with a robot bidding only while it has no order
+// (max_queue 1) and one formation at a time heading for a first pick, every order completes.
+TEST(CoreStreamTest, TableOneThreeTimesCompletesWithShortQueuesAndOneFormationPerPick) {
+  const World w = Chu();
+  std::vector<Order> orders;
+  for (int k = 1; k <= 3; ++k) {
+    for (Order o : TaskTable(w, "chu2024-table1.csv")) {
+      o.id += "-" + std::to_string(k);
+      o.client_id = o.id;
+      orders.push_back(std::move(o));
+    }
+  }
+  std::stable_sort(orders.begin(), orders.end(), [](const Order& a, const Order& b) {
+    return a.release_time.value_or(a.created_time) < b.release_time.value_or(b.created_time);
+  });
+  StreamConfig c = Config();
+  c.max_time = 3000;
+  c.allocation.max_queue = 1;
+  c.one_formation_per_pick = true;
+  auto r = SimulateOnCore(w.map, w.routes, Fleet(w, 18), orders, c);
+  ASSERT_TRUE(r.ok()) << r.error().message;
+  ExpectSane(w, orders, *r, c);
+  EXPECT_EQ(r->completed, orders.size()) << (r->blocked.empty() ? std::string() : r->blocked.front());
 }
 
 }  // namespace
