@@ -304,7 +304,9 @@ void DispatchCore::ApplyOrder(const OrderChange& line) {
   if (line.robots) b.robots = *line.robots;
   if (*line.to == OrderState::kAccepted) allocation_due_ = true;  // back for re-allocation
   // A formation at its first pick: the next formation to that pick may be allocated (MakeRound).
-  if (*line.to == OrderState::kInProgress && b.order->formation) allocation_due_ = true;
+  if (options_.one_formation_per_pick && *line.to == OrderState::kInProgress && b.order->formation) {
+    allocation_due_ = true;
+  }
 }
 
 std::vector<RobotCommand> DispatchCore::Apply(const Change& change) {
