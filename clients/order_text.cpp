@@ -27,6 +27,10 @@ std::string Stops(const v1::Order& o) {
 }
 
 void AppendBid(std::string& out, const v1::Bid& b) {
+  if (b.queue_full()) {
+    out += Format("  %-6s has a full queue (does not bid)\n", b.robot_id().c_str());
+    return;
+  }
   if (!b.reachable()) {
     out += Format("  %-6s cannot reach the order\n", b.robot_id().c_str());
     return;

@@ -19,10 +19,12 @@ double NumOf(const json& j) {
 json BidJson(const engine::Bid& b) {
   json peaks = json::array();
   for (const auto& [zone, n] : b.peaks) peaks.push_back({zone, n});
-  return {{"robot", b.robot}, {"reachable", b.reachable}, {"priced", b.priced},
+  json out = {{"robot", b.robot}, {"reachable", b.reachable}, {"priced", b.priced},
           {"t_d", Num(b.t_d)}, {"t_w", Num(b.t_w)}, {"t_t", Num(b.t_t)},
           {"flow", Num(b.flow)}, {"x", Num(b.x)}, {"bid", Num(b.bid)},
           {"ready_time", Num(b.ready_time)}, {"peaks", peaks}};
+  if (b.queue_full) out["queue_full"] = true;  // only when set: older details read the same
+  return out;
 }
 
 engine::Bid BidOf(const json& j) {
@@ -30,6 +32,7 @@ engine::Bid BidOf(const json& j) {
   b.robot = j.at("robot").get<std::string>();
   b.reachable = j.at("reachable").get<bool>();
   b.priced = j.at("priced").get<bool>();
+  b.queue_full = j.value("queue_full", false);
   b.t_d = NumOf(j.at("t_d"));
   b.t_w = NumOf(j.at("t_w"));
   b.t_t = NumOf(j.at("t_t"));

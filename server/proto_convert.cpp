@@ -43,6 +43,7 @@ void BidToProto(const engine::Bid& b, const engine::WarehouseMap& map,
                 const std::vector<std::string>& winners, pb::Bid* out) {
   out->set_robot_id(b.robot);
   out->set_reachable(b.reachable);
+  out->set_queue_full(b.queue_full);
   out->set_priced(b.priced);
   out->set_travel_time(b.t_d);
   out->set_work_time(b.t_w);

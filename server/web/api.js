@@ -37,7 +37,7 @@ window.WebMap = window.WebMap || {};
 
   // Bid
   const bid = b => ({
-    robot: b.robot_id, reachable: b.reachable, priced: b.priced, t_t: number(b.total_time), t_d: number(b.travel_time),
+    robot: b.robot_id, reachable: b.reachable, queue_full: b.queue_full === true, priced: b.priced, t_t: number(b.total_time), t_d: number(b.travel_time),
     t_w: number(b.work_time), flow: number(b.traffic_flow), bid: number(b.total),
   });
 

@@ -119,7 +119,7 @@ window.WebMap = window.WebMap || {};
     const sorted = [...bids].sort((x, y) => key(x) - key(y));
     const rows = sorted.map(b => {
       const win = winners.has(b.robot);
-      const note = b.reachable === false ? "unreachable" : b.priced === false ? "not priced" : "";
+      const note = b.queue_full ? "queue full" : b.reachable === false ? "unreachable" : b.priced === false ? "not priced" : "";
       return `<tr class="bid${win ? " winner" : ""}${note ? " excluded" : ""}" data-robot="${esc(b.robot)}">` +
         `<td>${robotTag(b.robot)}</td><td>${num(b.t_t)}</td><td>${num(b.t_d)}</td><td>${num(b.t_w)}</td>` +
         `<td>${num(b.flow, 4)}</td><td>${note ? `<span class="muted">${note}</span>` : num(b.bid, 2)}</td>` +
