@@ -88,52 +88,10 @@ Dispatcher::~Dispatcher() {
 }
 
 engine::Status Dispatcher::Recover() {
-  // Orders, in submission order. The finished ones are sorted by finish time (they load in
-  // submission order) and trimmed to the newest finished_retained after every page, so a long
-  // history never passes through memory whole.
-  auto keep_newest = [this](std::size_t slack) {
-    book_.SortFinished();
-    book_.Retire(slack);
-  };
-  storage::OrderQuery query;
-  query.page_size = storage::kMaxPageSize;
-  for (;;) {
-    auto page = store_.ListOrders(query);
-    if (!page.ok()) return page.error();
-    for (const auto& record : page->orders) {
-      auto view = std::make_shared<OrderView>();
-      view->record = record;
-      if (engine::IsTerminal(record.order.state)) view->finished_time = record.updated_time;
-      time_base_ = std::max({time_base_, record.updated_time, record.order.created_time});
-      const std::string& id = record.order.id;
-      if (id.rfind("ord-", 0) == 0) {
-        last_order_number_ = std::max<std::int64_t>(last_order_number_, std::atoll(id.c_str() + 4));
-      }
-      book_.Put(std::move(view));
-    }
-    if (page->next_page_token.empty()) break;
-    query.page_token = page->next_page_token;
-    keep_newest(storage::kMaxPageSize);
-  }
-  keep_newest(0);
-  // Allocation explanations from the journal (the latest per order wins).
-  storage::EventQuery events;
-  events.limit = 1000;
-  for (;;) {
-    auto batch = store_.ListEvents(events);
-    if (!batch.ok()) return batch.error();
-    for (const auto& event : *batch) {
-      events.after_id = event.id;
-      auto explanation = ParseAllocationDetail(event.detail);
-      if (!explanation) continue;
-      if (auto view = book_.Find(event.order_id)) {
-        auto copy = std::make_shared<OrderView>(*view);
-        copy->explanation = std::move(*explanation);
-        book_.Put(std::move(copy));
-      }
-    }
-    if (batch->size() < static_cast<std::size_t>(events.limit)) break;
-  }
+  auto loaded = book_.Load(store_);
+  if (!loaded.ok()) return loaded.error();
+  time_base_ = std::max(time_base_, loaded->latest_time);
+  last_order_number_ = std::max(last_order_number_, loaded->last_order_number);
   // The open orders enter the core with their robots.
   for (const auto& view : book_.all()) {
     const storage::OrderRecord& rec = view->record;

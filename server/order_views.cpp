@@ -1,8 +1,12 @@
 #include "server/order_views.h"
 
+#include <cstdlib>
+
 #include <algorithm>
 #include <unordered_set>
 #include <utility>
+
+#include "server/json_convert.h"
 
 namespace dispatch::server {
 
@@ -63,6 +67,54 @@ void OrderViews::SortFinished() {
   std::stable_sort(finished_.begin(), finished_.end(), [this](const std::string& a, const std::string& b) {
     return Find(a)->finished_time.value_or(0.0) < Find(b)->finished_time.value_or(0.0);
   });
+}
+
+engine::Result<LoadedOrders> OrderViews::Load(storage::Store& store) {
+  LoadedOrders out;
+  auto keep_newest = [this](std::size_t slack) {
+    SortFinished();  // they load in submission order
+    Retire(slack);
+  };
+  storage::OrderQuery query;
+  query.page_size = storage::kMaxPageSize;
+  for (;;) {
+    auto page = store.ListOrders(query);
+    if (!page.ok()) return page.error();
+    for (const auto& record : page->orders) {
+      auto view = std::make_shared<OrderView>();
+      view->record = record;
+      if (engine::IsTerminal(record.order.state)) view->finished_time = record.updated_time;
+      out.latest_time = std::max({out.latest_time, record.updated_time, record.order.created_time});
+      const std::string& id = record.order.id;
+      if (id.rfind("ord-", 0) == 0) {
+        out.last_order_number = std::max<std::int64_t>(out.last_order_number, std::atoll(id.c_str() + 4));
+      }
+      Put(std::move(view));
+    }
+    if (page->next_page_token.empty()) break;
+    query.page_token = page->next_page_token;
+    keep_newest(storage::kMaxPageSize);
+  }
+  keep_newest(0);
+  // Allocation explanations from the journal (the latest per order wins).
+  storage::EventQuery events;
+  events.limit = 1000;
+  for (;;) {
+    auto batch = store.ListEvents(events);
+    if (!batch.ok()) return batch.error();
+    for (const auto& event : *batch) {
+      events.after_id = event.id;
+      auto explanation = ParseAllocationDetail(event.detail);
+      if (!explanation) continue;
+      if (auto view = Find(event.order_id)) {
+        auto copy = std::make_shared<OrderView>(*view);
+        copy->explanation = std::move(*explanation);
+        Put(std::move(copy));
+      }
+    }
+    if (batch->size() < static_cast<std::size_t>(events.limit)) break;
+  }
+  return out;
 }
 
 std::shared_ptr<const Snapshot::OrderIndex> OrderViews::Index() {

@@ -15,14 +15,27 @@
 #include <unordered_map>
 #include <vector>
 
+#include "engine/common/result.h"
 #include "engine/fleet/order.h"
 #include "server/snapshot.h"
+#include "storage/store.h"
 
 namespace dispatch::server {
+
+// What recovery learnt from the stored orders besides the book.
+struct LoadedOrders {
+  double latest_time = 0.0;             // the latest creation or update time stored
+  std::int64_t last_order_number = 0;  // of the "ord-N" ids
+};
 
 class OrderViews {
  public:
   explicit OrderViews(std::size_t retained) : retained_(retained) {}
+
+  // Recovery: every stored order, in submission order, the finished ones trimmed to the
+  // retention page by page (a long history never passes through memory whole), each with its
+  // latest allocation explanation from the journal.
+  engine::Result<LoadedOrders> Load(storage::Store& store);
 
   std::shared_ptr<const OrderView> Find(const std::string& order_id) const;
   std::shared_ptr<const OrderView> FindClient(const std::string& client_id) const;
