@@ -32,6 +32,15 @@ ServiceStatus FromEngineError(const engine::Error& error) {
   return MakeStatus(StatusCode::kInternal, error.message);
 }
 
+engine::CoreOptions CoreOptionsOf(const DispatcherOptions& options) {
+  engine::CoreOptions core;
+  core.robot_snap_tolerance = options.robot_snap_tolerance;
+  core.traffic_control = options.traffic_control;
+  core.traffic = options.traffic;
+  core.one_formation_per_pick = options.one_formation_per_pick;
+  return core;
+}
+
 engine::Result<std::unique_ptr<Dispatcher>> Dispatcher::Create(
     std::shared_ptr<const engine::WarehouseMap> map, std::shared_ptr<const engine::RouteTable> routes,
     storage::Store& store, DispatcherOptions options) {
@@ -46,12 +55,7 @@ engine::Result<std::unique_ptr<Dispatcher>> Dispatcher::Create(
   };
   auto rounds = std::make_unique<engine::RoundRunner>(map, routes, options.allocation,
                                                       std::move(allocator).value(), stopwatch);
-  engine::CoreOptions core_options;
-  core_options.robot_snap_tolerance = options.robot_snap_tolerance;
-  core_options.traffic_control = options.traffic_control;
-  core_options.traffic = options.traffic;
-  core_options.one_formation_per_pick = options.one_formation_per_pick;
-  auto core = engine::DispatchCore::Create(map, routes, core_options);
+  auto core = engine::DispatchCore::Create(map, routes, CoreOptionsOf(options));
   if (!core.ok()) return core.error();
   const bool journaled = options.journal != nullptr;
   std::unique_ptr<Dispatcher> d(new Dispatcher(

@@ -119,6 +119,9 @@ struct DispatcherOptions {
   std::uint64_t journal_max_bytes = 0;
 };
 
+// The dispatch core the dispatcher builds for `options` (its journal's setup records the same).
+engine::CoreOptions CoreOptionsOf(const DispatcherOptions& options);
+
 struct SubmitReply {
   ServiceStatus status;
   std::shared_ptr<const OrderView> order;

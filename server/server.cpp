@@ -79,10 +79,7 @@ engine::Result<StartedJournal> StartJournal(const ServerConfig& config, const Di
   setup.map_source = map_source;
   setup.strategy = options.strategy;
   setup.allocation = options.allocation;
-  setup.core.robot_snap_tolerance = options.robot_snap_tolerance;
-  setup.core.traffic_control = options.traffic_control;
-  setup.core.traffic = options.traffic;
-  setup.core.one_formation_per_pick = options.one_formation_per_pick;
+  setup.core = CoreOptionsOf(options);
   setup.route_cache_bytes = static_cast<std::size_t>(config.route_cache_mb) << 20;
   setup.time_scale = options.time_scale;
   auto encoded = storage::EncodeRunSetup(setup);

@@ -142,8 +142,7 @@ Status WriteSimulationJournal(const std::string& db, const std::string& map_sour
   setup.map_source = map_source;
   setup.strategy = AllocationStrategyName(config.strategy);
   setup.allocation = config.allocation;
-  setup.core.traffic = config.traffic;  // as SimulateOnCore builds its core
-  setup.core.one_formation_per_pick = config.one_formation_per_pick;
+  setup.core = CoreOptionsOf(config);
   setup.core.traffic.speed = config.allocation.speed;
   auto encoded = storage::EncodeRunSetup(setup);
   if (!encoded.ok()) return encoded.error();

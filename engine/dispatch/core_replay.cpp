@@ -75,7 +75,6 @@ void CoreReplay::Observe(const std::vector<RobotCommand>& messages, double now) 
 
 Result<std::string> CoreReplay::Feed(const JournalEntry& e) {
   const CoreInput& in = e.input;
-  if (in.time > last_time_) last_time_ = in.time;
   using K = CoreInput::Kind;
   switch (in.kind) {
     case K::kAddOrder: {
@@ -100,11 +99,9 @@ Result<std::string> CoreReplay::Feed(const JournalEntry& e) {
     case K::kPlace:
       core_->Place(in.robot_id);
       return std::string();
-    case K::kConnect: {
+    case K::kConnect:
       if (!in.robot) return Malformed(e, "no robot");
-      connected_[in.robot->id] = true;
       return DescribeMessages(core_->Connect(*in.robot, in.time));
-    }
     case K::kDisconnect:
       core_->Disconnect(in.robot_id);
       return std::string();

@@ -59,7 +59,6 @@ class CoreReplay {
   // Every order seen, in the order they entered the core.
   const std::vector<OrderTrace>& orders() const { return orders_; }
   double hold_seconds() const { return hold_seconds_; }
-  std::size_t robots_connected() const { return connected_.size(); }
 
  private:
   CoreReplay(std::unique_ptr<DispatchCore> core, std::unique_ptr<RoundRunner> rounds);
@@ -79,9 +78,7 @@ class CoreReplay {
   std::vector<OrderTrace> orders_;
   std::map<std::string, std::size_t> order_index_;
   std::map<std::string, double> held_since_;
-  std::map<std::string, bool> connected_;
   double hold_seconds_ = 0.0;
-  double last_time_ = 0.0;
 };
 
 }  // namespace dispatch::engine

@@ -260,6 +260,14 @@ class CoreRun {
 
 }  // namespace
 
+CoreOptions CoreOptionsOf(const StreamConfig& config) {
+  CoreOptions options;
+  options.traffic = config.traffic;
+  options.traffic.speed = config.allocation.speed;
+  options.one_formation_per_pick = config.one_formation_per_pick;
+  return options;
+}
+
 Result<StreamResult> SimulateOnCore(std::shared_ptr<const WarehouseMap> map, std::shared_ptr<const RouteTable> routes,
                                     const std::vector<FleetRobot>& robots, std::vector<Order> orders,
                                     const StreamConfig& config, std::vector<JournalEntry>* journal) {
@@ -275,11 +283,7 @@ Result<StreamResult> SimulateOnCore(std::shared_ptr<const WarehouseMap> map, std
   auto allocator = MakeAllocator(AllocationStrategyName(config.strategy));
   if (!allocator.ok()) return allocator.error();
   auto rounds = std::make_unique<RoundRunner>(map, routes, config.allocation, std::move(allocator).value());
-  CoreOptions options;
-  options.traffic = config.traffic;
-  options.traffic.speed = config.allocation.speed;
-  options.one_formation_per_pick = config.one_formation_per_pick;
-  auto core = DispatchCore::Create(map, routes, options);
+  auto core = DispatchCore::Create(map, routes, CoreOptionsOf(config));
   if (!core.ok()) return core.error();
   CoreRun run(map, config, std::make_unique<JournaledCore>(std::move(core).value(), journal != nullptr),
               std::move(rounds));

@@ -30,9 +30,13 @@
 #include <vector>
 
 #include "engine/dispatch/core_journal.h"
+#include "engine/dispatch/dispatch_core.h"
 #include "engine/sim/order_stream.h"
 
 namespace dispatch::engine {
+
+// The core SimulateOnCore builds for `config` (its journal's setup records the same).
+CoreOptions CoreOptionsOf(const StreamConfig& config);
 
 // With `journal`, every call the run made on the core is journaled there (the service's format,
 // engine/dispatch/core_journal.h): CoreReplay reproduces the run from it.

@@ -27,8 +27,7 @@ ReplaySetup SetupOf(const World& w, const StreamConfig& c) {
   ReplaySetup s;
   s.map = w.map;
   s.routes = w.routes;
-  s.core.traffic = c.traffic;
-  s.core.traffic.speed = c.allocation.speed;
+  s.core = CoreOptionsOf(c);
   s.strategy = AllocationStrategyName(c.strategy);
   s.allocation = c.allocation;
   return s;
