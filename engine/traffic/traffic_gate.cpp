@@ -114,9 +114,14 @@ void GateImpl::Hold(GateBot& b, const std::string& why, std::vector<GateEffect>&
   out.push_back(std::move(e));
 }
 
+std::optional<GateImpl::TeamSpan> GateImpl::SpanOf(const GateBot& b, const std::string& o) {
+  auto cached = b.spans.find(o);
+  return cached != b.spans.end() ? cached->second : FindSpan(b, o);
+}
+
 // The formation segment of order `o` in b's plan: join index J (first waypoint of the run at
 // the rendezvous point before the slot), F (the formation's first pick), E (its drop).
-std::optional<GateImpl::TeamSpan> GateImpl::SpanOf(const GateBot& b, const std::string& o) const {
+std::optional<GateImpl::TeamSpan> GateImpl::FindSpan(const GateBot& b, const std::string& o) {
   const auto& w = b.plan.waypoints;
   long first = -1, f = -1, e = -1;
   for (long i = 0; i < static_cast<long>(w.size()); ++i) {

@@ -18,6 +18,13 @@
 
 namespace dispatch::engine {
 
+// The formation segment of one order in a robot's plan (GateImpl::SpanOf).
+struct GateTeamSpan {
+  long join = -1, first_pick = -1, drop = -1;
+  PointId rendezvous = kNoPoint;
+  std::uint64_t seq_first_pick = 0, seq_drop = 0;
+};
+
 // One robot as the gate knows it.
 struct GateBot {
   std::string id;
@@ -47,6 +54,8 @@ struct GateBot {
   std::vector<PointId> leg;  // the controller route as last set or adopted
   long leg_stop = -1;     // plan index of the leg's last waypoint (-1: none)
   bool leg_stale = true;  // recompute the leg before the next request
+  // Per formation order of the plan, its segment (none: no pick of it left); kept by Reindex.
+  std::map<std::string, std::optional<GateTeamSpan>> spans;
 };
 
 // One formation team (Chu2024 §3.2): the members, leader first, and their shared agent.
@@ -69,11 +78,7 @@ struct GateTeam {
 };
 
 struct GateImpl {
-  struct TeamSpan {
-    long join = -1, first_pick = -1, drop = -1;
-    PointId rendezvous = kNoPoint;
-    std::uint64_t seq_first_pick = 0, seq_drop = 0;
-  };
+  using TeamSpan = GateTeamSpan;
 
   GateImpl(std::shared_ptr<const WarehouseMap> map, std::shared_ptr<const RouteTable> routes,
            TrafficControllerConfig config, TrafficController ctl);
@@ -120,9 +125,11 @@ struct GateImpl {
   static long RunEnd(const GateBot& b, long from, PointId p, long limit);
   double Departure(const GateBot& b, long i) const;
   static bool IsStop(const Waypoint& w);
-  std::optional<TeamSpan> SpanOf(const GateBot& b, const std::string& order) const;
+  // The formation segment of `order` in b's plan (from b.spans for its formation orders).
+  static std::optional<TeamSpan> SpanOf(const GateBot& b, const std::string& order);
+  static std::optional<TeamSpan> FindSpan(const GateBot& b, const std::string& order);
   long NextJoin(const GateBot& b, long from, std::string* order) const;
-  void Reindex(GateBot& b);
+  void Reindex(GateBot& b);  // after b.plan changed: its index, idx and spans
   using Offset = std::function<Eigen::Vector2d(PointId from, PointId to)>;
   long RewriteLeg(GateBot& b, long cut, const std::vector<PointId>& route, long resume, double t,
                   std::vector<GateEffect>& out, const Offset& offset = {});

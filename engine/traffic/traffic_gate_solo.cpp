@@ -140,6 +140,8 @@ void GateImpl::Reindex(GateBot& b) {
     b.index[static_cast<std::uint64_t>(b.plan.waypoints[i].seq)] = i;
     b.plan.next_sequence = std::max<std::uint64_t>(b.plan.next_sequence, b.plan.waypoints[i].seq + 1);
   }
+  b.spans.clear();
+  for (const auto& team : b.plan.teams) b.spans.emplace(team.first, FindSpan(b, team.first));
   b.idx = -1;
   for (long i = static_cast<long>(b.plan.waypoints.size()) - 1; i >= 0; --i) {
     if (static_cast<std::uint64_t>(b.plan.waypoints[static_cast<std::size_t>(i)].seq) <= b.reached_seq) {
