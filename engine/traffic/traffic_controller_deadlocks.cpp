@@ -19,8 +19,26 @@ namespace dispatch::engine {
 // A* with the straight-line time as heuristic (admissible: paths are never shorter than
 // the straight distance and no robot is faster than `speed`); searches stop once every
 // open route costs more than `bound` seconds (no route returned then).
+std::size_t traffic_detail::RouteQueryHash::operator()(const traffic_detail::RouteQuery& q) const {
+  std::size_t h = std::hash<double>{}(q.bound);
+  for (long long v : {static_cast<long long>(q.from), static_cast<long long>(q.to),
+                      static_cast<long long>(q.ban_point), static_cast<long long>(q.ban_corridor),
+                      static_cast<long long>(q.ban_guard)}) {
+    h = h * 1000003u ^ std::hash<long long>{}(v);
+  }
+  return h;
+}
+
 Detour TrafficController::Impl::Route(PointId from, PointId to, PointId ban_point, int ban_corridor,
                                       int ban_guard, double bound) {
+  const traffic_detail::RouteQuery q{from, to, ban_point, ban_corridor, ban_guard, bound};
+  if (auto known = route_memo.find(q); known != route_memo.end()) return known->second;
+  if (route_memo.size() >= kRouteMemo) route_memo.clear();
+  return route_memo.emplace(q, Search(q)).first->second;
+}
+
+Detour TrafficController::Impl::Search(const traffic_detail::RouteQuery& q) {
+  const auto [from, to, ban_point, ban_corridor, ban_guard, bound] = q;
   Detour out;
   if (to == ban_point || from == to) {
     if (from == to) out = {{from}, 0.0};

@@ -60,6 +60,21 @@ struct Detour {
   double cost = kInf;
 };
 
+// A Route query. Route depends on the map and these alone, so its answers can be kept: a
+// waiting robot asks the same question every step until something moves.
+struct RouteQuery {
+  PointId from, to, ban_point;
+  int ban_corridor, ban_guard;
+  double bound;
+  bool operator==(const RouteQuery& o) const {
+    return from == o.from && to == o.to && ban_point == o.ban_point && ban_corridor == o.ban_corridor &&
+           ban_guard == o.ban_guard && bound == o.bound;
+  }
+};
+struct RouteQueryHash {
+  std::size_t operator()(const RouteQuery& q) const;
+};
+
 }  // namespace traffic_detail
 
 using traffic_detail::CorridorState;
@@ -85,6 +100,9 @@ struct TrafficController::Impl {
   std::vector<ArcId> via;
   std::vector<std::uint32_t> seen;
   std::uint32_t stamp = 0;
+  // Route's recent answers (cleared when full: kRouteMemo entries bound its memory).
+  static constexpr std::size_t kRouteMemo = 4096;
+  std::unordered_map<traffic_detail::RouteQuery, Detour, traffic_detail::RouteQueryHash> route_memo;
 
   const WarehouseMap& M() const { return *map; }
   double ArcTime(ArcId a) const {
@@ -141,6 +159,7 @@ struct TrafficController::Impl {
   // Detours, back-off, sidings and deadlocks (traffic_controller_deadlocks.cpp).
   Detour Route(PointId from, PointId to, PointId ban_point, int ban_corridor, int ban_guard,
                double bound = kInf);
+  Detour Search(const traffic_detail::RouteQuery& q);  // Route without the memo
   bool StartAllowed(std::size_t r, const std::vector<PointId>& points) const;
   bool TryDetour(std::size_t r, PointId ban_point, int ban_corridor, int ban_guard,
                  bool need_free_first_hop);
