@@ -89,6 +89,7 @@ bool RoundRunner::ReplayQueue(FleetState& fleet, std::size_t index, const RoundR
                               std::vector<std::string>& notes) const {
   const Assignment& plan = r.assignment;
   const auto& stored = plan.plan.waypoints;
+  const std::vector<std::size_t> starts = SegmentStarts(plan);
   for (std::size_t k = 0; k < plan.order_ids.size(); ++k) {
     if (k >= r.queue.size() || !r.queue[k]) {
       notes.push_back("allocation: queue of " + r.id + " replayed up to " + plan.order_ids[k] +
@@ -99,7 +100,7 @@ bool RoundRunner::ReplayQueue(FleetState& fleet, std::size_t index, const RoundR
     std::vector<PointId> picks = order.picks;
     if (k == 0) {  // only the picks still ahead of the robot
       picks.clear();
-      for (std::size_t w = 1; w < SegmentStart(plan, 1) && w < stored.size(); ++w) {
+      for (std::size_t w = 1; w < starts[1] && w < stored.size(); ++w) {
         if (stored[w].action == WaypointAction::kPick && static_cast<std::uint64_t>(stored[w].seq) > r.last_reached) {
           picks.push_back(stored[w].point);
         }
@@ -109,7 +110,7 @@ bool RoundRunner::ReplayQueue(FleetState& fleet, std::size_t index, const RoundR
     // The stored waypoints of this order (the first: those not reached yet), re-timed from
     // the queue's end: no routing (on a large floor every random pick is a new destination
     // of the lazy route table, and re-routing every queue each round thrashed its cache).
-    const std::size_t begin = k == 0 ? 1 : SegmentStart(plan, k), end = SegmentStart(plan, k + 1);
+    const std::size_t begin = starts[k], end = starts[k + 1];
     std::vector<Waypoint> segment;
     const PointId from = fleet.summary(index).end_point;
     segment.push_back({0, from, map_->point(from).position, 0.0, WaypointAction::kMove, 0.0});

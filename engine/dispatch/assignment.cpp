@@ -14,6 +14,16 @@ std::size_t SegmentStart(const Assignment& a, std::size_t k) {
   return w.size();
 }
 
+std::vector<std::size_t> SegmentStarts(const Assignment& a) {
+  const auto& w = a.plan.waypoints;
+  std::vector<std::size_t> out{1};
+  for (std::size_t i = 1; i < w.size() && out.size() <= a.order_ids.size(); ++i) {
+    if (w[i].action == WaypointAction::kDrop) out.push_back(i + 1);
+  }
+  out.resize(a.order_ids.size() + 1, w.size());
+  return out;
+}
+
 std::vector<std::string> OrdersOfWaypoints(const Assignment& a) {
   const auto& w = a.plan.waypoints;
   std::vector<std::string> out(w.size());

@@ -33,6 +33,8 @@ struct Assignment {
 
 // Index of the first waypoint of the k-th order segment (k = order_ids.size(): the end).
 std::size_t SegmentStart(const Assignment& a, std::size_t k);
+// SegmentStart for every k = 0 .. order_ids.size(), in one pass.
+std::vector<std::size_t> SegmentStarts(const Assignment& a);
 // Per waypoint, the order it serves ("" for the anchor and for waypoints past the last drop).
 std::vector<std::string> OrdersOfWaypoints(const Assignment& a);
 // The order waypoint `index` serves (OrdersOfWaypoints for one waypoint).

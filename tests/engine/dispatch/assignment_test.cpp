@@ -43,6 +43,7 @@ TEST(Assignment, AppendNumbersWaypointsLifeLongAndSegmentsFollowTheDrops) {
   EXPECT_EQ(SegmentStart(a, 0), 1u);
   EXPECT_EQ(SegmentStart(a, 1), 4u);
   EXPECT_EQ(SegmentStart(a, 2), 7u);
+  EXPECT_EQ(SegmentStarts(a), (std::vector<std::size_t>{1, 4, 7}));
   const std::vector<std::string> of = OrdersOfWaypoints(a);
   EXPECT_EQ(of, (std::vector<std::string>{"", "o1", "o1", "o1", "o2", "o2", "o2"}));
   for (std::size_t i = 0; i < of.size(); ++i) EXPECT_EQ(OrderOfWaypoint(a, i), of[i]) << i;
