@@ -1,15 +1,18 @@
-// Dispatcher: loop, recovery and snapshots. The order book and the order commands are in
-// dispatcher_orders.cpp, allocation in dispatcher_allocation.cpp, plans in
-// dispatcher_plans.cpp, robot streams in dispatcher_robots.cpp.
+// Dispatcher: creation, recovery, the loop and publishing. The order commands are in
+// dispatcher_orders.cpp, allocation rounds in dispatcher_allocation.cpp, carrying out the
+// core's changes in dispatcher_commit.cpp, robot streams in dispatcher_robots.cpp, traffic
+// control in dispatcher_traffic.cpp; the parts they use are robot_sessions.h (streams and
+// message sequences), order_views.h (the order book), change_store.h (a change's store
+// transaction), snapshot_builder.h and core_journal_writer.h.
 #include "server/dispatcher.h"
 
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
-#include <cmath>
 
 #include "engine/dispatch/strategy.h"
 #include "server/json_convert.h"
+#include "server/snapshot_builder.h"
 
 namespace dispatch::server {
 namespace {
@@ -17,20 +20,6 @@ namespace {
 constexpr int kWorkerNice = 5;  // the workers' CPU priority below the loop's (WorkerThread)
 
 }  // namespace
-
-ServiceStatus FromEngineError(const engine::Error& error) {
-  switch (error.code) {
-    case engine::ErrorCode::kInvalidArgument:
-    case engine::ErrorCode::kNotFound:
-    case engine::ErrorCode::kUnreachable:
-      return MakeStatus(StatusCode::kInvalidArgument, error.message);
-    case engine::ErrorCode::kFailedPrecondition:
-      return MakeStatus(StatusCode::kFailedPrecondition, error.message);
-    case engine::ErrorCode::kIoError:
-      return MakeStatus(StatusCode::kUnavailable, "storage failed: " + error.message);
-  }
-  return MakeStatus(StatusCode::kInternal, error.message);
-}
 
 engine::CoreOptions CoreOptionsOf(const DispatcherOptions& options) {
   engine::CoreOptions core;
@@ -80,15 +69,19 @@ Dispatcher::Dispatcher(std::shared_ptr<const engine::WarehouseMap> map,
       book_(options_.finished_retained),
       // Below the loop's priority: traffic control first when the cores are busy.
       route_worker_(std::make_unique<WorkerThread>(kWorkerNice)),
-      allocation_worker_(std::make_unique<WorkerThread>(kWorkerNice)),
-      journal_worker_(std::make_unique<WorkerThread>(kWorkerNice)) {}
+      allocation_worker_(std::make_unique<WorkerThread>(kWorkerNice)) {
+  if (options_.journal) {
+    journal_writer_ = std::make_unique<CoreJournalWriter>(*options_.journal, options_.journal_run,
+                                                          options_.journal_max_bytes, kWorkerNice);
+  }
+}
 
 Dispatcher::~Dispatcher() {
   // The workers post to the loop: they stop before anything is torn down.
   route_worker_->Stop();
   allocation_worker_->Stop();
   Stop();
-  journal_worker_->Stop();
+  if (journal_writer_) journal_writer_->Stop();
 }
 
 engine::Status Dispatcher::Recover() {
@@ -113,11 +106,8 @@ engine::Status Dispatcher::Recover() {
   }
   for (auto& record : *robots) {
     const std::string id = record.robot.id;
-    RobotSession& s = sessions_[id];
-    s.kind = record.kind;
-    s.last_seen = record.last_seen;
-    s.last_acked_sequence = record.last_acked_sequence;
-    s.next_sequence = record.next_sequence;
+    RobotSession& s = sessions_.Get(id);
+    RestoreSession(s, record);
     s.offline_since = Clock::now();
     time_base_ = std::max(time_base_, record.last_seen);
     // On line when the old process stopped: where it is now is known when it reports.
@@ -149,10 +139,8 @@ void Dispatcher::Start() {
 void Dispatcher::CloseStreams() {
   Post([this] {
     for (auto& [id, s] : sessions_) {
-      if (s.link) {
-        CloseLink(s.link, MakeStatus(StatusCode::kUnavailable, "dispatcher shutting down"));
-        link_robot_.erase(s.link.get());
-        s.link.reset();
+      if (auto link = sessions_.Detach(id)) {
+        CloseLink(link, MakeStatus(StatusCode::kUnavailable, "dispatcher shutting down"));
         dirty_ = true;
       }
     }
@@ -177,7 +165,7 @@ void Dispatcher::Stop() {
   queue_cv_.notify_all();
   if (thread_.joinable()) thread_.join();
   WriteJournal();  // the last batch's entries
-  journal_worker_->Stop();
+  if (journal_writer_) journal_writer_->Stop();
 }
 
 void Dispatcher::Post(std::function<void()> fn) {
@@ -255,85 +243,18 @@ void Dispatcher::Flush() {
 }
 
 void Dispatcher::Publish() {
-  auto snap = std::make_shared<Snapshot>();
-  snap->version = ++snapshot_version_;
-  snap->time = Now();
-  snap->map_name = map_->name();
-  snap->map_version = options_.map_version;
-  snap->strategy = options_.strategy;
-  snap->time_scale = options_.time_scale;
-  snap->orders = book_.all();
-  snap->finished_in_store = book_.finished_in_store();
-  snap->index = book_.Index();
-  const engine::TrafficGate* gate = core_->gate();
-  for (const auto& [id, r] : core_->robots()) {
-    RobotView view;
-    view.robot = r.robot;
-    if (auto s = sessions_.find(id); s != sessions_.end()) {
-      view.kind = s->second.kind;
-      view.connected = s->second.link != nullptr;
-      view.last_seen = s->second.last_seen;
-    }
-    if (r.has_assignment) {
-      view.plan_id = r.assignment.plan_id;
-      view.waypoints = r.assignment.plan.waypoints.size();
-    }
-    if (gate) {
-      engine::GateRobotState traffic = gate->RobotState(id);
-      view.held = traffic.held;
-      view.hold_reason = std::move(traffic.reason);
-      view.formation = std::move(traffic.formation);
-    }
-    snap->robots.emplace(id, std::move(view));
-  }
-  snap->zones = ZoneViews(snap->robots);
-  snap->traffic.implausible_reports = implausible_;
-  if (gate) {
-    for (auto& g : gate->Intersections()) {
-      snap->intersections.push_back({std::move(g.holders), std::move(g.waiting)});
-    }
-    TrafficView& t = snap->traffic;
-    const engine::CoreCounts& counts = core_->counts();
-    t.enabled = true;
-    t.grants = counts.grants;
-    t.holds = counts.holds;
-    t.replans = counts.replans;
-    t.deadlocks_resolved = gate->stats().deadlocks_resolved;
-    t.head_on_conflicts = gate->stats().head_on_conflicts;
-    t.nudges = gate->stats().nudges;
-    t.awaiting_reconnect.assign(awaiting_reconnect_.begin(), awaiting_reconnect_.end());
-    if (std::isfinite(min_distance_.distance)) {
-      t.min_distance = min_distance_.distance;
-      t.min_pair_a = min_distance_.a;
-      t.min_pair_b = min_distance_.b;
-      t.min_time = min_distance_.time;
-    }
-  }
-  std::atomic_store(&snapshot_, std::shared_ptr<const Snapshot>(std::move(snap)));
+  SnapshotFacts facts;
+  facts.version = ++snapshot_version_;
+  facts.time = Now();
+  facts.map_version = options_.map_version;
+  facts.strategy = options_.strategy;
+  facts.time_scale = options_.time_scale;
+  facts.implausible_reports = implausible_;
+  facts.awaiting_reconnect = &awaiting_reconnect_;
+  facts.min_distance = min_distance_;
+  std::atomic_store(&snapshot_, std::shared_ptr<const Snapshot>(BuildSnapshot(*map_, *core_, sessions_, book_, facts)));
   dirty_ = false;
   last_publish_ = Clock::now();
-}
-
-std::vector<ZoneView> Dispatcher::ZoneViews(const std::map<std::string, RobotView>& robots) const {
-  const auto& zones = map_->zones();
-  std::vector<ZoneView> out(zones.size());
-  for (const auto& [id, view] : robots) {
-    if (!view.connected) continue;
-    const engine::Robot& r = view.robot;
-    long zone = -1;
-    if (r.current_point != engine::kNoPoint) {
-      zone = map_->point(r.current_point).zone;
-    } else {
-      for (std::size_t z = 0; z < zones.size() && zone < 0; ++z) {
-        if (zones[z].Contains(r.pose.position)) zone = static_cast<long>(z);
-      }
-    }
-    if (zone >= 0) out[static_cast<std::size_t>(zone)].robots.push_back(id);
-  }
-  for (std::size_t z = 0; z < zones.size(); ++z) {
-    if (zones[z].area > 0) out[z].density = static_cast<double>(out[z].robots.size()) / zones[z].area;
-  }
-  return out;
 }
 
 void Dispatcher::Journal(const storage::OrderEvent& event) {

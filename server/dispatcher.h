@@ -77,9 +77,11 @@
 #include "engine/routing/route_table.h"
 #include "engine/traffic/traffic_controller.h"
 #include "engine/traffic/traffic_gate.h"
+#include "server/core_journal_writer.h"
 #include "server/metrics.h"
 #include "server/order_views.h"
 #include "server/robot_link.h"
+#include "server/robot_sessions.h"
 #include "server/service_status.h"
 #include "server/snapshot.h"
 #include "server/watch_hub.h"
@@ -194,19 +196,7 @@ class Dispatcher {
   }
 
  private:
-  using Clock = std::chrono::steady_clock;
-  // What the service keeps of a robot besides the core's book: its stream and the session's
-  // bookkeeping (message sequences, heartbeats).
-  struct RobotSession {
-    std::string kind;                       // drive kinematics, e.g. "differential"
-    double last_seen = 0.0;                 // dispatcher seconds of its last message
-    std::uint64_t last_acked_sequence = 0;  // server message sequence it acknowledged
-    std::uint64_t next_sequence = 1;        // next server message sequence to use
-    std::shared_ptr<RobotLink> link;        // null when not connected
-    Clock::time_point last_heard;
-    std::optional<Clock::time_point> offline_since;  // set while offline with orders to watch
-    std::optional<double> held_since;                // dispatcher seconds of the Hold in force
-  };
+  using Clock = RobotSession::Clock;
   // An allocation round on its way into the store: the core's commit, and per award the
   // explanation as the journal keeps it.
   struct ServerRound {
@@ -275,15 +265,14 @@ class Dispatcher {
   void Publish();
   // Publishes the snapshot if anything changed, then runs the deferred effects.
   void Flush();
-  // Live zone densities from the robots' reported positions (their current point's zone).
-  std::vector<ZoneView> ZoneViews(const std::map<std::string, RobotView>& robots) const;
 
   // Traffic control (dispatcher_traffic.cpp).
   void StepTraffic();
 
-  // The core's journal (dispatcher_journal.cpp): hands the batch's entries to the journal
-  // worker; at the size limit, recording stops.
-  void WriteJournal();
+  // Hands the batch's journal entries to the journal writer (if journaling).
+  void WriteJournal() {
+    if (journal_writer_) journal_writer_->Write(*core_);
+  }
 
   const std::shared_ptr<const engine::WarehouseMap> map_;
   const std::shared_ptr<const engine::RouteTable> routes_;
@@ -308,8 +297,7 @@ class Dispatcher {
   Clock::time_point wall_start_;
   double time_base_ = 0.0;  // dispatcher seconds at wall_start_
   OrderViews book_;  // every open order and the newest finished ones, as operators read them
-  std::map<std::string, RobotSession> sessions_;  // every robot the core knows
-  std::unordered_map<const RobotLink*, std::string> link_robot_;
+  RobotSessions sessions_;  // every robot the core knows, and their streams
   std::int64_t last_order_number_ = 0;
   std::uint64_t snapshot_version_ = 0;
   bool dirty_ = true;
@@ -335,12 +323,8 @@ class Dispatcher {
   // Stopped first (Stop, destructor): what they still hold reaches the loop's queue.
   std::unique_ptr<WorkerThread> route_worker_;
   std::unique_ptr<WorkerThread> allocation_worker_;
-  // Journal writes (options_.journal), in batch order; stopped last.
-  std::unique_ptr<WorkerThread> journal_worker_;
-  std::uint64_t journal_bytes_ = 0;         // journal worker only
-  bool journal_failed_ = false;             // journal worker only: a write failed
-  std::atomic<bool> journal_full_{false};   // set by the worker at journal_max_bytes
-  bool journal_stopped_ = false;            // loop: recording stopped, marker written
+  // Journal writes (options_.journal), in batch order; stopped last. Null: no journal.
+  std::unique_ptr<CoreJournalWriter> journal_writer_;
 };
 
 }  // namespace dispatch::server

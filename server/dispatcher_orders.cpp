@@ -6,7 +6,6 @@
 
 #include "engine/dispatch/order_intake.h"
 #include "server/dispatcher.h"
-#include "server/json_convert.h"
 
 namespace dispatch::server {
 
@@ -14,28 +13,7 @@ engine::Result<std::shared_ptr<const OrderView>> Dispatcher::FindAnywhere(const 
                                                                           bool explain) const {
   auto snap = snapshot();
   if (auto view = by_client_id ? snap->FindClientOrder(key) : snap->FindOrder(key)) return view;
-  auto record = by_client_id ? store_.GetOrderByClientId(key) : store_.GetOrder(key);
-  if (!record.ok()) {
-    if (record.error().code == engine::ErrorCode::kNotFound) return std::shared_ptr<const OrderView>();
-    return record.error();
-  }
-  auto view = std::make_shared<OrderView>();
-  view->record = std::move(record).value();
-  if (engine::IsTerminal(view->record.order.state)) view->finished_time = view->record.updated_time;
-  if (explain) {  // the latest allocation detail in its journal
-    storage::EventQuery events;
-    events.order_id = view->record.order.id;
-    for (;;) {
-      auto batch = store_.ListEvents(events);
-      if (!batch.ok()) return batch.error();
-      for (const auto& event : *batch) {
-        events.after_id = event.id;
-        if (auto explanation = ParseAllocationDetail(event.detail)) view->explanation = std::move(explanation);
-      }
-      if (batch->size() < static_cast<std::size_t>(events.limit)) break;
-    }
-  }
-  return std::shared_ptr<const OrderView>(std::move(view));
+  return OrderViews::FromStore(store_, key, by_client_id, explain);
 }
 
 std::string Dispatcher::NextOrderId() {

@@ -21,23 +21,23 @@ void Dispatcher::OnRobotGone(std::shared_ptr<RobotLink> link) {
 }
 
 void Dispatcher::DoRobotMessage(const std::shared_ptr<RobotLink>& link, const RobotInbound& m) {
-  auto known = link_robot_.find(link.get());
+  const std::string* known = sessions_.RobotOf(link.get());
   if (m.kind == RobotInbound::Kind::kHello) {
-    if (known != link_robot_.end()) {
+    if (known) {
       CloseLink(link, MakeStatus(StatusCode::kInvalidArgument, "Hello sent twice on one stream"));
       return;
     }
     DoHello(link, m);
     return;
   }
-  if (known == link_robot_.end()) {
+  if (!known) {
     CloseLink(link, MakeStatus(StatusCode::kInvalidArgument, "the first message of a stream must be Hello"));
     return;
   }
-  const std::string id = known->second;
-  auto session = sessions_.find(id);
-  if (session == sessions_.end() || session->second.link != link) return;  // a superseded stream
-  RobotSession& s = session->second;
+  const std::string id = *known;
+  RobotSession* session = sessions_.Find(id);
+  if (!session || session->link != link) return;  // a superseded stream
+  RobotSession& s = *session;
   s.last_heard = Clock::now();
   s.last_seen = Now();
   dirty_ = true;
@@ -76,33 +76,17 @@ void Dispatcher::DoHello(const std::shared_ptr<RobotLink>& link, const RobotInbo
   if (!located.ok()) return reject(StatusCode::kInvalidArgument, located.error().message);
   const engine::PointId point = *located;
   const std::string& id = hello.robot_id;
-  auto existing = sessions_.find(id);
-  if (existing != sessions_.end() && existing->second.link && existing->second.link != link) {
-    RobotSession& old = existing->second;
-    const std::chrono::duration<double> silent = Clock::now() - old.last_heard;
+  const RobotSession* existing = sessions_.Find(id);
+  if (existing && existing->link && existing->link != link) {
+    const std::chrono::duration<double> silent = Clock::now() - existing->last_heard;
     if (silent.count() <= options_.heartbeat_timeout) {
       return reject(StatusCode::kAlreadyExists,
                     "robot " + id + " already has a live stream (heard " + engine::FormatFixed(silent.count()) +
                         " s ago); retry after its heartbeat times out");
     }
-    CloseLink(old.link, MakeStatus(StatusCode::kUnavailable, "superseded by a new stream"));
-    link_robot_.erase(old.link.get());
-    old.link.reset();
+    CloseLink(sessions_.Detach(id), MakeStatus(StatusCode::kUnavailable, "superseded by a new stream"));
   }
-  storage::RobotRecord record = RecordOf(id);
-  record.robot.id = id;
-  if (hello.diameter > 0) record.robot.diameter = hello.diameter;
-  record.robot.max_speed = hello.max_speed > 0 ? hello.max_speed : options_.allocation.speed;
-  record.robot.pose = hello.pose;
-  record.robot.current_point = point;
-  record.robot.state = engine::RobotState::kIdle;
-  if (record.robot.battery && !(*record.robot.battery >= 0.0 && *record.robot.battery <= 1.0)) {
-    record.robot.battery.reset();  // stored by an older server that took any report
-  }
-  record.kind = hello.robot_kind.empty() ? "differential" : hello.robot_kind;
-  record.last_seen = Now();
-  record.last_acked_sequence = std::max(record.last_acked_sequence, hello.last_acked_sequence);
-  if (record.next_sequence <= record.last_acked_sequence) record.next_sequence = record.last_acked_sequence + 1;
+  const storage::RobotRecord record = HelloRecord(RecordOf(id), hello, point, options_.allocation.speed, Now());
   if (auto valid = engine::ValidateRobot(record.robot); !valid.ok()) {
     return reject(StatusCode::kInvalidArgument, valid.error().message);
   }
@@ -113,15 +97,11 @@ void Dispatcher::DoHello(const std::shared_ptr<RobotLink>& link, const RobotInbo
   if (auto saved = store_.UpsertRobot(stored); !saved.ok()) {
     return reject(StatusCode::kUnavailable, "robot " + id + " not registered: storage failed: " + saved.error().message);
   }
-  RobotSession& s = sessions_[id];
-  s.kind = record.kind;
-  s.last_seen = record.last_seen;
-  s.last_acked_sequence = record.last_acked_sequence;
-  s.next_sequence = record.next_sequence;
-  s.link = link;
+  RobotSession& s = sessions_.Get(id);
+  RestoreSession(s, record);
+  sessions_.Attach(id, link);
   s.last_heard = Clock::now();
   s.offline_since.reset();
-  link_robot_[link.get()] = id;
   dirty_ = true;
   std::vector<engine::RobotCommand> plan = core_->Connect(record.robot, Now());
   RobotOutbound welcome;
@@ -165,12 +145,8 @@ void Dispatcher::DoTaskEvent(const std::string& id, const engine::TaskReport& re
 }
 
 void Dispatcher::MarkOffline(const std::string& id, const std::string& why) {
-  RobotSession& s = sessions_.at(id);
-  if (s.link) {
-    CloseLink(s.link, MakeStatus(StatusCode::kUnavailable, why));
-    link_robot_.erase(s.link.get());
-    s.link.reset();
-  }
+  RobotSession& s = sessions_.Get(id);
+  if (auto link = sessions_.Detach(id)) CloseLink(link, MakeStatus(StatusCode::kUnavailable, why));
   s.offline_since = Clock::now();
   dirty_ = true;
   core_->Disconnect(id);
@@ -181,12 +157,11 @@ void Dispatcher::MarkOffline(const std::string& id, const std::string& why) {
 }
 
 void Dispatcher::DoRobotGone(const std::shared_ptr<RobotLink>& link) {
-  auto known = link_robot_.find(link.get());
-  if (known == link_robot_.end()) return;
-  const std::string id = known->second;
-  auto s = sessions_.find(id);
-  if (s != sessions_.end() && s->second.link == link) MarkOffline(id, "stream closed");
-  link_robot_.erase(link.get());
+  const std::string* known = sessions_.RobotOf(link.get());
+  if (!known) return;
+  const std::string id = *known;
+  if (const RobotSession* s = sessions_.Find(id); s && s->link == link) MarkOffline(id, "stream closed");
+  sessions_.Forget(link.get());
 }
 
 bool Dispatcher::LoseRobot(const std::string& id, const std::string& why) {

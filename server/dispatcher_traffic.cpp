@@ -36,7 +36,7 @@ void Dispatcher::Reported(const std::string& robot_id) {
 void Dispatcher::EndRecoveryWait(bool timed_out) {
   if (timed_out) {
     for (const auto& id : awaiting_reconnect_) {
-      if (auto it = sessions_.find(id); it != sessions_.end() && !it->second.link) core_->Place(id);
+      if (const RobotSession* s = sessions_.Find(id); s && !s->link) core_->Place(id);
     }
     spdlog::warn("traffic control resumes after {:.1f} s without a report from {} (placed at their stored points)",
                  options_.heartbeat_timeout, AwaitedList());
@@ -58,9 +58,9 @@ void Dispatcher::StepTraffic() {
   engine::StepOutcome step = core_->Step(now);
   if (!step.messages.empty()) dirty_ = true;  // the snapshot shows grants and holds
   for (auto& c : step.messages) {
-    auto session = sessions_.find(c.robot);
-    if (session == sessions_.end()) continue;
-    RobotSession& s = session->second;
+    RobotSession* session = sessions_.Find(c.robot);
+    if (!session) continue;
+    RobotSession& s = *session;
     using Kind = RobotOutbound::Kind;
     if (c.message.kind == Kind::kHold) {
       if (!s.held_since) s.held_since = now;

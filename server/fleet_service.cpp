@@ -7,12 +7,12 @@
 namespace dispatch::server {
 namespace {
 
-class RobotSession;
+class RobotStreamReactor;
 
-// The dispatcher's handle on a session; outlives it (the session detaches in OnDone).
-class SessionLink final : public RobotLink {
+// The dispatcher's handle on a robot stream; outlives it (the stream detaches in OnDone).
+class StreamLink final : public RobotLink {
  public:
-  explicit SessionLink(RobotSession* session) : session_(session) {}
+  explicit StreamLink(RobotStreamReactor* session) : session_(session) {}
   void Send(RobotOutbound message) override;
   void Close(ServiceStatus status) override;
   void Detach() {
@@ -22,14 +22,14 @@ class SessionLink final : public RobotLink {
 
  private:
   std::mutex mu_;  // guards session_ (deleted only after Detach)
-  RobotSession* session_;
+  RobotStreamReactor* session_;
 };
 
-class RobotSession final
+class RobotStreamReactor final
     : public QueuedWriter<grpc::ServerBidiReactor<pb::RobotMessage, pb::ServerMessage>, pb::ServerMessage> {
  public:
-  explicit RobotSession(Dispatcher& dispatcher)
-      : dispatcher_(dispatcher), link_(std::make_shared<SessionLink>(this)) {
+  explicit RobotStreamReactor(Dispatcher& dispatcher)
+      : dispatcher_(dispatcher), link_(std::make_shared<StreamLink>(this)) {
     StartRead(&in_);
   }
 
@@ -57,18 +57,18 @@ class RobotSession final
 
  private:
   Dispatcher& dispatcher_;
-  std::shared_ptr<SessionLink> link_;
+  std::shared_ptr<StreamLink> link_;
   pb::RobotMessage in_;
 };
 
-void SessionLink::Send(RobotOutbound message) {
+void StreamLink::Send(RobotOutbound message) {
   pb::ServerMessage out;
   OutboundToProto(message, &out);
   std::lock_guard<std::mutex> lock(mu_);
   if (session_) session_->Enqueue(std::move(out));
 }
 
-void SessionLink::Close(ServiceStatus status) {
+void StreamLink::Close(ServiceStatus status) {
   std::lock_guard<std::mutex> lock(mu_);
   if (session_) session_->RequestFinish(Fitted(ToGrpcStatus(status)));
 }
@@ -77,7 +77,7 @@ void SessionLink::Close(ServiceStatus status) {
 
 grpc::ServerBidiReactor<pb::RobotMessage, pb::ServerMessage>* FleetServiceImpl::Connect(
     grpc::CallbackServerContext* /*context*/) {
-  return new RobotSession(dispatcher_);
+  return new RobotStreamReactor(dispatcher_);
 }
 
 MapServiceImpl::MapServiceImpl(const Dispatcher& dispatcher) {

@@ -36,6 +36,52 @@ void OrderViews::Put(std::shared_ptr<OrderView> view) {
   }
 }
 
+engine::Result<std::shared_ptr<const OrderView>> OrderViews::FromStore(storage::Store& store, const std::string& key,
+                                                                       bool by_client_id, bool explain) {
+  auto record = by_client_id ? store.GetOrderByClientId(key) : store.GetOrder(key);
+  if (!record.ok()) {
+    if (record.error().code == engine::ErrorCode::kNotFound) return std::shared_ptr<const OrderView>();
+    return record.error();
+  }
+  auto view = std::make_shared<OrderView>();
+  view->record = std::move(record).value();
+  if (engine::IsTerminal(view->record.order.state)) view->finished_time = view->record.updated_time;
+  if (explain) {  // the latest allocation detail in its journal
+    storage::EventQuery events;
+    events.order_id = view->record.order.id;
+    for (;;) {
+      auto batch = store.ListEvents(events);
+      if (!batch.ok()) return batch.error();
+      for (const auto& event : *batch) {
+        events.after_id = event.id;
+        if (auto explanation = ParseAllocationDetail(event.detail)) view->explanation = std::move(explanation);
+      }
+      if (batch->size() < static_cast<std::size_t>(events.limit)) break;
+    }
+  }
+  return std::shared_ptr<const OrderView>(std::move(view));
+}
+
+void OrderViews::Follow(const engine::Change& change, const std::vector<AllocationRecord>* records) {
+  for (const engine::OrderChange& line : change.orders) {
+    auto found = Find(line.order_id);
+    if (!found) continue;
+    auto view = std::make_shared<OrderView>(*found);
+    if (auto d = change.dropped_by.find(line.order_id); d != change.dropped_by.end()) view->dropped_by = d->second;
+    if (line.to) {
+      const engine::OrderState to = *line.to;
+      view->record.order.state = to;
+      view->record.updated_time = change.time;
+      if (line.robots) view->record.robots = *line.robots;
+      if (line.distance) view->record.distance = *line.distance;
+      if (engine::IsTerminal(to)) view->finished_time = change.time;
+      if (to == engine::OrderState::kCancelled || to == engine::OrderState::kFailed) view->record.reason = line.detail;
+      if (records && line.award < records->size()) view->explanation = (*records)[line.award];
+    }
+    Put(std::move(view));
+  }
+}
+
 bool OrderViews::Retire(std::size_t slack) {
   if (finished_.size() <= retained_ + slack) return false;
   std::unordered_set<std::string> leaving;

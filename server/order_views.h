@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "engine/common/result.h"
+#include "engine/dispatch/dispatch_core.h"
 #include "engine/fleet/order.h"
 #include "server/snapshot.h"
 #include "storage/store.h"
@@ -37,10 +38,20 @@ class OrderViews {
   // latest allocation explanation from the journal.
   engine::Result<LoadedOrders> Load(storage::Store& store);
 
+  // An order as the store has it (one that left memory): by server id, or with by_client_id
+  // by client order id; with `explain` its latest allocation explanation from its journal.
+  // nullptr when there is none.
+  static engine::Result<std::shared_ptr<const OrderView>> FromStore(storage::Store& store, const std::string& key,
+                                                                    bool by_client_id, bool explain);
+
   std::shared_ptr<const OrderView> Find(const std::string& order_id) const;
   std::shared_ptr<const OrderView> FindClient(const std::string& client_id) const;
   // Replaces (or adds, at the end) an order; a finished one joins the finished list.
   void Put(std::shared_ptr<OrderView> view);
+  // The views follow a committed core change: per order line the state, robots, distance,
+  // finish time, reason and the members that dropped; with `records` (per award of the
+  // change's round) the allocation explanation.
+  void Follow(const engine::Change& change, const std::vector<AllocationRecord>* records);
   // Once more than retained + slack finished orders are in memory, the oldest finished ones
   // leave it down to `retained` (counted in finished_in_store). True when some left.
   bool Retire(std::size_t slack);
