@@ -112,7 +112,7 @@ engine::Status Dispatcher::Recover() {
     time_base_ = std::max(time_base_, record.last_seen);
     // On line when the old process stopped: where it is now is known when it reports.
     const bool was_on_line = options_.traffic_control && record.robot.state != engine::RobotState::kOffline;
-    if (was_on_line) awaiting_reconnect_.insert(id);
+    if (was_on_line) restart_wait_.Await(id);
     auto plan = plans.find(id);
     core_->RestoreRobot(std::move(record.robot),
                         plan == plans.end() ? std::nullopt : std::optional<engine::Assignment>(std::move(plan->second)),
@@ -122,17 +122,17 @@ engine::Status Dispatcher::Recover() {
   for (const auto& [state, n] : book_.finished_in_store()) retired += n;
   spdlog::info("recovered {} orders ({} finished ones left in the store), {} robots, {} assignments; "
                "dispatcher time {:.1f} s", book_.all().size(), retired, sessions_.size(), plans.size(), time_base_);
-  if (!awaiting_reconnect_.empty()) {
+  if (restart_wait_.waiting()) {
     spdlog::info("traffic control waits up to {:.1f} s for the {} robots that were on line to report",
-                 options_.heartbeat_timeout, awaiting_reconnect_.size());
+                 options_.heartbeat_timeout, restart_wait_.awaited().size());
   }
   return engine::Ok{};
 }
 
 void Dispatcher::Start() {
   if (started_.exchange(true)) return;
-  awaiting_until_ = Clock::now() + std::chrono::duration_cast<Clock::duration>(
-                                       std::chrono::duration<double>(options_.heartbeat_timeout));
+  restart_wait_.SetDeadline(Clock::now() + std::chrono::duration_cast<Clock::duration>(
+                                                std::chrono::duration<double>(options_.heartbeat_timeout)));
   thread_ = std::thread([this] { Loop(); });
 }
 
@@ -250,7 +250,7 @@ void Dispatcher::Publish() {
   facts.strategy = options_.strategy;
   facts.time_scale = options_.time_scale;
   facts.implausible_reports = implausible_;
-  facts.awaiting_reconnect = &awaiting_reconnect_;
+  facts.awaiting_reconnect = &restart_wait_.awaited();
   facts.min_distance = min_distance_;
   std::atomic_store(&snapshot_, std::shared_ptr<const Snapshot>(BuildSnapshot(*map_, *core_, sessions_, book_, facts)));
   dirty_ = false;

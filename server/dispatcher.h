@@ -1,54 +1,39 @@
-// Dispatcher: the one writer of the engine state (SPEC §4 "Concurrency").
+// Dispatcher: the service's adapter around the dispatch core (engine/dispatch/dispatch_core.h,
+// which owns what orders, plans, robots and traffic mean), and the one writer of its state
+// (SPEC §4 "Concurrency").
 //
-// One loop thread owns the order book, the robots (pose, link, current plan) and the
-// allocator. API threads never touch them: they post commands (Post) and get the answer
-// through a callback run on the loop thread (gRPC reactors finish from it; REST waits on a
-// future, see Call). The loop publishes an immutable Snapshot (atomic shared_ptr swap) that
-// reads use without locks of the loop: after every batch whose replies, journal events,
-// Welcomes or stream ends announce a change (they go out only after that publish: read-your-writes), and
-// otherwise at most every 20 ms while robots report (positions, grants and holds are at most
-// that stale in REST).
+// One loop thread owns the core, the order views and the robot sessions. API threads never
+// touch them: they post commands (Post) and get the answer through a callback run on the loop
+// thread (gRPC reactors finish from it; REST waits on a future, see Call). The loop publishes
+// an immutable Snapshot (snapshot_builder.h) that reads use without locks: after every batch
+// whose replies, journal events, Welcomes or stream ends announce a change (they go out only
+// after that publish: read-your-writes), otherwise at most every 20 ms while robots report.
 //
-// Durability: an order is committed to the Store (InsertOrder) before SubmitOrder answers
-// OK; a failed write is an error to the caller and leaves the in-memory state unchanged.
-// Awards (order -> assigned + the allocation explanation as a journal entry + the robots'
-// plans) are one store transaction. At start the dispatcher recovers orders, explanations,
-// robots and assignments from the store.
+// Durability: an order is in the Store before SubmitOrder answers OK; every core change (an
+// award with its explanation, a transition, new plans, the robots' reserved message sequences)
+// is stored in one transaction (change_store.h) before the core and the views take it, and a
+// failed write changes nothing. At start the orders, explanations, robots and plans are
+// recovered from the store.
 //
-// Allocation (dispatcher_allocation.cpp): a round of the strategy (auction or greedy) over
-// the connected robots starts after every batch in which an order arrived, a robot connected
-// or finished an order, or an order came back for re-allocation - and the previous round has
-// been committed (one round at a time). The loop copies the round's inputs (the accepted
-// orders, every available robot's point, plan and queue); a worker thread builds a fresh
-// engine::FleetState from them with every robot at its point now, replays its remaining
-// orders into its queue (ReplayQueue), then auctions the orders in (priority, created) order;
-// back on the loop, the awards whose robots and orders have not changed meanwhile are
-// committed, a few per loop turn and each group in one store transaction (a new order's
-// waypoints appended to the robots' plans); the others stay `accepted` for the next round. So traffic control (grants, holds) never
-// waits for an auction or its route searches. New orders' route searches run on another
-// worker before the loop sees the order (SubmitOrder). Orders stay `accepted` while no robot
-// (or fewer than 3 for a formation) is connected.
+// Allocation (dispatcher_allocation.cpp): after a batch in which the core says a round is due,
+// and once the previous round is committed, the core's round inputs go to a worker that runs
+// the strategy (engine::RoundRunner); back on the loop the awards that still hold are
+// committed, a few per loop turn. So traffic control never waits for an auction. New orders'
+// route searches run on another worker before the loop sees the order.
 //
-// Robots: Hello registers (snapping the pose to the nearest map point within
-// Options::robot_snap_tolerance); waypoints are numbered over the robot's whole life
-// (AssignmentRecord::released_up_to keeps the highest sequence ever issued). Traffic control
-// (dispatcher_traffic.cpp, TrafficGate): plans are sent with only the waypoints at the
-// robot's point released; after every batch the gate runs the TrafficController and its
-// releases go out as Grants (Resume after a Hold), its waits as Holds with the reason, its
-// detours as PlanUpdates; a robot blocked with no alternative loses its orders (assigned ones
-// are re-allocated, in-progress ones fail) and is marked fault. Progress: a pick (waypoint reached or picked event) moves the order to
-// in_progress, the drop of every team member completes it. A robot silent for
-// heartbeat_timeout goes offline (stream closed); after offline_grace more its assigned
-// orders go back to accepted and are re-allocated, and its in_progress orders fail (the load
-// is on a robot that is gone).
+// Robots (dispatcher_robots.cpp, robot_sessions.h): Hello registers the robot at the map point
+// its pose snaps to; its reports go to the core, the core's messages (plans, Grants, Holds,
+// Resumes, PlanUpdates, cancels) to its stream, numbered over the robot's life. After every
+// batch the core's traffic gate steps (dispatcher_traffic.cpp); a robot blocked with no way
+// out, or offline for offline_grace after heartbeat_timeout of silence, loses its orders
+// (the core's PlanLoss: assigned ones are re-allocated, in-progress ones fail).
 //
-// Restart: robots stored offline are placed in the gate at their stored points (obstacles
-// until they reconnect). Robots the old process had on line may have driven on since their
-// record was written, and may still be driving to the horizon it released: until every one
-// of them has reconnected and sent a state report, or heartbeat_timeout has passed since the
-// loop started, the gate releases nothing (a robot back first must not be given a point one
-// still away stands on or drives into). Those still away then are placed at their stored
-// points; /api/v1/status lists whom the wait is for (traffic.awaiting_reconnect).
+// Restart (restart_wait.h): robots stored offline are obstacles at their stored points until
+// they reconnect; until every robot the old process had on line has reported, or
+// heartbeat_timeout has passed, the gate releases nothing; those still away are then placed at
+// their stored points. /api/v1/status lists whom the wait is for (traffic.awaiting_reconnect).
+//
+// The core's journal (core_journal_writer.h) is written off the loop, batch by batch.
 //
 // Thread safety: the public methods are thread-safe; everything else runs on the loop thread.
 #pragma once
@@ -59,27 +44,20 @@
 #include <deque>
 #include <functional>
 #include <future>
-#include <map>
 #include <memory>
 #include <mutex>
-#include <set>
 #include <string>
 #include <thread>
-#include <unordered_map>
-#include <unordered_set>
 #include <vector>
 
 #include "engine/dispatch/allocation_round.h"
-#include "engine/dispatch/dispatch_core.h"
 #include "engine/dispatch/journaled_core.h"
-#include "engine/dispatch/robot_progress.h"
 #include "engine/fleet/order.h"
 #include "engine/routing/route_table.h"
-#include "engine/traffic/traffic_controller.h"
-#include "engine/traffic/traffic_gate.h"
 #include "server/core_journal_writer.h"
 #include "server/metrics.h"
 #include "server/order_views.h"
+#include "server/restart_wait.h"
 #include "server/robot_link.h"
 #include "server/robot_sessions.h"
 #include "server/service_status.h"
@@ -256,11 +234,8 @@ class Dispatcher {
   void MarkOffline(const std::string& robot_id, const std::string& why);
   // The robot is lost (offline too long, blocked): its orders go back (core PlanLoss).
   bool LoseRobot(const std::string& robot_id, const std::string& why);
-  // The robot reported after a restart; the wait ends when nobody is awaited any more.
-  void Reported(const std::string& robot_id);
   // The wait after a restart is over: traffic control resumes (dispatcher_traffic.cpp).
   void EndRecoveryWait(bool timed_out);
-  std::string AwaitedList() const;  // "R3, R7": the robots the wait is for
   void Tick();
   void Publish();
   // Publishes the snapshot if anything changed, then runs the deferred effects.
@@ -314,10 +289,7 @@ class Dispatcher {
   bool round_again_ = false;     // a round became due meanwhile
   engine::MinDistance min_distance_;
   Clock::time_point next_distance_sample_{};
-  // Restart (see the top): robots on line before it that have not reported since, and when
-  // the gate stops waiting for them.
-  std::set<std::string> awaiting_reconnect_;
-  Clock::time_point awaiting_until_{};
+  RestartWait restart_wait_;  // see the top, "Restart"
   std::uint64_t implausible_ = 0;  // robot reports not taken (Implausible)
   // Route searches of new orders (SubmitOrder) and allocation rounds: off the loop thread.
   // Stopped first (Stop, destructor): what they still hold reaches the loop's queue.

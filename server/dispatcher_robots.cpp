@@ -45,7 +45,7 @@ void Dispatcher::DoRobotMessage(const std::shared_ptr<RobotLink>& link, const Ro
     case RobotInbound::Kind::kState: {
       engine::ReportOutcome report = core_->Report(id, m.pose, m.arc_id, m.state, m.battery, m.sequence, Now());
       if (!report.taken) return;  // a pose off the floor: no news
-      if (!awaiting_reconnect_.empty()) Reported(id);
+      if (restart_wait_.Reported(id)) EndRecoveryWait(false);
       Progressed(id, std::move(report));
       break;
     }

@@ -11,7 +11,7 @@ OrderRoutes Dispatcher::RoutesOf(const std::string& order_id) const { return cor
 
 std::vector<std::pair<std::string, std::string>> Dispatcher::TrafficLines() const {
   std::vector<std::pair<std::string, std::string>> out;
-  const std::string awaiting = AwaitedList();
+  const std::string awaiting = restart_wait_.List();
   const engine::TrafficGate* gate = core_->gate();
   for (const auto& [id, r] : core_->robots()) {
     std::string line = gate ? gate->Describe(id) : std::string("traffic control off");
@@ -21,37 +21,25 @@ std::vector<std::pair<std::string, std::string>> Dispatcher::TrafficLines() cons
   return out;
 }
 
-std::string Dispatcher::AwaitedList() const {
-  std::string out;
-  for (const auto& id : awaiting_reconnect_) out += (out.empty() ? "" : ", ") + id;
-  return out;
-}
-
-void Dispatcher::Reported(const std::string& robot_id) {
-  if (awaiting_reconnect_.erase(robot_id) == 0) return;
-  dirty_ = true;
-  if (awaiting_reconnect_.empty()) EndRecoveryWait(false);
-}
-
 void Dispatcher::EndRecoveryWait(bool timed_out) {
   if (timed_out) {
-    for (const auto& id : awaiting_reconnect_) {
+    for (const auto& id : restart_wait_.awaited()) {
       if (const RobotSession* s = sessions_.Find(id); s && !s->link) core_->Place(id);
     }
     spdlog::warn("traffic control resumes after {:.1f} s without a report from {} (placed at their stored points)",
-                 options_.heartbeat_timeout, AwaitedList());
+                 options_.heartbeat_timeout, restart_wait_.List());
   } else {
     spdlog::info("every robot that was on line before the restart has reported: traffic control resumes");
   }
-  awaiting_reconnect_.clear();
+  restart_wait_.End();
   dirty_ = true;
 }
 
 void Dispatcher::StepTraffic() {
   const engine::TrafficGate* gate = core_->gate();
   if (!gate) return;
-  if (!awaiting_reconnect_.empty()) {  // after a restart: nothing moves until the fleet is known
-    if (Clock::now() < awaiting_until_) return;
+  if (restart_wait_.waiting()) {  // after a restart: nothing moves until the fleet is known
+    if (!restart_wait_.Expired(Clock::now())) return;
     EndRecoveryWait(true);
   }
   const double now = Now();

@@ -149,6 +149,7 @@ ReportOutcome JournaledCore::Report(const std::string& robot, const Pose& pose, 
   const std::uint64_t seq = Begin();
   ReportOutcome out = core_->Report(robot, pose, arc_id, state, battery, claimed, now);
   if (out.change) out.change->origin = seq;
+  if (!recording_) return out;  // the most frequent call: no input built for nothing
   CoreInput in;
   in.kind = CoreInput::Kind::kReport;
   in.time = now;
@@ -158,7 +159,7 @@ ReportOutcome JournaledCore::Report(const std::string& robot, const Pose& pose, 
   in.state = state;
   in.battery = battery;
   in.sequence = claimed;
-  Record(seq, std::move(in), recording_ ? DescribeReport(out) : "");
+  Record(seq, std::move(in), DescribeReport(out));
   return out;
 }
 
@@ -167,13 +168,14 @@ ReportOutcome JournaledCore::Reached(const std::string& robot, std::uint64_t way
   const std::uint64_t seq = Begin();
   ReportOutcome out = core_->Reached(robot, waypoint, pose, now);
   if (out.change) out.change->origin = seq;
+  if (!recording_) return out;
   CoreInput in;
   in.kind = CoreInput::Kind::kReached;
   in.time = now;
   in.robot_id = robot;
   in.sequence = waypoint;
   in.pose = pose;
-  Record(seq, std::move(in), recording_ ? DescribeReport(out) : "");
+  Record(seq, std::move(in), DescribeReport(out));
   return out;
 }
 

@@ -11,6 +11,7 @@
 #include "engine/routing/route_table.h"
 #include "server/change_store.h"
 #include "server/core_journal_writer.h"
+#include "server/restart_wait.h"
 #include "server/robot_sessions.h"
 #include "storage/sqlite_store.h"
 #include "tests/server/test_support.h"
@@ -75,6 +76,29 @@ TEST(RobotSessionsTest, AHelloContinuesTheMessageSequenceAfterWhatTheRobotAcknow
   EXPECT_EQ(again.next_sequence, 10u);
   EXPECT_EQ(again.robot.max_speed, 0.8);
   EXPECT_EQ(again.kind, "four_wheel_steer");
+}
+
+TEST(RestartWaitTest, EndsWithTheLastAwaitedReportOrAtItsDeadline) {
+  using Clock = RestartWait::Clock;
+  const Clock::time_point t0{};
+  RestartWait wait;
+  EXPECT_FALSE(wait.waiting());
+  EXPECT_FALSE(wait.Expired(t0 + std::chrono::hours(1)));  // nobody awaited: nothing to expire
+  wait.Await("R7");
+  wait.Await("R3");
+  wait.SetDeadline(t0 + std::chrono::seconds(5));
+  EXPECT_EQ(wait.List(), "R3, R7");
+  EXPECT_FALSE(wait.Reported("R9"));  // not awaited
+  EXPECT_FALSE(wait.Reported("R3"));  // R7 still away
+  EXPECT_FALSE(wait.Reported("R3"));  // twice changes nothing
+  EXPECT_FALSE(wait.Expired(t0 + std::chrono::seconds(4)));
+  EXPECT_TRUE(wait.Expired(t0 + std::chrono::seconds(5)));
+  EXPECT_TRUE(wait.Reported("R7"));  // the last one: over
+  EXPECT_FALSE(wait.waiting());
+  wait.Await("R1");
+  wait.End();
+  EXPECT_FALSE(wait.waiting());
+  EXPECT_EQ(wait.List(), "");
 }
 
 std::unique_ptr<engine::JournaledCore> RecordingCore() {
