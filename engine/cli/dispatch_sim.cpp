@@ -232,10 +232,6 @@ std::string TablesLabel(const StreamArgs& a) {
 }
 
 Result<StreamResult> Simulate(const StreamArgs& a, const Setup& s, const StreamConfig& c) {
-  if (a.model == "core" && a.check_safety) {
-    return InvalidArgument("--check-safety runs on the order-stream model (add --model stream); the core "
-                           "reports the closest pair and every pair below eps1 instead");
-  }
   if (a.model != "core") {
     if (!a.journal.empty()) return InvalidArgument("--journal records the dispatch core's calls: --model core");
     return SimulateOrderStream(s.map, s.routes, s.robots, s.orders, c);

@@ -11,6 +11,7 @@
 #include "engine/dispatch/journaled_core.h"
 #include "engine/dispatch/strategy.h"
 #include "engine/sim/waypoint_robot.h"
+#include "engine/traffic/safety_check.h"
 
 namespace dispatch::engine {
 namespace {
@@ -76,6 +77,7 @@ class CoreRun {
       Allocate(t);
       MoveRobots(t);
       Traffic(t);
+      if (config_.check_safety || config_.record_frames) Record(t);
     }
     out_.steps = step;
     out_.end_time = std::min(t, config_.max_time);
@@ -83,6 +85,17 @@ class CoreRun {
       if (!terminal_of_.count(k)) Fail(k, "not finished by " + std::to_string(config_.max_time) + " s");
     }
     Summarise();
+    if (config_.check_safety) {
+      TrafficConfig rules;
+      rules.formation_radius = FormationRadius();
+      rules.epsilon_single_single = config_.traffic.point_clearance;
+      rules.epsilon_single_formation = rules.epsilon_single_single + rules.formation_radius;
+      rules.epsilon_formation_formation = rules.epsilon_single_single + 2.0 * rules.formation_radius;
+      SafetyCheckOptions options;
+      options.followers_may_diverge = true;  // the controller re-plans inside I_w (as the stream model)
+      out_.safety = CheckSafety(frames_, *map_, rules, options);
+    }
+    if (config_.record_frames) out_.frames = std::move(frames_);
     return std::move(out_);
   }
 
@@ -214,6 +227,23 @@ class CoreRun {
     ++terminal_;
   }
 
+  // Where every robot really is (not where the gate believes it is), tagged with what the
+  // gate makes of it: a formation member moves with its team's agent, and is exempt from its
+  // teammates from the approach to its slot until it has driven off after the drop.
+  void Record(double t) {
+    SafetyFrame& frame = frames_.emplace_back();
+    frame.t = t;
+    const TrafficGate* gate = core_->gate();
+    for (const WaypointRobot& b : bots_) {
+      const GateRobotState s = gate ? gate->RobotState(b.id()) : GateRobotState{};
+      const std::string& first = s.team.empty() ? s.former_team : s.team;
+      const std::string second = s.team.empty() ? std::string() : s.former_team;
+      frame.robots.push_back({b.id(), s.formation.empty() ? b.id() : "formation " + s.formation,
+                              first.empty() ? b.id() : "team " + first, !s.formation.empty(), b.xy(),
+                              second.empty() ? std::string() : "team " + second});
+    }
+  }
+
   void Summarise() {
     double sum = 0.0;
     for (const StreamOrderOutcome& oc : out_.orders) {
@@ -247,6 +277,7 @@ class CoreRun {
     std::uint64_t reached = 0;
   };
   std::vector<LastReport> reported_;  // each robot's last state report
+  std::vector<SafetyFrame> frames_;    // check_safety, record_frames
   std::vector<Order> orders_;  // by release time
   std::size_t next_release_ = 0;
   double next_allocation_ = 0.0;

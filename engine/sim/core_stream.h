@@ -20,8 +20,10 @@
 // failure; the gate's traffic statistics; total distance driven, robot-seconds waiting with a
 // plan (not moving, not working), moving -> waiting transitions; overall_min_distance is the
 // gate's (centre distance of robots of different agents, from the robots' positions at every
-// step). The per-step distance series and CheckSafety frames are not recorded (config
-// record_series / check_safety / record_frames are ignored); nor is `preassigned` supported.
+// step). With check_safety, CheckSafety over every step's true robot positions (not the gate's
+// belief), a formation's members grouped as the gate groups them; record_frames keeps those
+// frames. The per-step distance series (record_series) is not recorded, and `preassigned` is
+// not supported.
 //
 // Pure function of its inputs; thread-safe.
 #pragma once

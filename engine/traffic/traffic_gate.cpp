@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <tuple>
 #include <unordered_map>
 #include <utility>
 
@@ -349,6 +350,7 @@ GateRobotState TrafficGate::RobotState(const std::string& robot) const {
   state.held = it->second.held;
   if (state.held) state.reason = it->second.hold_reason;
   state.formation = it->second.team;
+  std::tie(state.team, state.former_team) = impl_->TeamKeys(it->second);
   return state;
 }
 

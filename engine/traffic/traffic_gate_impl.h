@@ -51,6 +51,8 @@ struct GateBot {
   std::string former_team;
   PointId former_at = kNoPoint;
   std::uint64_t leave_seq = 0;  // leaving a team: the waypoint it was placed at (to reach first)
+  // The team it counted as one with (TeamKeys().first) when its controller group was last set.
+  std::string approach;
   std::vector<PointId> leg;  // the controller route as last set or adopted
   long leg_stop = -1;     // plan index of the leg's last waypoint (-1: none)
   bool leg_stale = true;  // recompute the leg before the next request

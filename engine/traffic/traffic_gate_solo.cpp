@@ -51,6 +51,7 @@ bool GateImpl::PlaceNear(GateBot& b) {
   if (b.has_xy) candidates.push_back(map->NearestPoint(b.xy));
   if (b.ctl >= 0) {  // teammates (a formation it is in or just left) do not keep it off
     const auto keys = TeamKeys(b);
+    b.approach = keys.first;
     ctl.SetGroup(static_cast<std::size_t>(b.ctl), keys.first.empty() ? 0 : GroupOf(keys.first),
                  keys.second.empty() ? 0 : GroupOf(keys.second));
   }
@@ -167,6 +168,7 @@ void GateImpl::StepSolo(GateBot& b, double t, std::vector<GateEffect>& out) {
   const long n = static_cast<long>(w.size());
   // On its way to a rendezvous, or leaving one, a member may come closer to its teammates.
   const auto keys = TeamKeys(b);
+  b.approach = keys.first;
   ctl.SetGroup(r, keys.first.empty() ? 0 : GroupOf(keys.first), keys.second.empty() ? 0 : GroupOf(keys.second));
   const PointId next = ctl.Next(r);
   if (next != kNoPoint) {  // driving: the point behind is released once clear of it

@@ -72,8 +72,22 @@ void GateImpl::BreakTeam(GateTeam& team) {
   const int group = GroupOf(team.order);
   for (const std::string& id : team.members) {  // leader first
     auto it = bots.find(id);
-    if (it == bots.end() || it->second.team != team.order) continue;
-    GateBot& b = it->second;
+    if (it == bots.end()) continue;
+    GateBot& m = it->second;
+    if (m.team.empty()) {
+      // Not in the team yet: on its way to the rendezvous it was exempt from its teammates
+      // (its controller group, TeamKeys) and may stand closer to one than eps1 now. It stays
+      // exempt from them until it has reached its next point, as a member that had joined
+      // (unless it is still leaving another team's drop). Found by the core's safety check:
+      // two members waiting 0.4 m apart for their rendezvous lost the exemption at once.
+      if (m.approach == team.order && (m.former_team.empty() || m.former_at == kNoPoint)) {
+        m.former_team = team.order;
+        m.former_at = kNoPoint;
+      }
+      continue;
+    }
+    if (m.team != team.order) continue;
+    GateBot& b = m;
     b.team.clear();
     b.former_team = team.order;
     b.former_at = kNoPoint;  // broken up on the way: until its next point
