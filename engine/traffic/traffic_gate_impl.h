@@ -50,6 +50,9 @@ struct GateBot {
   // The team it left (at point former_at), until it has driven out of the team's envelope.
   std::string former_team;
   PointId former_at = kNoPoint;
+  // The team it had left before former_team, while it had not driven off from that one either
+  // (a member of two teams in turn at one rendezvous); cleared with former_team.
+  std::string older_former;
   std::uint64_t leave_seq = 0;  // leaving a team: the waypoint it was placed at (to reach first)
   // The team it counted as one with (TeamKeys().first) when its controller group was last set.
   std::string approach;
@@ -178,6 +181,9 @@ struct GateImpl {
   void StepTeams(double t, std::vector<GateEffect>& out);
   void StepTeamsAfterDeadlocks(double t, std::vector<GateEffect>& out);
   void BreakTeam(GateTeam& team);
+  // b leaves (or never joins) `order`'s team at `at` (kNoPoint: until its next point): exempt
+  // from its members until it has driven off; a former team it still had moves to older_former.
+  static void BecomeFormer(GateBot& b, const std::string& order, PointId at);
   bool StepLeaving(GateTeam& team, double t, std::vector<GateEffect>& out);
 };
 

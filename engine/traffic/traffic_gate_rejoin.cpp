@@ -51,8 +51,7 @@ bool GateImpl::RejoinTeam(GateBot& b, const std::string& order, const TeamSpan& 
     for (const std::string& id : team.members) {
       auto m = bots.find(id);
       if (m == bots.end() || !m->second.team.empty()) continue;
-      m->second.former_team = order;
-      m->second.former_at = d;
+      BecomeFormer(m->second, order, d);
     }
     BreakTeam(team);
     finished_teams.insert(order);

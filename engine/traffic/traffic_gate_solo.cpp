@@ -362,6 +362,7 @@ void GateImpl::OnReached(GateBot& b, std::uint64_t seq, double t) {
            (map->point(ctl.At(r)).position - map->point(b.former_at).position).norm() >= envelope - 1e-9) &&
           teammates_out()) {
         b.former_team.clear();
+        b.older_former.clear();
         ctl.SetEnvelope(r, 0.0);
       }
     }
@@ -371,7 +372,7 @@ void GateImpl::OnReached(GateBot& b, std::uint64_t seq, double t) {
 // --- Minimum distance ---------------------------------------------------------------------
 
 // The formation orders a robot counts as one agent with: the team it is in or approaches,
-// and the team it left at its last drop until it (and its teammates) have driven off.
+// and the teams it left (at a drop, or broken up) until it (and its teammates) have driven off.
 std::pair<std::string, std::string> GateImpl::TeamKeys(const GateBot& b) const {
   if (b.team.empty() && b.former_team.empty() && b.plan.teams.empty()) return {};  // a robot alone
   std::string current = b.team;
@@ -382,7 +383,16 @@ std::pair<std::string, std::string> GateImpl::TeamKeys(const GateBot& b) const {
       if (!o.empty() && b.plan.teams.count(o)) current = o;
     }
   }
-  return {current, b.former_team};
+  // Two keys at most (the controller's two groups): the first two distinct ones of the team it
+  // is in or approaches, the team it left last and the one before.
+  std::vector<const std::string*> keys;
+  const std::string* candidates[] = {&current, &b.former_team, &b.older_former};
+  for (const std::string* k : candidates) {
+    if (!k->empty() && std::none_of(keys.begin(), keys.end(), [&](const std::string* o) { return *o == *k; })) {
+      keys.push_back(k);
+    }
+  }
+  return {keys.size() > 0 ? *keys[0] : std::string(), keys.size() > 1 ? *keys[1] : std::string()};
 }
 
 void GateImpl::SampleDistances(double t) {

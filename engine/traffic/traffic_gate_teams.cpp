@@ -62,6 +62,12 @@ void GateImpl::SyncTeams(GateBot& b) {
   }
 }
 
+void GateImpl::BecomeFormer(GateBot& b, const std::string& order, PointId at) {
+  if (!b.former_team.empty() && b.former_team != order) b.older_former = b.former_team;
+  b.former_team = order;
+  b.former_at = at;
+}
+
 void GateImpl::BreakTeam(GateTeam& team) {
   notes.push_back("formation " + team.order + " broken up");
   if (TeamAgentOnFloor(team)) {
@@ -77,20 +83,16 @@ void GateImpl::BreakTeam(GateTeam& team) {
     if (m.team.empty()) {
       // Not in the team yet: on its way to the rendezvous it was exempt from its teammates
       // (its controller group, TeamKeys) and may stand closer to one than eps1 now. It stays
-      // exempt from them until it has reached its next point, as a member that had joined
-      // (unless it is still leaving another team's drop). Found by the core's safety check:
+      // exempt from them until it has reached its next point, as a member that had joined.
+      // Found by the core's safety check:
       // two members waiting 0.4 m apart for their rendezvous lost the exemption at once.
-      if (m.approach == team.order && (m.former_team.empty() || m.former_at == kNoPoint)) {
-        m.former_team = team.order;
-        m.former_at = kNoPoint;
-      }
+      if (m.approach == team.order) BecomeFormer(m, team.order, kNoPoint);
       continue;
     }
     if (m.team != team.order) continue;
     GateBot& b = m;
     b.team.clear();
-    b.former_team = team.order;
-    b.former_at = kNoPoint;  // broken up on the way: until its next point
+    BecomeFormer(b, team.order, kNoPoint);  // broken up on the way: until its next point
     b.leg_stale = true;
     // It stands in its slot (D_f off the team's point) until it reports elsewhere: back on the
     // floor there at once, by its pose, before anyone is given the points the team agent held
@@ -371,8 +373,7 @@ bool GateImpl::StepLeaving(GateTeam& team, double t, std::vector<GateEffect>& ou
     // Until it has left the formation's envelope it still stands in its slot, D_f off the point.
     ctl.SetEnvelope(static_cast<std::size_t>(b.ctl), FormationRadius());
     b.team.clear();
-    b.former_team = team.order;
-    b.former_at = d;
+    BecomeFormer(b, team.order, d);
     b.leg_stale = true;
     b.left = false;
   };

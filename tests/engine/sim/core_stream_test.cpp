@@ -171,16 +171,16 @@ TEST(CoreStreamTest, TableOneThreeTimesCompletesWithShortQueuesAndOneFormationPe
 
 // Members on their way to one rendezvous may stand closer than eps1 (teammates are exempt
 // from each other). When their team breaks up before they have joined it, they stay exempt
-// until each has reached its next point (the gate's former team), as joined members do. Seed
-// Tables 1 and 2 ten times at once (the freeze): two members waiting 0.4 m apart for their
-// rendezvous lost the exemption the moment it broke up (t = 239.4 s), checked on the robots'
-// true positions. The horizon ends before t = 403 s, where a member of two broken-up teams in
-// turn loses the older exemption (a robot keeps one former team; README, "Safety check").
+// until each has reached its next point (the gate's former team), as joined members do; and a
+// member of two broken-up teams in turn stays exempt from both. Seed Tables 1 and 2 ten times
+// at once (the freeze), checked on the robots' true positions: two members waiting 0.4 m
+// apart for their rendezvous lost the exemption the moment it broke up (t = 239.4 s), and
+// later a member of two teams lost the older one (t = 403.2 s, 0.400 m).
 TEST(CoreStreamTest, MembersOnTheirWayStayExemptFromEachOtherWhenTheirTeamBreaksUp) {
   const World w = Chu();
   const std::vector<Order> orders = Repeated(w, {"chu2024-table1.csv", "chu2024-table2.csv"}, 10);
   StreamConfig c = Config();
-  c.max_time = 400;
+  c.max_time = 3000;
   c.check_safety = true;
   auto r = SimulateOnCore(w.map, w.routes, Fleet(w, 18), orders, c);
   ASSERT_TRUE(r.ok()) << r.error().message;
