@@ -377,7 +377,9 @@ std::pair<std::string, std::string> GateImpl::TeamKeys(const GateBot& b) const {
   if (b.team.empty() && b.former_team.empty() && b.plan.teams.empty()) return {};  // a robot alone
   std::string current = b.team;
   if (current.empty()) {
-    const long i = std::min<long>(b.idx + 1, static_cast<long>(b.plan.order_of.size()) - 1);
+    // The waypoint it drives to; before the first one is reached, the first after the anchor
+    // (which serves no order).
+    const long i = std::min<long>(std::max(b.idx + 1, 1L), static_cast<long>(b.plan.order_of.size()) - 1);
     if (i >= 0) {
       const std::string& o = b.plan.order_of[static_cast<std::size_t>(i)];
       if (!o.empty() && b.plan.teams.count(o)) current = o;

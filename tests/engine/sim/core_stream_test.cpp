@@ -188,5 +188,22 @@ TEST(CoreStreamTest, MembersOnTheirWayStayExemptFromEachOtherWhenTheirTeamBreaks
   EXPECT_TRUE(r->safety->ok()) << r->safety->violations.front().Describe();
 }
 
+// Before it reaches the first waypoint of a new plan, a robot counts as one with the team of
+// that waypoint's order (not with none, as the plan's anchor serves no order). Seed Table 1
+// four times at once, checked on true positions: a formation member whose new plan began with
+// its next formation, off the floor beside the rendezvous, was taken for a stranger to its new
+// teammates, and one drove into its slot past it at 0.20 m without either being exempt.
+TEST(CoreStreamTest, ARobotCountsWithItsNextTeamBeforeItsFirstWaypoint) {
+  const World w = Chu();
+  const std::vector<Order> orders = Repeated(w, {"chu2024-table1.csv"}, 4);
+  StreamConfig c = Config();
+  c.max_time = 3000;
+  c.check_safety = true;
+  auto r = SimulateOnCore(w.map, w.routes, Fleet(w, 18), orders, c);
+  ASSERT_TRUE(r.ok()) << r.error().message;
+  ASSERT_TRUE(r->safety.has_value());
+  EXPECT_TRUE(r->safety->ok()) << r->safety->violations.front().Describe();
+}
+
 }  // namespace
 }  // namespace dispatch::engine::testing
