@@ -14,11 +14,6 @@
 
 namespace dispatch::engine {
 
-// Cheapest route from -> to avoiding `ban_point`, corridor `ban_corridor` and intersection
-// `ban_guard` (each -1/kNoPoint for none). Empty points when there is none.
-// A* with the straight-line time as heuristic (admissible: paths are never shorter than
-// the straight distance and no robot is faster than `speed`); searches stop once every
-// open route costs more than `bound` seconds (no route returned then).
 std::size_t traffic_detail::RouteQueryHash::operator()(const traffic_detail::RouteQuery& q) const {
   std::size_t h = std::hash<double>{}(q.bound);
   for (long long v : {static_cast<long long>(q.from), static_cast<long long>(q.to),
@@ -29,6 +24,11 @@ std::size_t traffic_detail::RouteQueryHash::operator()(const traffic_detail::Rou
   return h;
 }
 
+// Cheapest route from -> to avoiding `ban_point`, corridor `ban_corridor` and intersection
+// `ban_guard` (each -1/kNoPoint for none). Empty points when there is none.
+// A* with the straight-line time as heuristic (admissible: paths are never shorter than
+// the straight distance and no robot is faster than `speed`); searches stop once every
+// open route costs more than `bound` seconds (no route returned then).
 Detour TrafficController::Impl::Route(PointId from, PointId to, PointId ban_point, int ban_corridor,
                                       int ban_guard, double bound) {
   const traffic_detail::RouteQuery q{from, to, ban_point, ban_corridor, ban_guard, bound};
@@ -37,6 +37,7 @@ Detour TrafficController::Impl::Route(PointId from, PointId to, PointId ban_poin
   return route_memo.emplace(q, Search(q)).first->second;
 }
 
+// Search: Route without the memo.
 Detour TrafficController::Impl::Search(const traffic_detail::RouteQuery& q) {
   const auto [from, to, ban_point, ban_corridor, ban_guard, bound] = q;
   Detour out;

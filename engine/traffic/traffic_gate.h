@@ -98,8 +98,9 @@ struct GateRobotState {
   bool held = false;       // a Hold is in force
   std::string reason;      // why, while held
   std::string formation;   // the formation order whose team it is in ("": none)
-  // The formation orders it counts as one with (CheckSafety's groups): the team it is in or
-  // drives to join, and the team it left at its last drop until it has driven off ("": none).
+  // The formation orders it counts as one with (CheckSafety's groups), at most two: the team it
+  // is in or drives to join, and the teams it left (at a drop, or broken up) until it has
+  // driven off ("": none).
   std::string team, former_team;
 };
 

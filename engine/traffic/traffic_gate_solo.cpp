@@ -7,6 +7,7 @@
 #include <cmath>
 #include <limits>
 #include <unordered_map>
+#include <utility>
 
 #include "engine/fleet/formation.h"
 #include "engine/traffic/traffic_gate_impl.h"
@@ -387,14 +388,17 @@ std::pair<std::string, std::string> GateImpl::TeamKeys(const GateBot& b) const {
   }
   // Two keys at most (the controller's two groups): the first two distinct ones of the team it
   // is in or approaches, the team it left last and the one before.
-  std::vector<const std::string*> keys;
-  const std::string* candidates[] = {&current, &b.former_team, &b.older_former};
-  for (const std::string* k : candidates) {
-    if (!k->empty() && std::none_of(keys.begin(), keys.end(), [&](const std::string* o) { return *o == *k; })) {
-      keys.push_back(k);
+  const std::string* keys[2] = {nullptr, nullptr};
+  for (const std::string* k : {&std::as_const(current), &b.former_team, &b.older_former}) {
+    if (k->empty() || (keys[0] && *keys[0] == *k)) continue;
+    if (!keys[0]) {
+      keys[0] = k;
+    } else {
+      keys[1] = k;
+      break;
     }
   }
-  return {keys.size() > 0 ? *keys[0] : std::string(), keys.size() > 1 ? *keys[1] : std::string()};
+  return {keys[0] ? *keys[0] : std::string(), keys[1] ? *keys[1] : std::string()};
 }
 
 void GateImpl::SampleDistances(double t) {
