@@ -1,6 +1,7 @@
 // TrafficGate's state, shared by traffic_gate.cpp (plans, effects, interface),
-// traffic_gate_solo.cpp (solo agents), traffic_gate_teams.cpp (formations) and
-// traffic_gate_rejoin.cpp (formations formed again after a restart). Internal to the gate; see
+// traffic_gate_solo.cpp (solo agents), traffic_gate_teams.cpp (formations),
+// traffic_gate_leaving.cpp (a formation leaving its drop) and traffic_gate_rejoin.cpp
+// (formations formed again after a restart). Internal to the gate; see
 // traffic_gate.h for the model.
 #pragma once
 
@@ -184,7 +185,7 @@ struct GateImpl {
   // b leaves (or never joins) `order`'s team at `at` (kNoPoint: until its next point): exempt
   // from its members until it has driven off; a former team it still had moves to older_former.
   static void BecomeFormer(GateBot& b, const std::string& order, PointId at);
-  bool StepLeaving(GateTeam& team, double t, std::vector<GateEffect>& out);
+  bool StepLeaving(GateTeam& team, double t, std::vector<GateEffect>& out);  // traffic_gate_leaving.cpp
 };
 
 struct TrafficGate::Impl : GateImpl {
