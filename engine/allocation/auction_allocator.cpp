@@ -101,27 +101,35 @@ void AuctionAllocator::PriceLowest(const AllocationConfig& c, std::vector<Bid>& 
     }
     return;
   }
-  // A min-heap of (lower bound, robot): robots come out in increasing bound, ties in robot
-  // order, and only as many as get priced pay for more than the O(n) heap build.
+  // A min-heap of (lower bound, robot), in two rounds per robot: first its time terms alone
+  // (x = 0; F >= 0), then, when that comes out on top, alpha T_t + beta T_d + zeta bound(i).
+  // Robots come out in increasing bound, ties in robot order; only those whose time bound
+  // comes out pay for bound(i), and only as many as get priced pay for more.
   order_.clear();
   flow_bounds_.assign(bids.size(), 0.0);
+  bounded_.assign(bids.size(), false);
   for (std::size_t i = 0; i < bids.size(); ++i) {
-    if (!bids[i].reachable) continue;
-    flow_bounds_[i] = bound(i);
-    bids[i].bid = BidValue(c.alpha, c.beta, bids[i].t_t, bids[i].t_d, c.zeta * flow_bounds_[i]);
-    order_.emplace_back(bids[i].bid, i);
+    if (bids[i].reachable) order_.emplace_back(bids[i].bid, i);  // SetTimes: the x = 0 bid
   }
   const auto later = std::greater<std::pair<double, std::size_t>>();
   std::make_heap(order_.begin(), order_.end(), later);
   kept_.clear();
   while (!order_.empty()) {
-    const std::size_t i = order_.front().second;
-    Bid& b = bids[i];
-    // Full bids are >= their bound: once the bound passes the keep-th lowest full bid, this
+    const auto [key, i] = order_.front();
+    // Full bids are >= their bounds: once a bound passes the keep-th lowest full bid, this
     // robot and every later one are out of the lowest `keep` (ties still priced).
-    if (kept_.size() == keep && b.bid > kept_.back()) break;
+    if (kept_.size() == keep && key > kept_.back()) break;
     std::pop_heap(order_.begin(), order_.end(), later);
     order_.pop_back();
+    Bid& b = bids[i];
+    if (!bounded_[i]) {
+      bounded_[i] = true;
+      flow_bounds_[i] = bound(i);
+      b.bid = BidValue(c.alpha, c.beta, b.t_t, b.t_d, c.zeta * flow_bounds_[i]);
+      order_.emplace_back(b.bid, i);
+      std::push_heap(order_.begin(), order_.end(), later);
+      continue;
+    }
     price(i);
     if (!b.reachable) continue;
     kept_.insert(std::upper_bound(kept_.begin(), kept_.end(), b.bid), b.bid);
@@ -130,8 +138,8 @@ void AuctionAllocator::PriceLowest(const AllocationConfig& c, std::vector<Bid>& 
   for (const auto& [bound_bid, i] : order_) {
     Bid& b = bids[i];
     b.priced = false;
-    b.flow = flow_bounds_[i];
-    b.x = c.zeta * b.flow;  // b.bid is already BidValue(..., b.x)
+    b.flow = flow_bounds_[i];  // 0 when only the time bound was taken
+    b.x = c.zeta * b.flow;     // b.bid is already BidValue(..., b.x)
   }
 }
 

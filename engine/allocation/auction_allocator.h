@@ -70,9 +70,11 @@ class AuctionAllocator final : public Allocator {
 
   // Calls price(i) for the robots that can be among the `keep` lowest bids (all when keep is
   // 0), in increasing order of their lower bounds, and marks the others unpriced. bids holds
-  // every robot's time terms on entry; bound(i) returns a lower bound of robot i's F (keep >
-  // 0 only), so alpha T_t + beta T_d + zeta bound(i) bounds its bid; price(i) completes
-  // bids[i]. An unpriced bid keeps its bound: flow = bound(i), x and bid to match.
+  // every robot's time terms on entry (bid = alpha T_t + beta T_d, its bound with F = 0);
+  // bound(i) returns a lower bound of robot i's F (keep > 0 only, called only for robots whose
+  // time bound could still win), so alpha T_t + beta T_d + zeta bound(i) bounds its bid;
+  // price(i) completes bids[i]. An unpriced bid keeps its bound: flow = bound(i) (0 when not
+  // called), x and bid to match.
   template <typename Bound, typename Price>
   void PriceLowest(const AllocationConfig& c, std::vector<Bid>& bids, std::size_t keep,
                    Bound&& bound, Price&& price);
@@ -93,7 +95,8 @@ class AuctionAllocator final : public Allocator {
                    const ZoneRun* runs, std::size_t run_count, const double* times);
 
   std::vector<std::pair<double, std::size_t>> order_;  // PriceLowest's heap of (bound, robot)
-  std::vector<double> flow_bounds_;  // PriceLowest's bound(i) per robot
+  std::vector<double> flow_bounds_;  // PriceLowest's bound(i) per robot (0 until taken)
+  std::vector<bool> bounded_;        // PriceLowest: bound(i) taken
   std::vector<double> kept_;        // PriceLowest's k lowest full bids, ascending
 
   struct MixedSample {

@@ -120,7 +120,7 @@ Status FleetState::AssignSingle(std::size_t robot, const std::string& order_id,
 }
 
 void FleetState::AppendTask(RobotEntry& e, const std::string& order_id, const PlanTask& task,
-                            const std::vector<Waypoint>& segment, double travel) {
+                            const std::vector<Waypoint>& segment, double travel, bool publish) {
   QueuedTask q{order_id, task, {e.info.id}, e.summary.end_time, segment.back().departure()};
   AppendSegment(e.plan, segment);
   e.summary.end_point = task.drop;
@@ -128,11 +128,11 @@ void FleetState::AppendTask(RobotEntry& e, const std::string& order_id, const Pl
   e.summary.travel_time += travel;
   e.summary.work_time += TaskWorkTime(task);
   e.queue.push_back(std::move(q));
-  Publish(e);
+  if (publish) Publish(e);
 }
 
 Status FleetState::AssignPlanned(std::size_t robot, const std::string& order_id, const PlanTask& task,
-                                 std::vector<Waypoint> segment) {
+                                 std::vector<Waypoint> segment, bool publish) {
   if (robot >= robots_.size()) {
     return NotFound("order " + order_id + ": unknown robot index " + std::to_string(robot));
   }
@@ -152,7 +152,7 @@ Status FleetState::AssignPlanned(std::size_t robot, const std::string& order_id,
     return InvalidArgument("order " + order_id + ": a planned segment must end at the task's drop");
   }
   for (Waypoint& w : segment) w.eta += shift;
-  AppendTask(e, order_id, task, segment, travel);
+  AppendTask(e, order_id, task, segment, travel, publish);
   return Ok{};
 }
 

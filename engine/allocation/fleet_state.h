@@ -112,9 +112,14 @@ class FleetState {
   // no routing). segment[0] stands for the queue's end point; the segment is shifted to start
   // at the queue's end time, and its driving time (arrivals minus the previous departures)
   // counts as the task's T_d. Errors: unknown robot index, fewer than 2 waypoints, times
-  // that go backwards, a last waypoint that is not the task's drop.
+  // that go backwards, a last waypoint that is not the task's drop. With publish = false the
+  // traffic predictor does not see the new plan until Publish(robot) (a queue of several
+  // orders replayed at once is predicted once, not once per order); until then the robot's
+  // prediction is its plan before the call.
   Status AssignPlanned(std::size_t robot, const std::string& order_id, const PlanTask& task,
-                       std::vector<Waypoint> segment);
+                       std::vector<Waypoint> segment, bool publish = true);
+  // Gives the predictor robot's current plan (after AssignPlanned with publish = false).
+  void Publish(std::size_t robot) { Publish(robots_.at(robot)); }
   // Appends a formation task to the three distinct members' queues (team[0] leads).
   Status AssignFormation(const std::array<std::size_t, 3>& team, const std::string& order_id,
                          const PlanTask& task);
@@ -131,9 +136,9 @@ class FleetState {
   // Appends `segment` (its waypoint 0 repeats the plan's end and is dropped) to the plan.
   static void AppendSegment(Plan& plan, const std::vector<Waypoint>& segment);
   // Appends a planned single task (segment starts at the queue's end) and updates the queue,
-  // its summary and the prediction.
+  // its summary and (publish) the prediction.
   void AppendTask(RobotEntry& e, const std::string& order_id, const PlanTask& task,
-                  const std::vector<Waypoint>& segment, double travel);
+                  const std::vector<Waypoint>& segment, double travel, bool publish = true);
   // Gives the predictor robot e's plan plus a final wait of config_.hold_seconds.
   void Publish(RobotEntry& e);
 

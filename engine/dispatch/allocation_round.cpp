@@ -94,6 +94,7 @@ bool RoundRunner::ReplayQueue(FleetState& fleet, std::size_t index, const RoundR
     if (k >= r.queue.size() || !r.queue[k]) {
       notes.push_back("allocation: queue of " + r.id + " replayed up to " + plan.order_ids[k] +
                       " only: the order is not known");
+      fleet.Publish(index);
       return false;
     }
     const Order& order = *r.queue[k];
@@ -126,14 +127,18 @@ bool RoundRunner::ReplayQueue(FleetState& fleet, std::size_t index, const RoundR
     }
     const PlanTask task = fleet.TaskOf(picks, order.drop, order.work_time);
     Status assigned = InvalidArgument("no stored waypoints");
-    if (segment.size() >= 2) assigned = fleet.AssignPlanned(index, order.id, task, std::move(segment));
+    // The predictor sees the replayed queue once, at the end (AssignSingle, which routes,
+    // publishes what is there so far).
+    if (segment.size() >= 2) assigned = fleet.AssignPlanned(index, order.id, task, std::move(segment), false);
     if (!assigned.ok()) assigned = fleet.AssignSingle(index, order.id, task);
     if (!assigned.ok()) {
       notes.push_back("allocation: queue of " + r.id + " replayed up to " + order.id + " only: " +
                       assigned.error().message);
+      fleet.Publish(index);
       return false;
     }
   }
+  if (!plan.order_ids.empty()) fleet.Publish(index);
   return true;
 }
 

@@ -80,6 +80,43 @@ TEST_F(FleetStateTest, APlannedTaskMatchesTheRoutedOneWithoutRouting) {
   EXPECT_FALSE(replayed.AssignPlanned(9, "o3", Task("2,0", "0,3"), segment).ok());
 }
 
+// A queue replayed with publish = false is predicted once, at Publish: until then the
+// predictor still sees the plan before the calls, afterwards exactly what publishing every
+// order would have shown.
+TEST_F(FleetStateTest, AQueueReplayedUnpublishedIsPredictedAtPublish) {
+  AllocationConfig c;
+  c.hold_seconds = 100.0;
+  FleetState routed = MakeFleet(map_, routes_, {{"A", Pt(*map_, "0,0"), 0.0}}, c);
+  ASSERT_TRUE(routed.AssignSingle(0, "o1", Task("2,0", "0,3")).ok());
+  const std::size_t first_end = routed.plan(0).waypoints.size();
+  ASSERT_TRUE(routed.AssignSingle(0, "o2", Task("5,0", "5,3", 1.0)).ok());
+  const std::vector<Waypoint>& all = routed.plan(0).waypoints;
+  const std::vector<Waypoint> first(all.begin(), all.begin() + static_cast<std::ptrdiff_t>(first_end));
+  std::vector<Waypoint> second{all[first_end - 1]};
+  second.insert(second.end(), all.begin() + static_cast<std::ptrdiff_t>(first_end), all.end());
+
+  FleetState each = MakeFleet(map_, routes_, {{"A", Pt(*map_, "0,0"), 0.0}}, c);
+  FleetState once = MakeFleet(map_, routes_, {{"A", Pt(*map_, "0,0"), 0.0}}, c);
+  ASSERT_TRUE(each.AssignPlanned(0, "o1", Task("2,0", "0,3"), first).ok());
+  ASSERT_TRUE(each.AssignPlanned(0, "o2", Task("5,0", "5,3", 1.0), second).ok());
+  ASSERT_TRUE(once.AssignPlanned(0, "o1", Task("2,0", "0,3"), first, false).ok());
+  ASSERT_TRUE(once.AssignPlanned(0, "o2", Task("5,0", "5,3", 1.0), second, false).ok());
+  const ZoneId start = once.predictor().ZoneAt(map_->point(Pt(*map_, "0,0")).position);
+  const ZoneId end = once.predictor().ZoneAt(map_->point(Pt(*map_, "5,3")).position);
+  ASSERT_NE(start, end);
+  const double late = each.summary(0).end_time + 10.0;
+  EXPECT_EQ(once.predictor().CountAt(start, late), 1);  // still the robot idle where it stands
+  EXPECT_EQ(once.predictor().CountAt(end, late), 0);
+  once.Publish(0);
+  EXPECT_EQ(once.summary(0).end_time, each.summary(0).end_time);
+  for (double t = 0.0; t <= late; t += 0.25) {
+    for (std::size_t z = 0; z < once.predictor().zone_index()->zones().size(); ++z) {
+      EXPECT_EQ(once.predictor().CountAt(static_cast<ZoneId>(z), t), each.predictor().CountAt(static_cast<ZoneId>(z), t))
+          << "zone " << z << " at " << t;
+    }
+  }
+}
+
 TEST_F(FleetStateTest, SecondTaskStartsWhenTheFirstEnds) {
   FleetState s = MakeFleet(map_, routes_, {{"A", Pt(*map_, "0,0"), 1.0}});
   EXPECT_EQ(s.summary(0).end_time, 1.0);
