@@ -38,13 +38,20 @@ const BookOrder* DispatchCore::order(const std::string& id) const {
 }
 
 const BookRobot* DispatchCore::robot(const std::string& id) const {
-  auto it = robots_.find(id);
-  return it == robots_.end() ? nullptr : &it->second;
+  auto it = robot_index_.find(id);
+  return it == robot_index_.end() ? nullptr : it->second;
 }
 
 BookRobot* DispatchCore::FindRobot(const std::string& id) {
-  auto it = robots_.find(id);
-  return it == robots_.end() ? nullptr : &it->second;
+  auto it = robot_index_.find(id);
+  return it == robot_index_.end() ? nullptr : it->second;
+}
+
+BookRobot& DispatchCore::Book(const std::string& id) {
+  if (BookRobot* r = FindRobot(id)) return *r;
+  BookRobot& r = robots_[id];
+  robot_index_.emplace(id, &r);
+  return r;
 }
 
 bool DispatchCore::TakeAllocationDue() {

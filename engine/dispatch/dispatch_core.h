@@ -30,6 +30,7 @@
 #include <optional>
 #include <set>
 #include <string>
+#include <unordered_map>
 #include <utility>
 #include <vector>
 
@@ -254,6 +255,7 @@ class DispatchCore {
   DispatchCore(std::shared_ptr<const WarehouseMap> map, std::shared_ptr<const RouteTable> routes,
                CoreOptions options);
   BookRobot* FindRobot(const std::string& id);
+  BookRobot& Book(const std::string& id);  // the robot's entry, made (and indexed) if new
   bool Eligible(const BookRobot& r) const;
   PointId StartOf(const BookRobot& r) const;
   RoundKey KeyOf(const BookRobot& r) const;
@@ -273,7 +275,9 @@ class DispatchCore {
   const CoreOptions options_;
   std::unique_ptr<TrafficGate> gate_;  // null without traffic control
   std::map<std::string, BookOrder> orders_;
-  std::map<std::string, BookRobot> robots_;
+  std::map<std::string, BookRobot> robots_;  // never erased: robot_index_ points into it
+  // robots_ by id in one hash lookup (every report and arrival looks its robot up).
+  std::unordered_map<std::string, BookRobot*> robot_index_;
   CoreCounts counts_;
   bool allocation_due_ = false;
 };

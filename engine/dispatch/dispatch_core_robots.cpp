@@ -10,7 +10,7 @@ namespace dispatch::engine {
 
 void DispatchCore::RestoreRobot(Robot robot, std::optional<Assignment> plan, bool place) {
   const std::string id = robot.id;
-  BookRobot& r = robots_[id];
+  BookRobot& r = Book(id);
   r.robot = std::move(robot);
   r.robot.state = RobotState::kOffline;
   r.connected = false;
@@ -33,7 +33,7 @@ void DispatchCore::Place(const std::string& id) {
 
 std::vector<RobotCommand> DispatchCore::Connect(Robot robot, double /*now*/) {
   const std::string id = robot.id;
-  BookRobot& r = robots_[id];
+  BookRobot& r = Book(id);
   r.robot = std::move(robot);
   r.robot.task_queue = r.has_assignment ? r.assignment.order_ids : std::vector<std::string>{};
   r.connected = true;

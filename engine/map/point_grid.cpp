@@ -39,10 +39,11 @@ PointGrid::PointGrid(const std::vector<Point>& points) {
   for (std::size_t i = 0; i < points.size(); ++i) {
     ids_[fill[static_cast<std::size_t>(cell_of[i])]++] = static_cast<PointId>(i);
   }
+  xy_.reserve(ids_.size());
+  for (PointId i : ids_) xy_.push_back(points[static_cast<std::size_t>(i)].position);
 }
 
-bool PointGrid::Nearest(const std::vector<Point>& points, const Eigen::Vector2d& xy, PointId* id,
-                        double* distance) const {
+bool PointGrid::Nearest(const Eigen::Vector2d& xy, PointId* id, double* distance) const {
   if (ids_.empty() || !xy.allFinite()) return false;
   if (xy.x() < lo_.x() || xy.y() < lo_.y() || xy.x() > hi_.x() || xy.y() > hi_.y()) return false;
   const long cx = std::min(cols_ - 1, static_cast<long>((xy.x() - lo_.x()) * inv_cell_));
@@ -54,7 +55,7 @@ bool PointGrid::Nearest(const std::vector<Point>& points, const Eigen::Vector2d&
     const auto c = static_cast<std::size_t>(y * cols_ + x);
     for (std::uint32_t k = begin_[c]; k < begin_[c + 1]; ++k) {
       const PointId i = ids_[k];
-      const double d = (points[static_cast<std::size_t>(i)].position - xy).norm();
+      const double d = (xy_[k] - xy).norm();
       if (d < best || (d == best && i < best_id)) {
         best = d;
         best_id = i;

@@ -24,10 +24,10 @@ class PointGrid {
   PointGrid() = default;
   explicit PointGrid(const std::vector<Point>& points);
 
-  // The nearest of `points` (the vector the grid was built from) to xy and its distance.
-  // False when the grid cannot answer: no points, or xy not finite or outside the points'
-  // bounding box (the caller scans instead).
-  bool Nearest(const std::vector<Point>& points, const Eigen::Vector2d& xy, PointId* id, double* distance) const;
+  // The nearest of the points the grid was built from (it keeps their positions) to xy and
+  // its distance. False when the grid cannot answer: no points, or xy not finite or outside
+  // the points' bounding box (the caller scans instead).
+  bool Nearest(const Eigen::Vector2d& xy, PointId* id, double* distance) const;
 
  private:
   Eigen::Vector2d lo_ = Eigen::Vector2d::Zero(), hi_ = Eigen::Vector2d::Zero();
@@ -35,6 +35,7 @@ class PointGrid {
   long cols_ = 0, rows_ = 0;
   std::vector<std::uint32_t> begin_;  // per cell (row-major), then one past the end
   std::vector<PointId> ids_;          // point ids by cell, ascending within a cell
+  std::vector<Eigen::Vector2d> xy_;   // their positions, side by side (no Point read per query)
 };
 
 }  // namespace dispatch::engine

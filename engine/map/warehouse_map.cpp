@@ -99,7 +99,7 @@ PointId WarehouseMap::NearestPoint(const Eigen::Vector2d& xy, std::optional<Poin
                                    double* distance) const {
   double best = std::numeric_limits<double>::infinity();
   PointId best_id = kNoPoint;
-  if (!kind && point_grid_.Nearest(points_, xy, &best_id, &best)) {
+  if (!kind && point_grid_.Nearest(xy, &best_id, &best)) {
     if (distance) *distance = best;
     return best_id;
   }

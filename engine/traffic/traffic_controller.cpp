@@ -54,6 +54,17 @@ Result<TrafficController> TrafficController::Create(std::shared_ptr<const Wareho
   impl->dist.assign(n, kInf);
   impl->via.assign(n, -1);
   impl->seen.assign(n, 0);
+  impl->point_xy.reserve(n);
+  impl->guard_of.reserve(n);
+  impl->search_begin.assign(1, 0);
+  for (std::size_t p = 0; p < n; ++p) {
+    impl->point_xy.push_back(m.points()[p].position);
+    impl->guard_of.push_back(m.IntersectionOf(static_cast<PointId>(p)));
+    for (ArcId a : m.out_arcs(static_cast<PointId>(p))) {
+      impl->search_arcs.push_back({m.arc(a).to, impl->CorridorOf(a), a, impl->ArcTime(a)});
+    }
+    impl->search_begin.push_back(static_cast<std::uint32_t>(impl->search_arcs.size()));
+  }
   // Clearance neighbours by a uniform grid of cell size point_clearance.
   impl->near.assign(n, {});
   const double cell = config.point_clearance + 2.0 * config.max_envelope;
@@ -126,6 +137,11 @@ std::vector<PointId> TrafficController::RemainingRoute(std::size_t r) const {
   const RobotState& x = impl_->robots.at(r);
   if (x.route.empty()) return {};
   return {x.route.begin() + static_cast<std::ptrdiff_t>(x.pos), x.route.end()};
+}
+bool TrafficController::RemainingRouteIs(std::size_t r, const std::vector<PointId>& route) const {
+  const RobotState& x = impl_->robots.at(r);
+  if (x.route.empty()) return route.empty();
+  return std::equal(x.route.begin() + static_cast<std::ptrdiff_t>(x.pos), x.route.end(), route.begin(), route.end());
 }
 bool TrafficController::HasRoute(std::size_t r) const {
   const RobotState& x = impl_->robots.at(r);

@@ -51,8 +51,8 @@ Detour TrafficController::Impl::Search(const traffic_detail::RouteQuery& q) {
   }
   using Item = std::pair<double, PointId>;
   std::priority_queue<Item, std::vector<Item>, std::greater<>> heap;
-  const Eigen::Vector2d goal = M().point(to).position;
-  auto h = [&](PointId v) { return (M().point(v).position - goal).norm() / config.speed; };
+  const Eigen::Vector2d goal = point_xy[static_cast<std::size_t>(to)];
+  auto h = [&](PointId v) { return (point_xy[static_cast<std::size_t>(v)] - goal).norm() / config.speed; };
   auto relax = [&](PointId v, double d, ArcId a) {
     const auto i = static_cast<std::size_t>(v);
     if (seen[i] == stamp && dist[i] <= d) return;
@@ -73,12 +73,14 @@ Detour TrafficController::Impl::Search(const traffic_detail::RouteQuery& q) {
       found = true;
       break;
     }
-    for (ArcId a : M().out_arcs(u)) {
-      const PointId v = M().arc(a).to;
+    const auto ui = static_cast<std::size_t>(u);
+    for (std::uint32_t k = search_begin[ui]; k < search_begin[ui + 1]; ++k) {
+      const SearchArc& a = search_arcs[k];
+      const PointId v = a.to;
       if (v == ban_point) continue;
-      if (ban_corridor >= 0 && CorridorOf(a) == ban_corridor) continue;
-      if (ban_guard >= 0 && M().IntersectionOf(v) == ban_guard && v != to) continue;
-      relax(v, d + ArcTime(a), a);
+      if (ban_corridor >= 0 && a.corridor == ban_corridor) continue;
+      if (ban_guard >= 0 && guard_of[static_cast<std::size_t>(v)] == ban_guard && v != to) continue;
+      relax(v, d + a.time, a.arc);
     }
   }
   const auto ti = static_cast<std::size_t>(to);

@@ -95,6 +95,19 @@ struct TrafficController::Impl {
   std::vector<RobotState> robots;
   std::unordered_map<std::string, std::size_t> index;
   TrafficStats stats;
+  // The map as Search reads it, in flat arrays (built once in Create): per point its position
+  // and intersection, its out-arcs (in out_arcs order) from search_begin[p] with their end,
+  // corridor and ArcTime.
+  struct SearchArc {
+    PointId to;
+    int corridor;
+    ArcId arc;
+    double time;
+  };
+  std::vector<Eigen::Vector2d> point_xy;
+  std::vector<int> guard_of;
+  std::vector<std::uint32_t> search_begin;  // point_count() + 1 entries
+  std::vector<SearchArc> search_arcs;
   // Dijkstra scratch.
   std::vector<double> dist;
   std::vector<ArcId> via;

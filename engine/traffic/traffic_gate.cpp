@@ -178,7 +178,7 @@ bool GateImpl::IsStop(const Waypoint& w) {
 
 void TrafficGate::Connect(const std::string& robot, const Eigen::Vector2d& xy, PointId point) {
   Impl& s = *impl_;
-  GateBot& b = s.bots[robot];
+  GateBot& b = s.Get(robot);
   b.id = robot;
   b.connected = true;
   b.synced = false;
@@ -205,13 +205,12 @@ void TrafficGate::Connect(const std::string& robot, const Eigen::Vector2d& xy, P
 }
 
 void TrafficGate::Disconnect(const std::string& robot) {
-  auto it = impl_->bots.find(robot);
-  if (it != impl_->bots.end()) it->second.connected = false;
+  if (GateBot* bot = impl_->Find(robot)) bot->connected = false;
 }
 
 void TrafficGate::SetPlan(const std::string& robot, GatePlan plan) {
   Impl& s = *impl_;
-  GateBot& b = s.bots[robot];
+  GateBot& b = s.Get(robot);
   b.id = robot;
   if (plan.order_of.size() != plan.waypoints.size()) plan.order_of.resize(plan.waypoints.size());
   plan.next_sequence = std::max(plan.next_sequence, b.plan.next_sequence);
@@ -224,23 +223,23 @@ void TrafficGate::SetPlan(const std::string& robot, GatePlan plan) {
 
 void TrafficGate::Reached(const std::string& robot, std::uint64_t sequence, double t,
                           const std::optional<Eigen::Vector2d>& xy) {
-  auto it = impl_->bots.find(robot);
-  if (it == impl_->bots.end()) return;
+  GateBot* bot = impl_->Find(robot);
+  if (!bot) return;
   if (xy) {
-    it->second.xy = *xy;
-    it->second.has_xy = true;
+    bot->xy = *xy;
+    bot->has_xy = true;
   }
-  impl_->OnReached(it->second, sequence, t);
+  impl_->OnReached(*bot, sequence, t);
 }
 
 void TrafficGate::Report(const std::string& robot, const Eigen::Vector2d& xy, std::uint64_t last_waypoint,
                          double t) {
-  auto it = impl_->bots.find(robot);
-  if (it == impl_->bots.end()) return;
-  it->second.xy = xy;
-  it->second.has_xy = true;
-  if (last_waypoint > it->second.reached_seq) impl_->OnReached(it->second, last_waypoint, t);
-  it->second.synced = true;
+  GateBot* bot = impl_->Find(robot);
+  if (!bot) return;
+  bot->xy = xy;
+  bot->has_xy = true;
+  if (last_waypoint > bot->reached_seq) impl_->OnReached(*bot, last_waypoint, t);
+  bot->synced = true;
 }
 
 std::vector<GateEffect> TrafficGate::Step(double t) {
@@ -264,7 +263,7 @@ std::vector<GateEffect> TrafficGate::Step(double t) {
   for (auto& [id, b] : s.bots) {
     if (!b.team.empty() || !s.OnFloor(b) || !b.connected || b.leg_stale) continue;
     const auto r = static_cast<std::size_t>(b.ctl);
-    if (s.ctl.Next(r) == kNoPoint && s.ctl.RemainingRoute(r) != b.leg) s.AdoptRoute(b, t, out);
+    if (s.ctl.Next(r) == kNoPoint && !s.ctl.RemainingRouteIs(r, b.leg)) s.AdoptRoute(b, t, out);
   }
   s.StepTeamsAfterDeadlocks(t, out);
   return out;
@@ -275,23 +274,22 @@ void TrafficGate::SampleDistances(double t) { impl_->SampleDistances(t); }
 double TrafficGate::NextWake() const { return impl_->next_wake; }
 
 bool TrafficGate::Available(const std::string& robot) const {
-  auto it = impl_->bots.find(robot);
-  return it == impl_->bots.end() || it->second.team.empty() ||
-         impl_->teams.count(it->second.team) == 0 ||
-         impl_->teams.at(it->second.team).phase != GateTeam::Phase::kLeaving;
+  const GateBot* bot = impl_->Find(robot);
+  return !bot || bot->team.empty() || impl_->teams.count(bot->team) == 0 ||
+         impl_->teams.at(bot->team).phase != GateTeam::Phase::kLeaving;
 }
 
 PointId TrafficGate::StartPoint(const std::string& robot) const {
   const Impl& s = *impl_;
-  auto it = s.bots.find(robot);
-  if (it == s.bots.end() || !it->second.team.empty() || !s.OnFloor(it->second)) return kNoPoint;
-  const auto r = static_cast<std::size_t>(it->second.ctl);
+  const GateBot* bot = s.Find(robot);
+  if (!bot || !bot->team.empty() || !s.OnFloor(*bot)) return kNoPoint;
+  const auto r = static_cast<std::size_t>(bot->ctl);
   return s.ctl.Next(r) != kNoPoint ? s.ctl.Next(r) : s.ctl.At(r);
 }
 
 std::uint64_t TrafficGate::ReleasedUpTo(const std::string& robot) const {
-  auto it = impl_->bots.find(robot);
-  return it == impl_->bots.end() ? 0 : it->second.released;
+  const GateBot* bot = impl_->Find(robot);
+  return bot ? bot->released : 0;
 }
 
 std::string TrafficGate::Describe(const std::string& robot) const {
@@ -345,12 +343,12 @@ std::vector<GateIntersection> TrafficGate::Intersections() const {
 
 GateRobotState TrafficGate::RobotState(const std::string& robot) const {
   GateRobotState state;
-  auto it = impl_->bots.find(robot);
-  if (it == impl_->bots.end()) return state;
-  state.held = it->second.held;
-  if (state.held) state.reason = it->second.hold_reason;
-  state.formation = it->second.team;
-  std::tie(state.team, state.former_team) = impl_->TeamKeys(it->second);
+  const GateBot* bot = impl_->Find(robot);
+  if (!bot) return state;
+  state.held = bot->held;
+  if (state.held) state.reason = bot->hold_reason;
+  state.formation = bot->team;
+  std::tie(state.team, state.former_team) = impl_->TeamKeys(*bot);
   return state;
 }
 

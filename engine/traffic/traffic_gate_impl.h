@@ -93,7 +93,24 @@ struct GateImpl {
   std::shared_ptr<const RouteTable> routes;
   TrafficControllerConfig config;
   TrafficController ctl;
-  std::map<std::string, GateBot> bots;
+  std::map<std::string, GateBot> bots;  // never erased: bot_index points into it
+  std::unordered_map<std::string, GateBot*> bot_index;  // bots by id in one hash lookup
+  GateBot* Find(const std::string& id) {
+    auto it = bot_index.find(id);
+    return it == bot_index.end() ? nullptr : it->second;
+  }
+  const GateBot* Find(const std::string& id) const {
+    auto it = bot_index.find(id);
+    return it == bot_index.end() ? nullptr : it->second;
+  }
+  // The robot's entry, made (and indexed, with its id) if new.
+  GateBot& Get(const std::string& id) {
+    if (GateBot* b = Find(id)) return *b;
+    GateBot& b = bots[id];
+    b.id = id;
+    bot_index.emplace(id, &b);
+    return b;
+  }
   std::map<std::string, GateTeam> teams;  // by formation order id
   std::set<std::string> finished_teams;   // formations that have left their drop point
   std::set<std::string> strays;  // broken-up teams' members not back on the floor (PlaceStrays)

@@ -222,7 +222,7 @@ void GateImpl::StepSolo(GateBot& b, double t, std::vector<GateEffect>& out) {
       b.leg_stale = false;
     }
     if (!ctl.HasRoute(r)) return;
-    if (b.leg_stale || ctl.RemainingRoute(r) != b.leg) {
+    if (b.leg_stale || !ctl.RemainingRouteIs(r, b.leg)) {
       // The controller moves it (a nudge or back-off in deadlock breaking): the plan follows.
       RewriteLeg(b, here, ctl.RemainingRoute(r), -1, t, out);
       b.leg = ctl.RemainingRoute(r);
@@ -245,7 +245,7 @@ void GateImpl::StepSolo(GateBot& b, double t, std::vector<GateEffect>& out) {
       }
       const bool from_plan = here >= 0 && w[static_cast<std::size_t>(here)].point == at;
       // An unchanged leg keeps the robot's place in the grant queues.
-      const bool same = from_plan && leg == ctl.RemainingRoute(r);
+      const bool same = from_plan && ctl.RemainingRouteIs(r, leg);
       if (!same && (!from_plan || !ctl.SetRoute(r, leg).ok())) {
         // The robot is not where its plan continues (restart, reconnect elsewhere, a fresh
         // plan from another point): route from where it stands to the stop.

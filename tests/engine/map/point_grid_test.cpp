@@ -50,7 +50,7 @@ TEST(PointGridTest, AgreesWithAScanInIdOrder) {
         Eigen::Vector2d xy = q % 4 == 0 ? points[rng() % points.size()].position : Eigen::Vector2d(ux(rng), uy(rng));
         PointId id = kNoPoint;
         double d = 0;
-        ASSERT_TRUE(grid.Nearest(points, xy, &id, &d)) << "shape " << shape << " n " << n;
+        ASSERT_TRUE(grid.Nearest(xy, &id, &d)) << "shape " << shape << " n " << n;
         const auto [want, want_d] = Scan(points, xy);
         ASSERT_EQ(id, want) << "shape " << shape << " n " << n << " at " << xy.transpose();
         ASSERT_EQ(d, want_d);
@@ -67,10 +67,10 @@ TEST(PointGridTest, DeclinesWhatItCannotAnswer) {
   const PointGrid grid(points);
   PointId id = kNoPoint;
   double d = 0;
-  EXPECT_FALSE(grid.Nearest(points, {-1, 5}, &id, &d));  // outside the bounding box
-  EXPECT_FALSE(grid.Nearest(points, {std::nan(""), 5}, &id, &d));
-  EXPECT_FALSE(PointGrid().Nearest({}, {0, 0}, &id, &d));
-  ASSERT_TRUE(grid.Nearest(points, {9, 9}, &id, &d));
+  EXPECT_FALSE(grid.Nearest({-1, 5}, &id, &d));  // outside the bounding box
+  EXPECT_FALSE(grid.Nearest({std::nan(""), 5}, &id, &d));
+  EXPECT_FALSE(PointGrid().Nearest({0, 0}, &id, &d));
+  ASSERT_TRUE(grid.Nearest({9, 9}, &id, &d));
   EXPECT_EQ(id, 2);
 }
 

@@ -62,6 +62,11 @@ TEST(TrafficControllerTest, PointsAreExclusive) {
   EXPECT_NE(ctl.why(b).find("held by A"), std::string::npos) << ctl.why(b);
   EXPECT_EQ(ctl.Request(a, 0.0), TrafficDecision::kGo);
   EXPECT_EQ(ctl.Next(a), P(*map, "c2"));
+  // The remaining route starts at the point it stands at (c1, until it arrives at c2).
+  EXPECT_EQ(ctl.RemainingRoute(a), Route(*map, {"c1", "c2", "c3"}));
+  EXPECT_TRUE(ctl.RemainingRouteIs(a, Route(*map, {"c1", "c2", "c3"})));
+  EXPECT_FALSE(ctl.RemainingRouteIs(a, Route(*map, {"c2", "c3"})));
+  EXPECT_FALSE(ctl.RemainingRouteIs(a, {}));
   EXPECT_EQ(ctl.Request(b, 0.1), TrafficDecision::kWait);  // A still holds c1 while driving
   ctl.Arrived(a, 1.0);
   EXPECT_EQ(ctl.Request(b, 1.0), TrafficDecision::kGo);
