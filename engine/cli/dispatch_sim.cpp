@@ -5,7 +5,7 @@
 //   dispatch-sim stream --map chu2024 --robots 18 (--orders FILE... [--repeat N] | --random 200 --seed 1
 //       [--formations 0.2]) [--strategy auction|greedy] [--zeta 100] [--csv series.csv]
 //       [--orders-csv out.csv] [--check-safety] [--journal run.db] [--max-queue N]
-//       [--one-formation-per-pick]
+//       [--one-formation-per-pick] [--trace R1,R2 [--trace-from T] [--trace-to T]]
 //       an order stream with release times (formation orders too) under the online traffic
 //       controller.
 //   dispatch-sim compare [--random 200 --seed 1 --robots 18 --map chu2024]
@@ -21,6 +21,7 @@
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
+#include <limits>
 #include <tuple>
 #include <utility>
 #include <fstream>
@@ -156,6 +157,8 @@ struct StreamArgs {
   std::uint64_t seed = 1;
   double interval = 2.0, zeta = 100.0, dt = 0.1, max_time = 36000.0, formations = 0.0;
   bool check_safety = false, one_formation_per_pick = false;
+  std::vector<std::string> trace;  // robots to trace (core model)
+  double trace_from = 0.0, trace_to = std::numeric_limits<double>::infinity();
   // "core": the service's dispatch core with robots following its messages (core_stream.h);
   // "stream": the order-stream model (order_stream.h).
   std::string model = "core";
@@ -220,6 +223,9 @@ StreamConfig ConfigOf(const StreamArgs& a, const std::string& strategy, double z
   c.allocation.max_queue = a.max_queue;
   c.one_formation_per_pick = a.one_formation_per_pick;
   c.check_safety = a.check_safety;
+  c.trace_robots = a.trace;
+  c.trace_from = a.trace_from;
+  c.trace_to = a.trace_to;
   return c;
 }
 
@@ -263,6 +269,7 @@ void PrintSummary(const std::string& label, const StreamResult& r) {
       std::printf("    %s\n", r.safety->violations[i].Describe().c_str());
     }
   }
+  for (const std::string& line : r.trace) std::printf("  trace: %s\n", line.c_str());
   for (std::size_t i = 0; i < r.too_close.size() && i < 5; ++i) {
     std::printf("  too close: %s\n", r.too_close[i].c_str());
   }
@@ -391,6 +398,11 @@ int Main(int argc, char** argv) {
                 "Allocate a formation only while no other is heading for its first pick (core model)");
     c->add_flag("--check-safety", a.check_safety,
                 "Run CheckSafety over every step (eps1 spacing, crossings in intersections)");
+    c->add_option("--trace", a.trace,
+                  "Robots to trace every step (core model): true position, motion, the gate's view")
+        ->delimiter(',');
+    c->add_option("--trace-from", a.trace_from, "Start of the trace window, s")->capture_default_str();
+    c->add_option("--trace-to", a.trace_to, "End of the trace window, s");
   };
   auto* s = app.add_subcommand("stream", "Order stream under the online traffic controller");
   add_stream(s, stream);

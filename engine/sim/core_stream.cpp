@@ -78,6 +78,7 @@ class CoreRun {
       MoveRobots(t);
       Traffic(t);
       if (config_.check_safety || config_.record_frames) Record(t);
+      if (!config_.trace_robots.empty()) Trace(t);
     }
     out_.steps = step;
     out_.end_time = std::min(t, config_.max_time);
@@ -162,6 +163,7 @@ class CoreRun {
 
   void Traffic(double t) {
     StepOutcome step = core_->Step(t);
+    notes_ = std::move(step.notes);
     Deliver(std::move(step.messages));
     for (const auto& [id, why] : step.blocked) {
       out_.blocked.push_back(id + ": blocked: " + why);
@@ -244,6 +246,27 @@ class CoreRun {
     }
   }
 
+  // StreamConfig::trace_robots: where each traced robot really is and what the gate makes of
+  // it, and the gate's notes, at every step of the window.
+  void Trace(double t) {
+    if (t + kTiny < config_.trace_from || t - kTiny > config_.trace_to) return;
+    char head[96];
+    for (const std::string& n : notes_) {
+      std::snprintf(head, sizeof head, "%.1f s: note: ", t);
+      out_.trace.push_back(head + n);
+    }
+    const TrafficGate* gate = core_->gate();
+    for (const std::string& id : config_.trace_robots) {
+      auto i = index_.find(id);
+      if (i == index_.end()) continue;
+      const WaypointRobot& b = bots_[i->second];
+      std::snprintf(head, sizeof head, "%.1f s: %s at (%.3f, %.3f) %s, reached %llu: ", t, id.c_str(), b.xy().x(),
+                    b.xy().y(), b.working() ? "working" : b.moving() ? "moving" : b.idle() ? "idle" : "waiting",
+                    static_cast<unsigned long long>(b.last_reached()));
+      out_.trace.push_back(head + (gate ? gate->Describe(id) : std::string("no traffic control")));
+    }
+  }
+
   void Summarise() {
     double sum = 0.0;
     for (const StreamOrderOutcome& oc : out_.orders) {
@@ -278,6 +301,7 @@ class CoreRun {
   };
   std::vector<LastReport> reported_;  // each robot's last state report
   std::vector<SafetyFrame> frames_;    // check_safety, record_frames
+  std::vector<std::string> notes_;     // the gate's notes of the current step (Trace)
   std::vector<Order> orders_;  // by release time
   std::size_t next_release_ = 0;
   double next_allocation_ = 0.0;

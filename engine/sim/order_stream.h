@@ -86,6 +86,12 @@ struct StreamConfig {
   bool record_frames = false;
   // SimulateOnCore: CoreOptions::one_formation_per_pick (the stream model ignores it).
   bool one_formation_per_pick = false;
+  // SimulateOnCore: for these robots, every step in [trace_from, trace_to] one line each in
+  // StreamResult::trace (true position, motion state, the gate's view), and the gate's notes
+  // (formations formed, broken up, leaving) of those steps: for debugging traffic.
+  std::vector<std::string> trace_robots;
+  double trace_from = 0.0;
+  double trace_to = std::numeric_limits<double>::infinity();
 };
 
 struct StreamOrderOutcome {
@@ -113,6 +119,7 @@ struct StreamResult {
   // SimulateOnCore: each time the closest pair came nearer than eps1, the two robots' traffic
   // state then (as the service logs it).
   std::vector<std::string> too_close;
+  std::vector<std::string> trace;  // SimulateOnCore, StreamConfig::trace_robots
   std::vector<double> times;          // per step (record_series)
   std::vector<double> min_distance;   // per step, +inf when no pair within distance_cap
   double overall_min_distance = std::numeric_limits<double>::infinity();

@@ -70,7 +70,15 @@ void GateImpl::BecomeFormer(GateBot& b, const std::string& order, PointId at) {
 
 void GateImpl::BreakTeam(GateTeam& team) {
   notes.push_back("formation " + team.order + " broken up");
+  // Where the members stand in their slots (around the point the team agent last stood at):
+  // each stays exempt from its former teammates until it has driven out of the envelope
+  // around it and none of them is still standing there (OnReached), as after a drop. Found by
+  // the core's safety check: a member that reached its next point 0.5 m from the team's point
+  // lost the exemption while a teammate still stood in its slot there, and that teammate,
+  // back on the floor, drove past it at 0.50 m.
+  PointId at = kNoPoint;
   if (TeamAgentOnFloor(team)) {
+    at = ctl.At(static_cast<std::size_t>(team.ctl));
     ctl.Remove(static_cast<std::size_t>(team.ctl));
   }
   if (team.ctl >= 0) team_pool.push_back(static_cast<std::size_t>(team.ctl));
@@ -83,16 +91,16 @@ void GateImpl::BreakTeam(GateTeam& team) {
     if (m.team.empty()) {
       // Not in the team yet: on its way to the rendezvous it was exempt from its teammates
       // (its controller group, TeamKeys) and may stand closer to one than eps1 now. It stays
-      // exempt from them until it has reached its next point, as a member that had joined.
-      // Found by the core's safety check:
-      // two members waiting 0.4 m apart for their rendezvous lost the exemption at once.
-      if (m.approach == team.order) BecomeFormer(m, team.order, kNoPoint);
+      // exempt from them until it has driven off, as a member that had joined. Found by the
+      // core's safety check: two members waiting 0.4 m apart for their rendezvous lost the
+      // exemption at once.
+      if (m.approach == team.order) BecomeFormer(m, team.order, at);
       continue;
     }
     if (m.team != team.order) continue;
     GateBot& b = m;
     b.team.clear();
-    BecomeFormer(b, team.order, kNoPoint);  // broken up on the way: until its next point
+    BecomeFormer(b, team.order, at);
     b.leg_stale = true;
     // It stands in its slot (D_f off the team's point) until it reports elsewhere: back on the
     // floor there at once, by its pose, before anyone is given the points the team agent held
