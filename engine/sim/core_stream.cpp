@@ -238,11 +238,10 @@ class CoreRun {
     const TrafficGate* gate = core_->gate();
     for (const WaypointRobot& b : bots_) {
       const GateRobotState s = gate ? gate->RobotState(b.id()) : GateRobotState{};
-      const std::string& first = s.team.empty() ? s.former_team : s.team;
-      const std::string second = s.team.empty() ? std::string() : s.former_team;
+      auto group = [&](std::size_t k) { return s.teams[k].empty() ? std::string() : "team " + s.teams[k]; };
       frame.robots.push_back({b.id(), s.formation.empty() ? b.id() : "formation " + s.formation,
-                              first.empty() ? b.id() : "team " + first, !s.formation.empty(), b.xy(),
-                              second.empty() ? std::string() : "team " + second});
+                              s.teams[0].empty() ? b.id() : group(0), !s.formation.empty(), b.xy(), group(1),
+                              group(2)});
     }
   }
 

@@ -19,15 +19,22 @@ struct Box {
 // One agent's stay inside one intersection box: frames [first, last].
 struct Visit {
   std::string agent;
-  std::string group, group2;
+  std::string group, group2, group3;
   int intersection = -1;
   std::size_t first = 0, last = 0;
   PointId entry = kNoPoint, exit = kNoPoint;
 };
 
-bool SharesGroup(const std::string& a, const std::string& a2, const std::string& b,
-                 const std::string& b2) {
-  return a == b || (!a2.empty() && (a2 == b || a2 == b2)) || (!b2.empty() && a == b2);
+// True when two robots (or agents' visits) have a group in common ("" is none).
+template <typename A, typename B>
+bool SharesGroup(const A& a, const B& b) {
+  for (const std::string* x : {&a.group, &a.group2, &a.group3}) {
+    if (x->empty()) continue;
+    for (const std::string* y : {&b.group, &b.group2, &b.group3}) {
+      if (*x == *y) return true;
+    }
+  }
+  return false;
 }
 
 PointId NearestInner(const WarehouseMap& map, const Intersection& in, const Eigen::Vector2d& p) {
@@ -68,7 +75,7 @@ SafetyReport CheckSafety(const std::vector<SafetyFrame>& frames, const Warehouse
     std::map<std::pair<std::string, std::string>, std::size_t> still_open;
     for (std::size_t i = 0; i < rs.size(); ++i) {
       for (std::size_t j = i + 1; j < rs.size(); ++j) {
-        if (SharesGroup(rs[i].group, rs[i].group2, rs[j].group, rs[j].group2)) continue;
+        if (SharesGroup(rs[i], rs[j])) continue;
         const double d = (rs[i].xy - rs[j].xy).norm();
         report.min_robot_distance = std::min(report.min_robot_distance, d);
         const double need = config.RobotClearance(rs[i].formation, rs[j].formation);
@@ -112,7 +119,7 @@ SafetyReport CheckSafety(const std::vector<SafetyFrame>& frames, const Warehouse
       e.first += r.xy;
       ++e.second;
       const RobotSample*& g = group_of[r.agent];
-      if (g == nullptr || (g->group2.empty() && !r.group2.empty())) g = &r;  // a second group if any member has one
+      if (g == nullptr || (g->group2.empty() && !r.group2.empty())) g = &r;  // further groups if any member has them
     }
     std::map<std::string, std::size_t> next;
     for (auto& [agent, sum] : refs) {
@@ -130,7 +137,8 @@ SafetyReport CheckSafety(const std::vector<SafetyFrame>& frames, const Warehouse
         next[agent] = it->second;
       } else {
         const PointId p = NearestInner(map, in, ref);
-        visits.push_back({agent, group_of[agent]->group, group_of[agent]->group2, inside, f, f, p, p});
+        const RobotSample& g = *group_of[agent];
+        visits.push_back({agent, g.group, g.group2, g.group3, inside, f, f, p, p});
         next[agent] = visits.size() - 1;
       }
     }
@@ -140,7 +148,7 @@ SafetyReport CheckSafety(const std::vector<SafetyFrame>& frames, const Warehouse
     for (std::size_t j = i + 1; j < visits.size(); ++j) {
       const Visit& a = visits[i];
       const Visit& b = visits[j];
-      if (a.intersection != b.intersection || SharesGroup(a.group, a.group2, b.group, b.group2)) continue;
+      if (a.intersection != b.intersection || SharesGroup(a, b)) continue;
       if (a.last < b.first || b.last < a.first) continue;
       if (a.entry == b.entry && a.exit == b.exit) continue;  // same movement: may share
       // Through the same entry one behind the other (the spacing rule keeps them apart): the

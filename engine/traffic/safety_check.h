@@ -46,9 +46,11 @@ struct RobotSample {
   std::string group;  // robots of one group never violate each other
   bool formation = false;
   Eigen::Vector2d xy = Eigen::Vector2d::Zero();
-  // A second group, or "": a robot that has just left one formation's drop while it already
-  // approaches the next formation's rendezvous is exempt from the members of both.
+  // A second and a third group, or "": a robot that has just left one formation's drop (or
+  // two, in turn) while it already approaches the next formation's rendezvous is exempt from
+  // the members of each.
   std::string group2 = {};
+  std::string group3 = {};
 };
 
 struct SafetyFrame {

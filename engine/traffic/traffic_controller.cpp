@@ -155,9 +155,10 @@ void TrafficController::SetWorking(std::size_t r, bool working, double work_end)
 }
 void TrafficController::SetLoaded(std::size_t r, bool loaded) { impl_->robots.at(r).loaded = loaded; }
 void TrafficController::SetIdle(std::size_t r, bool idle) { impl_->robots.at(r).idle = idle; }
-void TrafficController::SetGroup(std::size_t r, int group, int second) {
+void TrafficController::SetGroup(std::size_t r, int group, int second, int third) {
   impl_->robots.at(r).group = std::max(0, group);
   impl_->robots.at(r).group2 = std::max(0, second);
+  impl_->robots.at(r).group3 = std::max(0, third);
 }
 void TrafficController::SetEnvelope(std::size_t r, double extra) {
   impl_->robots.at(r).envelope = std::clamp(extra, 0.0, impl_->config.max_envelope);

@@ -129,8 +129,9 @@ class TrafficController {
   // Robots sharing a group (> 0; 0 = none), e.g. the members of a formation assembling at
   // its rendezvous or leaving its drop point (Chu2024 §3.2), do not keep point_clearance from
   // one another: a point is still held by one robot at a time, but its near points held by
-  // groupmates do not block. A robot may be in two groups (leaving one team, joining another).
-  void SetGroup(std::size_t r, int group, int second = 0);
+  // groupmates do not block. A robot may be in three groups (leaving one team or two in turn,
+  // joining another).
+  void SetGroup(std::size_t r, int group, int second = 0, int third = 0);
   // Extra clearance of an agent bigger than one robot (a formation: D_f, its members' distance
   // from the centre; clamped to max_envelope). Two agents' points conflict when closer than
   // point_clearance + both envelopes (Chu2024 eqs. (10)-(12): eps1, eps2, eps3).

@@ -30,7 +30,7 @@ struct RobotState {
   std::vector<ArcId> arcs;     // arcs[k]: route[k] -> route[k + 1]
   std::size_t pos = 0;
   bool working = false, loaded = false, removed = false;
-  int group = 0, group2 = 0;  // > 0: robots sharing a group (a formation) may come closer
+  int group = 0, group2 = 0, group3 = 0;  // > 0: robots sharing a group (a formation) may come closer
   double envelope = 0.0;  // extra clearance (a formation's D_f), <= config.max_envelope
   double work_end = 0.0;
   bool idle = true;
@@ -135,8 +135,10 @@ struct TrafficController::Impl {
   }
   // Robots of one formation (a shared group) may come closer than eps1.
   static bool Mates(const RobotState& a, const RobotState& b) {
-    return (a.group > 0 && (b.group == a.group || b.group2 == a.group)) ||
-           (a.group2 > 0 && (b.group == a.group2 || b.group2 == a.group2));
+    for (int g : {a.group, a.group2, a.group3}) {
+      if (g > 0 && (b.group == g || b.group2 == g || b.group3 == g)) return true;
+    }
+    return false;
   }
   std::string Name(PointId p) const { return "'" + M().point(p).name + "'"; }
 

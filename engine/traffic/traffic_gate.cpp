@@ -307,8 +307,11 @@ std::string TrafficGate::Describe(const std::string& robot) const {
   } else {
     out = robot + " (not on the floor)";
   }
-  const auto keys = s.TeamKeys(b);
-  if (!keys.first.empty() || !keys.second.empty()) out += "; team keys " + keys.first + "/" + keys.second;
+  const GateTeamKeys keys = s.TeamKeys(b);
+  if (!keys[0].empty()) {
+    out += "; team keys " + keys[0];
+    for (std::size_t k = 1; k < keys.size() && !keys[k].empty(); ++k) out += "/" + keys[k];
+  }
   out += "; waypoint " + std::to_string(b.idx) + "/" + std::to_string(b.plan.waypoints.size()) +
          ", released " + std::to_string(b.released) + (b.connected ? "" : ", offline");
   return out;
@@ -348,7 +351,7 @@ GateRobotState TrafficGate::RobotState(const std::string& robot) const {
   state.held = bot->held;
   if (state.held) state.reason = bot->hold_reason;
   state.formation = bot->team;
-  std::tie(state.team, state.former_team) = impl_->TeamKeys(*bot);
+  state.teams = impl_->TeamKeys(*bot);
   return state;
 }
 

@@ -37,6 +37,7 @@
 
 #include <Eigen/Core>
 
+#include <array>
 #include <cstdint>
 #include <limits>
 #include <map>
@@ -98,10 +99,10 @@ struct GateRobotState {
   bool held = false;       // a Hold is in force
   std::string reason;      // why, while held
   std::string formation;   // the formation order whose team it is in ("": none)
-  // The formation orders it counts as one with (CheckSafety's groups), at most two: the team it
-  // is in or drives to join, and the teams it left (at a drop, or broken up) until it has
-  // driven off ("": none).
-  std::string team, former_team;
+  // The formation orders it counts as one with (CheckSafety's groups), at most three, distinct,
+  // the set ones first: the team it is in or drives to join, and the teams it left (at a drop,
+  // or broken up; the last two) until it has driven off ("": none).
+  std::array<std::string, 3> teams;
 };
 
 class TrafficGate {

@@ -6,6 +6,7 @@
 #pragma once
 
 #include <algorithm>
+#include <array>
 #include <functional>
 #include <limits>
 #include <optional>
@@ -25,6 +26,10 @@ struct GateTeamSpan {
   PointId rendezvous = kNoPoint;
   std::uint64_t seq_first_pick = 0, seq_drop = 0;
 };
+
+// The formation orders a robot counts as one with (GateImpl::TeamKeys): distinct, the set ones
+// first ("": none).
+using GateTeamKeys = std::array<std::string, 3>;
 
 // One robot as the gate knows it.
 struct GateBot {
@@ -55,7 +60,7 @@ struct GateBot {
   // (a member of two teams in turn at one rendezvous); cleared with former_team.
   std::string older_former;
   std::uint64_t leave_seq = 0;  // leaving a team: the waypoint it was placed at (to reach first)
-  // The team it counted as one with (TeamKeys().first) when its controller group was last set.
+  // The team it counted as one with (TeamKeys()[0]) when its controller groups were last set.
   std::string approach;
   std::vector<PointId> leg;  // the controller route as last set or adopted
   long leg_stop = -1;     // plan index of the leg's last waypoint (-1: none)
@@ -125,7 +130,7 @@ struct GateImpl {
     long long cell;
     std::size_t order;
     const GateBot* bot;
-    mutable std::optional<std::pair<std::string, std::string>> keys;
+    mutable std::optional<GateTeamKeys> keys;
   };
   std::vector<DistanceItem> distance_items;
   Eigen::Vector2d distance_origin = Eigen::Vector2d::Zero();
@@ -174,7 +179,9 @@ struct GateImpl {
   void RequestSolo(GateBot& b, double t, std::vector<GateEffect>& out);
   void AdoptRoute(GateBot& b, double t, std::vector<GateEffect>& out);
   void OnReached(GateBot& b, std::uint64_t seq, double t);
-  std::pair<std::string, std::string> TeamKeys(const GateBot& b) const;
+  GateTeamKeys TeamKeys(const GateBot& b) const;
+  // b's controller groups (and b.approach) from its team keys.
+  void SetGroups(GateBot& b, const GateTeamKeys& keys);
   void SampleDistances(double t);
 
   // Teams (traffic_gate_teams.cpp).

@@ -50,12 +50,7 @@ bool GateImpl::PlaceNear(GateBot& b) {
   if (current && b.idx >= 0 && b.idx < n) candidates.push_back(b.plan.waypoints[static_cast<std::size_t>(b.idx)].point);
   if (current && b.idx + 1 < n) candidates.push_back(b.plan.waypoints[static_cast<std::size_t>(b.idx + 1)].point);
   if (b.has_xy) candidates.push_back(map->NearestPoint(b.xy));
-  if (b.ctl >= 0) {  // teammates (a formation it is in or just left) do not keep it off
-    const auto keys = TeamKeys(b);
-    b.approach = keys.first;
-    ctl.SetGroup(static_cast<std::size_t>(b.ctl), keys.first.empty() ? 0 : GroupOf(keys.first),
-                 keys.second.empty() ? 0 : GroupOf(keys.second));
-  }
+  if (b.ctl >= 0) SetGroups(b, TeamKeys(b));  // teammates (a formation it is in or just left) do not keep it off
   for (PointId p : candidates) {
     if (!PlaceBot(b, p)) continue;
     if (!b.former_team.empty() && !teams.count(b.former_team)) {
@@ -168,9 +163,7 @@ void GateImpl::StepSolo(GateBot& b, double t, std::vector<GateEffect>& out) {
   const auto& w = b.plan.waypoints;
   const long n = static_cast<long>(w.size());
   // On its way to a rendezvous, or leaving one, a member may come closer to its teammates.
-  const auto keys = TeamKeys(b);
-  b.approach = keys.first;
-  ctl.SetGroup(r, keys.first.empty() ? 0 : GroupOf(keys.first), keys.second.empty() ? 0 : GroupOf(keys.second));
+  SetGroups(b, TeamKeys(b));
   const PointId next = ctl.Next(r);
   if (next != kNoPoint) {  // driving: the point behind is released once clear of it
     // Clear of it by eps2 (Chu2024 eq. (11)): a formation may be given the point behind.
@@ -374,31 +367,35 @@ void GateImpl::OnReached(GateBot& b, std::uint64_t seq, double t) {
 
 // The formation orders a robot counts as one agent with: the team it is in or approaches,
 // and the teams it left (at a drop, or broken up) until it (and its teammates) have driven off.
-std::pair<std::string, std::string> GateImpl::TeamKeys(const GateBot& b) const {
-  if (b.team.empty() && b.former_team.empty() && b.plan.teams.empty()) return {};  // a robot alone
-  std::string current = b.team;
-  if (current.empty()) {
+GateTeamKeys GateImpl::TeamKeys(const GateBot& b) const {
+  GateTeamKeys keys;
+  if (b.team.empty() && b.former_team.empty() && b.plan.teams.empty()) return keys;  // a robot alone
+  const std::string* current = &b.team;
+  if (current->empty()) {
     // The waypoint it drives to; before the first one is reached, the first after the anchor
     // (which serves no order).
     const long i = std::min<long>(std::max(b.idx + 1, 1L), static_cast<long>(b.plan.order_of.size()) - 1);
     if (i >= 0) {
       const std::string& o = b.plan.order_of[static_cast<std::size_t>(i)];
-      if (!o.empty() && b.plan.teams.count(o)) current = o;
+      if (!o.empty() && b.plan.teams.count(o)) current = &o;
     }
   }
-  // Two keys at most (the controller's two groups): the first two distinct ones of the team it
-  // is in or approaches, the team it left last and the one before.
-  const std::string* keys[2] = {nullptr, nullptr};
-  for (const std::string* k : {&std::as_const(current), &b.former_team, &b.older_former}) {
-    if (k->empty() || (keys[0] && *keys[0] == *k)) continue;
-    if (!keys[0]) {
-      keys[0] = k;
-    } else {
-      keys[1] = k;
-      break;
-    }
+  // The distinct ones of the team it is in or approaches, the team it left last and the one
+  // before, in that order. All three count: found by the core's safety check (Table 1 ×5), a
+  // member of two broken-up teams in turn that was given its next formation dropped the older
+  // one and was 0.400 m from a teammate of that team still standing in its slot.
+  std::size_t n = 0;
+  for (const std::string* k : {current, &b.former_team, &b.older_former}) {
+    const auto end = keys.begin() + static_cast<std::ptrdiff_t>(n);
+    if (!k->empty() && std::find(keys.begin(), end, *k) == end) keys[n++] = *k;
   }
-  return {keys[0] ? *keys[0] : std::string(), keys[1] ? *keys[1] : std::string()};
+  return keys;
+}
+
+void GateImpl::SetGroups(GateBot& b, const GateTeamKeys& keys) {
+  b.approach = keys[0];
+  auto group = [](const std::string& k) { return k.empty() ? 0 : GroupOf(k); };
+  ctl.SetGroup(static_cast<std::size_t>(b.ctl), group(keys[0]), group(keys[1]), group(keys[2]));
 }
 
 void GateImpl::SampleDistances(double t) {
@@ -428,15 +425,14 @@ void GateImpl::SampleDistances(double t) {
     }
     return cy * static_cast<long long>(distance_cols) + cx;
   };
-  auto keys_of = [this](const Item& i) -> const std::pair<std::string, std::string>& {
+  auto keys_of = [this](const Item& i) -> const GateTeamKeys& {
     if (!i.keys) i.keys = TeamKeys(*i.bot);
     return *i.keys;
   };
   auto same_agent = [&](const Item& a, const Item& b) {
-    const auto& ka = keys_of(a);
-    const auto& kb = keys_of(b);
-    for (const std::string* x : {&ka.first, &ka.second}) {
-      if (!x->empty() && (*x == kb.first || *x == kb.second)) return true;
+    const GateTeamKeys& kb = keys_of(b);
+    for (const std::string& x : keys_of(a)) {
+      if (!x.empty() && std::find(kb.begin(), kb.end(), x) != kb.end()) return true;
     }
     return false;
   };

@@ -60,6 +60,26 @@ TEST_F(SafetyCheckTest, FormationMembersAreExemptFromEachOther) {
   EXPECT_EQ(r.violations[0].a, "R1");
 }
 
+// A robot may be in up to three groups (the team it approaches, the last two it left): it is
+// exempt from the members of each, and only of those.
+TEST_F(SafetyCheckTest, AnyOfThreeGroupsExempts) {
+  RobotSample a = Single("R1", {0, 0});
+  a.group = "team A";
+  a.group2 = "team B";
+  a.group3 = "team C";
+  RobotSample b = Single("R2", {0.4, 0});
+  for (const char* g : {"team A", "team B", "team C"}) {
+    b.group = "R2";
+    b.group3 = g;
+    EXPECT_TRUE(CheckSafety({{0.0, {a, b}}}, *map_, config_).ok()) << g;
+    b.group3.clear();
+    b.group = g;
+    EXPECT_TRUE(CheckSafety({{0.0, {a, b}}}, *map_, config_).ok()) << g;
+  }
+  b.group = "team D";
+  EXPECT_EQ(CheckSafety({{0.0, {a, b}}}, *map_, config_).violations.size(), 1u);
+}
+
 TEST_F(SafetyCheckTest, FindsCrossingMovementsInsideOneIntersection) {
   // Two robots on opposite edges of one I_w (1.5 m apart: no spacing problem) with
   // different movements at the same time.

@@ -100,15 +100,19 @@ TEST(TrafficControllerWorkAheadTest, DoesNotEnterAnAisleBeforeLongWorkButQueuesB
 }
 
 TEST(TrafficControllerWorkAheadTest, AFormationMateMayDriveUpToItsTeam) {
-  Floor f;
-  const std::size_t k = *f.ctl.AddRobot("K", P(*f.map, "A3"));
-  f.ctl.SetIdle(k, false);
-  f.ctl.SetWorking(k, true, 3600.0);
-  f.ctl.SetGroup(k, 7);
-  const std::size_t r = *f.ctl.AddRobot("R", P(*f.map, "W"));
-  f.ctl.SetGroup(r, 7);
-  ASSERT_TRUE(f.ctl.SetRoute(r, Route(*f.map, {"W", "C1", "C2", "A1", "A2", "A3"})).ok());
-  EXPECT_EQ(f.ctl.Request(r, 0.0), TrafficDecision::kGo) << f.ctl.why(r);
+  // The mate shares the team's group as its first, second or third group.
+  for (int slot = 0; slot < 3; ++slot) {
+    SCOPED_TRACE(slot);
+    Floor f;
+    const std::size_t k = *f.ctl.AddRobot("K", P(*f.map, "A3"));
+    f.ctl.SetIdle(k, false);
+    f.ctl.SetWorking(k, true, 3600.0);
+    f.ctl.SetGroup(k, 7);
+    const std::size_t r = *f.ctl.AddRobot("R", P(*f.map, "W"));
+    f.ctl.SetGroup(r, slot == 0 ? 7 : 3, slot == 1 ? 7 : 5, slot == 2 ? 7 : 9);
+    ASSERT_TRUE(f.ctl.SetRoute(r, Route(*f.map, {"W", "C1", "C2", "A1", "A2", "A3"})).ok());
+    EXPECT_EQ(f.ctl.Request(r, 0.0), TrafficDecision::kGo) << f.ctl.why(r);
+  }
 }
 
 }  // namespace
