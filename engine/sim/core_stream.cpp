@@ -230,8 +230,10 @@ class CoreRun {
   }
 
   // Where every robot really is (not where the gate believes it is), tagged with what the
-  // gate makes of it: a formation member moves with its team's agent, and is exempt from its
-  // teammates from the approach to its slot until it has driven off after the drop.
+  // gate makes of it: a formation member moves with its team's agent once that agent stands
+  // for it in the controller (not while it still drives to its slot on its own agent), and is
+  // exempt from its teammates from the approach to its slot until it has driven off after the
+  // drop.
   void Record(double t) {
     SafetyFrame& frame = frames_.emplace_back();
     frame.t = t;
@@ -239,9 +241,8 @@ class CoreRun {
     for (const WaypointRobot& b : bots_) {
       const GateRobotState s = gate ? gate->RobotState(b.id()) : GateRobotState{};
       auto group = [&](std::size_t k) { return s.teams[k].empty() ? std::string() : "team " + s.teams[k]; };
-      frame.robots.push_back({b.id(), s.formation.empty() ? b.id() : "formation " + s.formation,
-                              s.teams[0].empty() ? b.id() : group(0), !s.formation.empty(), b.xy(), group(1),
-                              group(2)});
+      frame.robots.push_back({b.id(), s.moved_by_team ? "formation " + s.formation : b.id(),
+                              s.teams[0].empty() ? b.id() : group(0), s.moved_by_team, b.xy(), group(1), group(2)});
     }
   }
 

@@ -34,6 +34,18 @@ Status IntersectionGrants::Request(std::size_t guard, const GrantRequest& reques
   return Ok{};
 }
 
+Status IntersectionGrants::Occupy(std::size_t guard, const std::string& agent) {
+  if (guard >= guards_.size()) return NotFound("grant occupy: unknown guard");
+  if (agent.empty()) return InvalidArgument("grant occupy: empty agent id");
+  Guard& g = guards_[guard];
+  auto same = [&](const GrantRequest& r) { return r.agent == agent; };
+  if (std::any_of(g.holders.begin(), g.holders.end(), same)) return Ok{};
+  g.queue.erase(std::remove_if(g.queue.begin(), g.queue.end(), same), g.queue.end());
+  g.holders.push_back({agent, Movement{}, 0.0, 0});
+  Promote(g);  // the head may share the occupier's movement
+  return Ok{};
+}
+
 void IntersectionGrants::Promote(Guard& g) {
   while (!g.queue.empty()) {
     const GrantRequest& head = g.queue.front();

@@ -51,6 +51,11 @@ class IntersectionGrants {
   Status Request(std::size_t guard, const GrantRequest& request);
   bool Granted(std::size_t guard, const std::string& agent) const;
   bool Waiting(std::size_t guard, const std::string& agent) const;
+  // An agent found standing inside the guard (placed there: a restart, a formation broken up
+  // on it) holds a grant at once, whatever the holders' movements (it is inside already), with
+  // the movement {kNoPoint, kNoPoint}: no crossing movement is granted until it has left. A
+  // request it had queued is withdrawn. Errors: guard out of range, empty agent id.
+  Status Occupy(std::size_t guard, const std::string& agent);
   // Ends the agent's grant (or withdraws its request) and grants what FIFO then allows.
   // Error when the agent neither holds nor requested it.
   Status Release(std::size_t guard, const std::string& agent);

@@ -124,6 +124,7 @@ Result<std::size_t> TrafficController::AddRobot(const std::string& id, PointId a
   }
   s.holder[static_cast<std::size_t>(at)] = static_cast<int>(r);
   s.index.emplace(id, r);
+  s.OccupyGuard(r);
   return r;
 }
 
@@ -198,6 +199,7 @@ Status TrafficController::Place(std::size_t r, PointId at) {
   x.idle = true;
   s.ClearWait(x);
   s.holder[static_cast<std::size_t>(at)] = static_cast<int>(r);
+  s.OccupyGuard(r);
   return Ok{};
 }
 bool TrafficController::removed(std::size_t r) const { return impl_->robots.at(r).removed; }

@@ -151,6 +151,9 @@ struct TrafficController::Impl {
   void DropCorridor(int c, std::size_t r);
   void ReconcileCorridors(std::size_t r);
   void ReleaseGuard(std::size_t r);
+  // A robot placed on a point of an intersection holds its grant at once (it stands inside:
+  // no crossing movement may be granted around it until it has left).
+  void OccupyGuard(std::size_t r);
   void ClearWait(RobotState& x);
   TrafficDecision Wait(std::size_t r, WaitKind kind, int on, double t, std::string why);
 

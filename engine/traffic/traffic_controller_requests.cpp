@@ -81,6 +81,16 @@ void TrafficController::Impl::ReleaseGuard(std::size_t r) {
   x.granted = false;
 }
 
+void TrafficController::Impl::OccupyGuard(std::size_t r) {
+  RobotState& x = robots[r];
+  const int g = config.intersection_grants ? M().IntersectionOf(x.at) : -1;
+  if (g < 0 || (x.guard == g && x.granted)) return;
+  ReleaseGuard(r);
+  (void)grants.Occupy(static_cast<std::size_t>(g), x.id);
+  x.guard = g;
+  x.granted = true;
+}
+
 void TrafficController::Impl::ClearWait(RobotState& x) {
   x.wait = WaitKind::kNone;
   x.waits_on = -1;

@@ -351,6 +351,7 @@ GateRobotState TrafficGate::RobotState(const std::string& robot) const {
   state.held = bot->held;
   if (state.held) state.reason = bot->hold_reason;
   state.formation = bot->team;
+  state.moved_by_team = !bot->team.empty() && !impl_->OnFloor(*bot);
   state.teams = impl_->TeamKeys(*bot);
   return state;
 }

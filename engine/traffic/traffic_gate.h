@@ -99,6 +99,9 @@ struct GateRobotState {
   bool held = false;       // a Hold is in force
   std::string reason;      // why, while held
   std::string formation;   // the formation order whose team it is in ("": none)
+  // The team's agent stands for it in the controller: false while a member that has joined
+  // still drives on its own agent to its slot (until clear of the point it joined from).
+  bool moved_by_team = false;
   // The formation orders it counts as one with (CheckSafety's groups), at most three, distinct,
   // the set ones first: the team it is in or drives to join, and the teams it left (at a drop,
   // or broken up; the last two) until it has driven off ("": none).

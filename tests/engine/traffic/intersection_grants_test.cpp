@@ -101,6 +101,28 @@ TEST(IntersectionGrantsTest, FormationHoldsOneGrantAsOneAgent) {
   EXPECT_TRUE(g.Granted(0, "R4"));
 }
 
+// An agent found inside (placed there) holds a grant at once, even beside a holder of another
+// movement, withdraws its own queued request, and keeps crossing movements out until it
+// releases.
+TEST(IntersectionGrantsTest, AnAgentFoundInsideHoldsAGrantAtOnce) {
+  IntersectionGrants g(1);
+  ASSERT_TRUE(g.Request(0, Req("R1", kEast, 1.0)).ok());
+  ASSERT_TRUE(g.Request(0, Req("R2", kNorth, 2.0)).ok());
+  ASSERT_TRUE(g.Occupy(0, "R2").ok());
+  EXPECT_TRUE(g.Granted(0, "R1"));
+  EXPECT_TRUE(g.Granted(0, "R2"));
+  EXPECT_TRUE(g.Queue(0).empty());
+  ASSERT_TRUE(g.Occupy(0, "R2").ok());  // idempotent
+  EXPECT_EQ(g.Holders(0), (std::vector<std::string>{"R1", "R2"}));
+  ASSERT_TRUE(g.Release(0, "R1").ok());
+  ASSERT_TRUE(g.Request(0, Req("R3", kWest, 3.0)).ok());
+  EXPECT_FALSE(g.Granted(0, "R3"));  // R2 is still inside
+  ASSERT_TRUE(g.Release(0, "R2").ok());
+  EXPECT_TRUE(g.Granted(0, "R3"));
+  EXPECT_FALSE(g.Occupy(1, "R4").ok());
+  EXPECT_FALSE(g.Occupy(0, "").ok());
+}
+
 TEST(IntersectionGrantsTest, ErrorsAreValues) {
   IntersectionGrants g(1);
   EXPECT_EQ(g.Request(1, Req("R1", kEast, 0.0)).error().code, ErrorCode::kNotFound);

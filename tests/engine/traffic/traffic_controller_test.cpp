@@ -224,6 +224,27 @@ TEST(TrafficControllerTest, IntersectionNeedsAGrantAndReleasesItBehind) {
   ctl.Arrived(a, 3.0);                                     // A has left I_w
   EXPECT_EQ(ctl.Request(c, 3.0), TrafficDecision::kGo);
   EXPECT_EQ(ctl.stats().grants, 2u);
+
+  // A robot placed on a point inside I_w (a restart, a formation broken up there) holds the
+  // grant from then on: nobody crosses around it until it has left.
+  TrafficController again = Make(map);
+  const std::size_t d = *again.AddRobot("D", P(*map, "C1"));
+  const std::size_t s = *again.AddRobot("S", P(*map, "S"));
+  ASSERT_TRUE(again.SetRoute(s, Route(*map, {"S", "C2", "N"})).ok());
+  EXPECT_EQ(again.Request(s, 0.0), TrafficDecision::kWait);
+  EXPECT_NE(again.why(s).find("grant"), std::string::npos) << again.why(s);
+  EXPECT_EQ(again.grants().Holders(0), std::vector<std::string>{"D"});
+  ASSERT_TRUE(again.SetRoute(d, Route(*map, {"C1", "C2", "E"})).ok());
+  EXPECT_EQ(again.Request(d, 0.0), TrafficDecision::kGo);  // inside and out: no request
+  again.Arrived(d, 1.0);
+  EXPECT_EQ(again.Request(s, 1.0), TrafficDecision::kWait);  // D still inside, at C2
+  EXPECT_EQ(again.Request(d, 1.0), TrafficDecision::kGo);
+  again.Arrived(d, 2.0);
+  EXPECT_EQ(again.Request(s, 2.0), TrafficDecision::kGo);
+  // The same after Remove and Place (S, granted, has not entered yet).
+  again.Remove(d);
+  ASSERT_TRUE(again.Place(d, P(*map, "C1")).ok());
+  EXPECT_EQ(again.grants().Holders(0), (std::vector<std::string>{"S", "D"}));
 }
 
 TEST(TrafficControllerTest, RejectsBadConfig) {
