@@ -3,23 +3,25 @@
 // (SPEC §4 "Concurrency").
 //
 // One loop thread owns the core, the order views and the robot sessions. API threads never
-// touch them: they post commands (Post) and get the answer through a callback run on the loop
-// thread (gRPC reactors finish from it; REST waits on a future, see Call). The loop publishes
-// an immutable Snapshot (snapshot_builder.h) that reads use without locks: after every batch
-// whose replies, journal events, Welcomes or stream ends announce a change (they go out only
-// after that publish: read-your-writes), otherwise at most every 20 ms while robots report.
+// touch them: they post commands (Post, command_queue.h) and get the answer through a callback
+// run on the loop thread (gRPC reactors finish from it; REST waits on a future, see Call). The
+// loop publishes an immutable Snapshot (snapshot_builder.h) that reads use without locks: after
+// every batch whose replies, journal events, Welcomes or stream ends announce a change (they go
+// out only after that publish: read-your-writes, batch_effects.h), otherwise at most every
+// 20 ms while robots report.
 //
 // Durability: an order is in the Store before SubmitOrder answers OK; every core change (an
 // award with its explanation, a transition, new plans, the robots' reserved message sequences)
 // is stored in one transaction (change_store.h) before the core and the views take it, and a
 // failed write changes nothing. At start the orders, explanations, robots and plans are
-// recovered from the store.
+// recovered from the store (state_recovery.h). Time is dispatcher seconds (dispatch_clock.h).
 //
 // Allocation (dispatcher_allocation.cpp): after a batch in which the core says a round is due,
-// and once the previous round is committed, the core's round inputs go to a worker that runs
-// the strategy (engine::RoundRunner); back on the loop the awards that still hold are
-// committed, a few per loop turn. So traffic control never waits for an auction. New orders'
-// route searches run on another worker before the loop sees the order.
+// and once the previous round is committed (round_schedule.h), the core's round inputs go to
+// the round worker (round_worker.h), which runs the strategy (engine::RoundRunner) off the
+// loop; back on the loop the awards that still hold are committed, a few per loop turn. So
+// traffic control never waits for an auction. New orders' route searches run on another
+// worker before the loop sees the order.
 //
 // Robots (dispatcher_robots.cpp, robot_sessions.h): Hello registers the robot at the map point
 // its pose snaps to; its reports go to the core, the core's messages (plans, Grants, Holds,
@@ -39,13 +41,9 @@
 #pragma once
 
 #include <atomic>
-#include <chrono>
-#include <condition_variable>
-#include <deque>
 #include <functional>
 #include <future>
 #include <memory>
-#include <mutex>
 #include <string>
 #include <thread>
 #include <vector>
@@ -54,12 +52,17 @@
 #include "engine/dispatch/journaled_core.h"
 #include "engine/fleet/order.h"
 #include "engine/routing/route_table.h"
+#include "server/batch_effects.h"
+#include "server/command_queue.h"
 #include "server/core_journal_writer.h"
+#include "server/dispatch_clock.h"
 #include "server/metrics.h"
 #include "server/order_views.h"
 #include "server/restart_wait.h"
 #include "server/robot_link.h"
 #include "server/robot_sessions.h"
+#include "server/round_schedule.h"
+#include "server/round_worker.h"
 #include "server/service_status.h"
 #include "server/snapshot.h"
 #include "server/watch_hub.h"
@@ -162,7 +165,7 @@ class Dispatcher {
                                                                 bool explain) const;
 
   // Runs `fn` on the loop thread.
-  void Post(std::function<void()> fn);
+  void Post(std::function<void()> fn) { queue_.Post(std::move(fn)); }
   // Runs `fn` on the loop thread and waits for its result (for threads that may block,
   // e.g. REST handlers).
   template <class T>
@@ -175,13 +178,6 @@ class Dispatcher {
 
  private:
   using Clock = RobotSession::Clock;
-  // An allocation round on its way into the store: the core's commit, and per award the
-  // explanation as the journal keeps it.
-  struct ServerRound {
-    engine::RoundCommit commit;
-    std::vector<AllocationRecord> records;
-    std::vector<std::string> details;  // AllocationDetail(records[i]), made on the worker
-  };
 
   Dispatcher(std::shared_ptr<const engine::WarehouseMap> map,
              std::shared_ptr<const engine::RouteTable> routes, storage::Store& store,
@@ -189,7 +185,7 @@ class Dispatcher {
              std::unique_ptr<engine::JournaledCore> core);
   engine::Status Recover();
   void Loop();
-  double Now() const;
+  double Now() const { return clock_.Now(); }
 
   // Orders (dispatcher_orders.cpp).
   void DoSubmit(const engine::OrderRequest& request, const std::function<void(SubmitReply)>& done);
@@ -210,16 +206,16 @@ class Dispatcher {
   // Publishes a committed journal event to the watchers (deferred, see Defer).
   void Journal(const storage::OrderEvent& event);
   // Runs `effect` at the end of this batch; with `after_publish` only once the snapshot
-  // holding the batch's changes is published: replies, journal events, Welcomes and stream
-  // ends leave the loop only once the state they announce is readable. Robot plans, grants and
-  // holds need no snapshot and do not force one (see Flush).
-  void Defer(std::function<void()> effect, bool after_publish = true);
+  // holding the batch's changes is published (replies, journal events, Welcomes and stream
+  // ends). Robot plans, grants and holds need no snapshot and do not force one.
+  void Defer(std::function<void()> effect, bool after_publish = true) {
+    effects_.Defer(std::move(effect), after_publish);
+  }
   void CloseLink(const std::shared_ptr<RobotLink>& link, ServiceStatus status);
 
   // Allocation rounds (dispatcher_allocation.cpp): the core's round inputs, run by the
-  // RoundRunner on the allocation worker, committed back a few awards per loop turn.
+  // round worker, committed back a few awards per loop turn.
   void AllocatePending();
-  std::shared_ptr<ServerRound> RunRound(const engine::RoundInput& input);
   void CommitNext(std::shared_ptr<ServerRound> round);
 
   // Robots (dispatcher_robots.cpp).
@@ -255,38 +251,24 @@ class Dispatcher {
   const DispatcherOptions options_;
   WatchHub hub_;
 
-  // Command queue: guarded by queue_mu_.
-  std::mutex queue_mu_;
-  std::condition_variable queue_cv_;
-  std::deque<std::function<void()>> queue_;
-  bool stopping_ = false;
+  CommandQueue queue_;  // thread-safe
   std::thread thread_;
   std::atomic<bool> started_{false};
 
   std::shared_ptr<const Snapshot> snapshot_;  // atomic_load / atomic_store only
 
-  // Allocation worker state (only rounds on allocation_worker_ touch it).
-  std::unique_ptr<engine::RoundRunner> rounds_;
   // Loop-thread state (no lock: only the loop touches it after Start).
   std::unique_ptr<engine::JournaledCore> core_;  // the dispatch book and its rules, journaled
-  Clock::time_point wall_start_;
-  double time_base_ = 0.0;  // dispatcher seconds at wall_start_
+  DispatchClock clock_;
   OrderViews book_;  // every open order and the newest finished ones, as operators read them
   RobotSessions sessions_;  // every robot the core knows, and their streams
   std::int64_t last_order_number_ = 0;
   std::uint64_t snapshot_version_ = 0;
-  bool dirty_ = true;
-  std::vector<std::function<void()>> deferred_;  // effects of the current batch
-  bool deferred_need_publish_ = false;            // one of them waits for the snapshot
-  static constexpr std::chrono::milliseconds kPublishEvery{20};
+  BatchEffects effects_;  // the batch's deferred effects; whether the snapshot is stale
   // Finished orders beyond finished_retained before Retire trims (one rebuild of the book's
   // indexes per this many finishes, not one per finish).
   static constexpr std::size_t kRetireSlack = 64;
-  Clock::time_point last_publish_{};
-  bool retry_allocation_ = false;  // a store failure left work for the next tick
-  bool allocation_due_ = false;  // an allocation round runs at the end of this batch
-  bool round_running_ = false;   // a round is on the worker or waits to be committed
-  bool round_again_ = false;     // a round became due meanwhile
+  RoundSchedule rounds_due_;  // when the next allocation round runs
   engine::MinDistance min_distance_;
   Clock::time_point next_distance_sample_{};
   RestartWait restart_wait_;  // see the top, "Restart"
@@ -294,7 +276,7 @@ class Dispatcher {
   // Route searches of new orders (SubmitOrder) and allocation rounds: off the loop thread.
   // Stopped first (Stop, destructor): what they still hold reaches the loop's queue.
   std::unique_ptr<WorkerThread> route_worker_;
-  std::unique_ptr<WorkerThread> allocation_worker_;
+  RoundWorker round_worker_;
   // Journal writes (options_.journal), in batch order; stopped last. Null: no journal.
   std::unique_ptr<CoreJournalWriter> journal_writer_;
 };

@@ -32,7 +32,7 @@ bool Dispatcher::Commit(const engine::Change& change, const ServerRound* round, 
   }
   for (const auto& e : *events) Journal(e);
   Send(std::move(commands));
-  dirty_ = true;
+  effects_.MarkChanged();
   return true;
 }
 

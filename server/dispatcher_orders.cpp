@@ -95,7 +95,7 @@ void Dispatcher::DoSubmit(const engine::OrderRequest& request,
   }
   ++last_order_number_;
   book_.Put(view);
-  dirty_ = true;
+  effects_.MarkChanged();
   core_->AddOrder(std::move(order));
   reply.order = view;
   reply.created = inserted->created;

@@ -40,7 +40,7 @@ void Dispatcher::DoRobotMessage(const std::shared_ptr<RobotLink>& link, const Ro
   RobotSession& s = *session;
   s.last_heard = Clock::now();
   s.last_seen = Now();
-  dirty_ = true;
+  effects_.MarkChanged();
   switch (m.kind) {
     case RobotInbound::Kind::kState: {
       engine::ReportOutcome report = core_->Report(id, m.pose, m.arc_id, m.state, m.battery, m.sequence, Now());
@@ -102,7 +102,7 @@ void Dispatcher::DoHello(const std::shared_ptr<RobotLink>& link, const RobotInbo
   sessions_.Attach(id, link);
   s.last_heard = Clock::now();
   s.offline_since.reset();
-  dirty_ = true;
+  effects_.MarkChanged();
   std::vector<engine::RobotCommand> plan = core_->Connect(record.robot, Now());
   RobotOutbound welcome;
   welcome.kind = RobotOutbound::Kind::kWelcome;
@@ -125,7 +125,7 @@ void Dispatcher::Progressed(const std::string& id, engine::ReportOutcome outcome
 
 void Dispatcher::Implausible(const std::string& id, const std::string& what, const std::string& why) {
   ++implausible_;
-  dirty_ = true;
+  effects_.MarkChanged();
   spdlog::warn("robot {}: '{}' not taken: {}", id, what, why);
 }
 
@@ -148,7 +148,7 @@ void Dispatcher::MarkOffline(const std::string& id, const std::string& why) {
   RobotSession& s = sessions_.Get(id);
   if (auto link = sessions_.Detach(id)) CloseLink(link, MakeStatus(StatusCode::kUnavailable, why));
   s.offline_since = Clock::now();
-  dirty_ = true;
+  effects_.MarkChanged();
   core_->Disconnect(id);
   if (auto saved = store_.UpsertRobot(RecordOf(id)); !saved.ok()) {
     spdlog::warn("robot {} offline state not stored: {}", id, saved.error().message);
@@ -167,7 +167,7 @@ void Dispatcher::DoRobotGone(const std::shared_ptr<RobotLink>& link) {
 bool Dispatcher::LoseRobot(const std::string& id, const std::string& why) {
   const engine::Change change = core_->PlanLoss(id, why, Now());
   if (!Commit(change, nullptr)) {
-    retry_allocation_ = true;  // tried again on the next tick
+    rounds_due_.Retry();  // tried again on the next tick
     return false;
   }
   return true;
@@ -192,7 +192,7 @@ void Dispatcher::Tick() {
       s.offline_since.reset();
     }
   }
-  if (retry_allocation_) allocation_due_ = true;
+  rounds_due_.Tick();
 }
 
 }  // namespace dispatch::server

@@ -32,7 +32,7 @@ void Dispatcher::EndRecoveryWait(bool timed_out) {
     spdlog::info("every robot that was on line before the restart has reported: traffic control resumes");
   }
   restart_wait_.End();
-  dirty_ = true;
+  effects_.MarkChanged();
 }
 
 void Dispatcher::StepTraffic() {
@@ -44,7 +44,7 @@ void Dispatcher::StepTraffic() {
   }
   const double now = Now();
   engine::StepOutcome step = core_->Step(now);
-  if (!step.messages.empty()) dirty_ = true;  // the snapshot shows grants and holds
+  if (!step.messages.empty()) effects_.MarkChanged();  // the snapshot shows grants and holds
   for (auto& c : step.messages) {
     RobotSession* session = sessions_.Find(c.robot);
     if (!session) continue;
@@ -69,7 +69,7 @@ void Dispatcher::StepTraffic() {
   for (const auto& [id, why] : step.blocked) {
     spdlog::warn("robot {} blocked: {} ({})", id, why, gate->Describe(id));
     for (const auto& [other, r] : core_->robots()) spdlog::debug("traffic: {}", gate->Describe(other));
-    dirty_ = true;
+    effects_.MarkChanged();
     LoseRobot(id, "robot " + id + " blocked: " + why);
   }
   for (const std::string& note : step.notes) spdlog::info("{}", note);
@@ -84,7 +84,7 @@ void Dispatcher::StepTraffic() {
                    gate->Describe(d.a), gate->Describe(d.b));
     }
     min_distance_ = d;
-    dirty_ = true;
+    effects_.MarkChanged();
   }
 }
 

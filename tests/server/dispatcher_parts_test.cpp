@@ -1,19 +1,32 @@
 // The dispatcher's parts on their own: robot sessions and what a Hello makes of a robot's
 // record (server/robot_sessions.h), the core journal's writer (server/core_journal_writer.h),
-// and what a core change stores (server/change_store.h).
+// what a core change stores (server/change_store.h), the loop's bookkeeping (command_queue.h,
+// batch_effects.h, dispatch_clock.h, round_schedule.h), the round worker (round_worker.h) and
+// recovery at start-up (state_recovery.h).
 #include <gtest/gtest.h>
 
+#include <future>
 #include <memory>
+#include <set>
 #include <string>
+#include <thread>
 #include <vector>
 
-#include "engine/map/chu2024_floor.h"
-#include "engine/routing/route_table.h"
+#include "engine/dispatch/strategy.h"
+#include "server/batch_effects.h"
 #include "server/change_store.h"
+#include "server/command_queue.h"
 #include "server/core_journal_writer.h"
+#include "server/dispatch_clock.h"
+#include "server/explanation.h"
+#include "server/json_convert.h"
 #include "server/restart_wait.h"
 #include "server/robot_sessions.h"
+#include "server/round_schedule.h"
+#include "server/round_worker.h"
+#include "server/state_recovery.h"
 #include "storage/sqlite_store.h"
+#include "tests/engine/dispatch/dispatch_test_support.h"
 #include "tests/server/test_support.h"
 
 namespace dispatch::server {
@@ -101,13 +114,13 @@ TEST(RestartWaitTest, EndsWithTheLastAwaitedReportOrAtItsDeadline) {
   EXPECT_EQ(wait.List(), "");
 }
 
+using engine::testing_util::Chu2024;
+using engine::testing_util::Chu2024Routes;
+using engine::testing_util::PointsOfKind;
+
+// A dispatch core on the Chu2024 floor (with traffic control) that journals every call.
 std::unique_ptr<engine::JournaledCore> RecordingCore() {
-  auto built = engine::BuildChu2024Floor();
-  if (!built.ok()) throw std::runtime_error(built.error().message);
-  auto map = std::make_shared<const engine::WarehouseMap>(std::move(built).value());
-  auto routes = engine::MakeRouteTable(map, {});
-  if (!routes.ok()) throw std::runtime_error(routes.error().message);
-  auto core = engine::DispatchCore::Create(map, std::move(routes).value(), {});
+  auto core = engine::DispatchCore::Create(Chu2024(), Chu2024Routes(), {});
   if (!core.ok()) throw std::runtime_error(core.error().message);
   return std::make_unique<engine::JournaledCore>(std::move(core).value(), true);
 }
@@ -221,6 +234,283 @@ TEST(ChangeStoreTest, AChangeIsStoredWholeOrNotAtAll) {
   robots = (*store)->ListRobots();
   ASSERT_TRUE(robots.ok());
   EXPECT_EQ(robots->front().robot.task_queue, std::vector<std::string>{order.id});
+}
+
+TEST(CommandQueueTest, ABatchIsEverythingQueuedInOrderAndSaysWhenTheQueueStopped) {
+  using Clock = CommandQueue::Clock;
+  CommandQueue queue;
+  // Nothing queued: Take returns at its wake time, empty.
+  CommandQueue::Batch idle = queue.Take(Clock::now() + std::chrono::milliseconds(1));
+  EXPECT_TRUE(idle.commands.empty());
+  EXPECT_FALSE(idle.stopping);
+  std::vector<int> ran;
+  for (int i = 0; i < 3; ++i) queue.Post([&ran, i] { ran.push_back(i); });
+  CommandQueue::Batch batch = queue.Take(Clock::now() + std::chrono::hours(1));  // returns at once
+  ASSERT_EQ(batch.commands.size(), 3u);
+  for (auto& command : batch.commands) command();
+  EXPECT_EQ(ran, (std::vector<int>{0, 1, 2}));
+  EXPECT_TRUE(queue.empty());
+  // A command posted from another thread wakes a Take that would wait an hour.
+  std::thread poster([&queue] { queue.Post([] {}); });
+  EXPECT_EQ(queue.Take(Clock::now() + std::chrono::hours(1)).commands.size(), 1u);
+  poster.join();
+  // Stopped: Take returns at once, and what is posted later is still taken.
+  queue.Stop();
+  EXPECT_TRUE(queue.stopping());
+  EXPECT_TRUE(queue.Take(Clock::now() + std::chrono::hours(1)).stopping);
+  queue.Post([] {});
+  EXPECT_FALSE(queue.empty());
+  CommandQueue::Batch last = queue.Take(Clock::now() + std::chrono::hours(1));
+  EXPECT_EQ(last.commands.size(), 1u);
+  EXPECT_TRUE(last.stopping);
+}
+
+TEST(BatchEffectsTest, AnnouncementsWaitForThePublishAndRobotMessagesDoNotForceOne) {
+  using Clock = BatchEffects::Clock;
+  const Clock::time_point t0 = Clock::now();
+  BatchEffects effects;
+  EXPECT_TRUE(effects.PublishDue(t0));  // nothing published yet
+  effects.Published(t0);
+  EXPECT_FALSE(effects.changed());
+  EXPECT_FALSE(effects.PublishDue(t0 + std::chrono::hours(1)));  // nothing changed
+  EXPECT_EQ(effects.WakeBy(t0 + std::chrono::seconds(1)), t0 + std::chrono::seconds(1));
+  // A robot report changed the state and a grant goes out: the snapshot waits for kPublishEvery.
+  std::vector<std::string> out;
+  effects.MarkChanged();
+  effects.Defer([&out] { out.push_back("grant"); }, /*after_publish=*/false);
+  EXPECT_FALSE(effects.PublishDue(t0 + std::chrono::milliseconds(5)));
+  EXPECT_TRUE(effects.PublishDue(t0 + BatchEffects::kPublishEvery));
+  EXPECT_EQ(effects.WakeBy(t0 + std::chrono::seconds(1)), t0 + BatchEffects::kPublishEvery);
+  // A reply announces the change: publish now.
+  effects.Defer([&out] { out.push_back("reply"); }, /*after_publish=*/true);
+  EXPECT_TRUE(effects.PublishDue(t0 + std::chrono::milliseconds(5)));
+  EXPECT_TRUE(out.empty());  // nothing leaves before the end of the batch
+  effects.Published(t0 + std::chrono::milliseconds(5));
+  effects.RunDeferred();
+  EXPECT_EQ(out, (std::vector<std::string>{"grant", "reply"}));
+  // An effect that defers another leaves it for the next batch; the reply waited for is gone.
+  effects.Defer([&] { effects.Defer([&out] { out.push_back("later"); }, false); }, false);
+  effects.RunDeferred();
+  EXPECT_EQ(out.size(), 2u);
+  effects.MarkChanged();
+  EXPECT_FALSE(effects.PublishDue(t0 + std::chrono::milliseconds(6)));
+  effects.RunDeferred();
+  EXPECT_EQ(out.back(), "later");
+}
+
+TEST(DispatchClockTest, GoesOnFromTheStoredTimeAtItsScale) {
+  using Clock = DispatchClock::Clock;
+  const Clock::time_point start{};
+  DispatchClock clock(5.0, start);
+  EXPECT_DOUBLE_EQ(clock.At(start + std::chrono::seconds(2)), 10.0);
+  clock.ContinueFrom(100.0);
+  clock.ContinueFrom(40.0);  // never back
+  EXPECT_DOUBLE_EQ(clock.At(start), 100.0);
+  EXPECT_DOUBLE_EQ(clock.At(start + std::chrono::seconds(2)), 110.0);
+  // Dispatcher second 120 comes 4 wall seconds after the start; one already past comes now.
+  EXPECT_EQ(clock.WallAt(120.0, start), start + std::chrono::seconds(4));
+  EXPECT_EQ(clock.WallAt(90.0, start + std::chrono::seconds(1)), start + std::chrono::seconds(1));
+  EXPECT_EQ(WallDuration(0.25), std::chrono::milliseconds(250));
+}
+
+TEST(RoundScheduleTest, OneRoundAtATimeAndWhatBecameDueMeanwhileRunsAfterIt) {
+  RoundSchedule rounds;
+  EXPECT_FALSE(rounds.due());
+  rounds.MarkDue();
+  ASSERT_TRUE(rounds.Begin());
+  EXPECT_FALSE(rounds.due());
+  rounds.Started();
+  // Due again while the round runs: not now, once it is committed.
+  rounds.MarkDue();
+  EXPECT_FALSE(rounds.Begin());
+  EXPECT_FALSE(rounds.due());
+  rounds.Finished();
+  EXPECT_TRUE(rounds.due());
+  ASSERT_TRUE(rounds.Begin());  // the core had nothing to allocate: no round starts
+  EXPECT_FALSE(rounds.running());
+  rounds.Finished();
+  EXPECT_FALSE(rounds.due());
+  // An award that did not hold: another round after this one.
+  ASSERT_TRUE(rounds.Begin());
+  rounds.Started();
+  rounds.Again();
+  rounds.Finished();
+  EXPECT_TRUE(rounds.due());
+  // A store failure: the next tick makes a round due, until a round begins.
+  ASSERT_TRUE(rounds.Begin());
+  rounds.Retry();
+  rounds.Tick();
+  EXPECT_TRUE(rounds.due());
+  ASSERT_TRUE(rounds.Begin());
+  rounds.Tick();
+  EXPECT_FALSE(rounds.due());
+}
+
+engine::Bid BidOf(const std::string& robot, double value) {
+  engine::Bid bid;
+  bid.robot = robot;
+  bid.bid = value;
+  return bid;
+}
+
+TEST(RoundWorkerTest, ARecordedRoundKeepsTheBestBidsForTheExplanationAndNoneForTheCore) {
+  engine::RoundResult result;
+  engine::RoundAward award;
+  award.order_id = "o1";
+  award.award.order_id = "o1";
+  award.award.winners = {"R40"};
+  for (int i = 1; i <= 40; ++i) award.award.bids.push_back(BidOf("R" + std::to_string(i), 100.0 - i));
+  award.seconds = 0.5;
+  result.awards.push_back(award);
+  engine::AllocationConfig config;
+  const ServerRound round = RecordRound(result, config, 12.0);
+  ASSERT_EQ(round.commit.awards.size(), 1u);
+  EXPECT_TRUE(round.commit.awards[0].award.bids.empty());
+  EXPECT_EQ(round.commit.awards[0].award.winners, std::vector<std::string>{"R40"});
+  EXPECT_EQ(round.commit.awards[0].seconds, 0.5);
+  ASSERT_EQ(round.records.size(), 1u);
+  EXPECT_EQ(round.records[0].award.bids.size(), kExplainedBids);
+  EXPECT_EQ(round.records[0].bids_total, 40u);
+  EXPECT_EQ(round.records[0].time, 12.0);
+  EXPECT_EQ(round.records[0].alpha, config.alpha);
+  ASSERT_EQ(round.details.size(), 1u);
+  EXPECT_EQ(round.details[0], AllocationDetail(round.records[0]));
+}
+
+TEST(RoundWorkerTest, RunsARoundOffTheCallersThreadAndHandsBackRoundsAfterStopCancelled) {
+  const auto& map = *Chu2024();
+  auto allocator = engine::MakeAllocator("auction");
+  ASSERT_TRUE(allocator.ok());
+  engine::AllocationConfig config;
+  RoundWorker worker(std::make_unique<engine::RoundRunner>(Chu2024(), Chu2024Routes(), config,
+                                                           std::move(allocator).value()),
+                     config, 0);
+  engine::RoundInput input;
+  input.now = 7.0;
+  input.robots.push_back({"R1", PointsOfKind(map, engine::PointKind::kPark).at(0), {}, 0, {}});
+  auto order = std::make_shared<engine::Order>(Order("o1"));
+  order->picks = {PointsOfKind(map, engine::PointKind::kPick).at(3)};
+  order->drop = PointsOfKind(map, engine::PointKind::kDrop).at(0);
+  input.pending = {order};
+  engine::RoundCommit keys;
+  keys.origin = 9;
+  keys.keys["R1"].plan_id = 4;
+  struct Handed {
+    std::shared_ptr<ServerRound> round;
+    bool cancelled;
+    std::thread::id thread;
+  };
+  std::promise<Handed> handed;
+  worker.Run(input, keys, [&handed](std::shared_ptr<ServerRound> round, bool cancelled) {
+    handed.set_value({std::move(round), cancelled, std::this_thread::get_id()});
+  });
+  const Handed got = handed.get_future().get();
+  EXPECT_FALSE(got.cancelled);
+  EXPECT_NE(got.thread, std::this_thread::get_id());
+  ASSERT_EQ(got.round->commit.awards.size(), 1u);
+  EXPECT_EQ(got.round->commit.awards[0].award.winners, std::vector<std::string>{"R1"});
+  EXPECT_EQ(got.round->records.size(), 1u);
+  EXPECT_EQ(got.round->commit.origin, 9u);
+  EXPECT_EQ(got.round->commit.keys.at("R1").plan_id, 4u);
+  // After Stop: handed back at once, on this thread, cancelled, with its keys and no awards.
+  worker.Stop();
+  bool ran = false;
+  worker.Run(input, keys, [&ran](std::shared_ptr<ServerRound> round, bool cancelled) {
+    ran = true;
+    EXPECT_TRUE(cancelled);
+    EXPECT_TRUE(round->commit.awards.empty());
+    EXPECT_EQ(round->commit.origin, 9u);
+  });
+  EXPECT_TRUE(ran);
+}
+
+storage::RobotRecord StoredRobot(const std::string& id, engine::RobotState state, engine::PointId point,
+                                 double last_seen) {
+  storage::RobotRecord r;
+  r.robot.id = id;
+  r.robot.state = state;
+  r.robot.current_point = point;
+  r.robot.pose.position = Chu2024()->point(point).position;
+  r.kind = "differential";
+  r.last_seen = last_seen;
+  r.last_acked_sequence = 10;
+  r.next_sequence = 12;
+  return r;
+}
+
+TEST(StateRecoveryTest, RobotsComeBackOfflineWithTheirPlansAndThoseThatWereOnLineAreAwaited) {
+  TempDir dir;
+  auto store = storage::SqliteStore::Open(dir.File("store.db"));
+  ASSERT_TRUE(store.ok()) << store.error().message;
+  ASSERT_TRUE((*store)->InsertOrder(Order("ord-000003")).ok());
+  ASSERT_TRUE((*store)->InsertOrder(Order("ord-000007")).ok());
+  storage::OrderTransition cancel;
+  cancel.order_id = "ord-000003";
+  cancel.to = engine::OrderState::kCancelled;
+  cancel.time = 9.0;
+  cancel.detail = "cancelled by client";
+  ASSERT_TRUE((*store)->TransitionOrder(cancel).ok());
+  const auto parks = PointsOfKind(*Chu2024(), engine::PointKind::kPark);
+  ASSERT_TRUE((*store)->UpsertRobot(StoredRobot("R1", engine::RobotState::kIdle, parks.at(0), 30.0)).ok());
+  ASSERT_TRUE((*store)->UpsertRobot(StoredRobot("R2", engine::RobotState::kOffline, parks.at(6), 5.0)).ok());
+  engine::Assignment plan;
+  plan.robot_id = "R1";
+  plan.plan.robot_id = "R1";
+  plan.order_ids = {"ord-000007"};
+  plan.updated_time = 42.0;
+  ASSERT_TRUE((*store)->SaveAssignment(plan).ok());
+
+  auto core = RecordingCore();
+  OrderViews book(10);
+  RobotSessions sessions;
+  RestartWait wait;
+  auto recovered = RecoverState(**store, /*traffic_control=*/true, book, *core, sessions, wait);
+  ASSERT_TRUE(recovered.ok()) << recovered.error().message;
+  EXPECT_EQ(recovered->latest_time, 42.0);  // the plan's update is the latest time stored
+  EXPECT_EQ(recovered->last_order_number, 7);
+  EXPECT_EQ(book.all().size(), 2u);
+  EXPECT_NE(core->order("ord-000007"), nullptr);
+  EXPECT_EQ(core->order("ord-000003"), nullptr);  // finished: in the views only
+  EXPECT_EQ(wait.awaited(), std::set<std::string>{"R1"});  // R2 was offline already
+  const engine::BookRobot* r1 = core->robot("R1");
+  ASSERT_NE(r1, nullptr);
+  EXPECT_EQ(r1->robot.state, engine::RobotState::kOffline);
+  EXPECT_TRUE(r1->has_assignment);
+  EXPECT_EQ(r1->robot.task_queue, std::vector<std::string>{"ord-000007"});
+  ASSERT_NE(core->robot("R2"), nullptr);
+  EXPECT_FALSE(core->robot("R2")->has_assignment);
+  const RobotSession* s1 = sessions.Find("R1");
+  ASSERT_NE(s1, nullptr);
+  EXPECT_EQ(s1->next_sequence, 12u);
+  EXPECT_EQ(s1->last_acked_sequence, 10u);
+  EXPECT_TRUE(s1->offline_since.has_value());
+  EXPECT_EQ(s1->link, nullptr);
+
+  // Without traffic control nobody is awaited.
+  auto plain = RecordingCore();
+  OrderViews plain_book(10);
+  RobotSessions plain_sessions;
+  RestartWait no_wait;
+  ASSERT_TRUE(RecoverState(**store, false, plain_book, *plain, plain_sessions, no_wait).ok());
+  EXPECT_FALSE(no_wait.waiting());
+  EXPECT_EQ(plain_sessions.size(), 2u);
+}
+
+TEST(StateRecoveryTest, AnEmptyStoreRecoversNothingAtTimeZero) {
+  TempDir dir;
+  auto store = storage::SqliteStore::Open(dir.File("store.db"));
+  ASSERT_TRUE(store.ok()) << store.error().message;
+  auto core = RecordingCore();
+  OrderViews book(10);
+  RobotSessions sessions;
+  RestartWait wait;
+  auto recovered = RecoverState(**store, true, book, *core, sessions, wait);
+  ASSERT_TRUE(recovered.ok()) << recovered.error().message;
+  EXPECT_EQ(recovered->latest_time, 0.0);
+  EXPECT_EQ(recovered->last_order_number, 0);
+  EXPECT_TRUE(book.all().empty());
+  EXPECT_EQ(sessions.size(), 0u);
+  EXPECT_FALSE(wait.waiting());
 }
 
 }  // namespace
