@@ -178,7 +178,7 @@ void Dispatcher::Publish() {
   facts.time_scale = options_.time_scale;
   facts.implausible_reports = implausible_;
   facts.awaiting_reconnect = &restart_wait_.awaited();
-  facts.min_distance = min_distance_;
+  facts.min_distance = distances_.closest();
   std::atomic_store(&snapshot_, std::shared_ptr<const Snapshot>(BuildSnapshot(*map_, *core_, sessions_, book_, facts)));
   effects_.Published(Clock::now());
 }

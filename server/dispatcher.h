@@ -23,12 +23,13 @@
 // traffic control never waits for an auction. New orders' route searches run on another
 // worker before the loop sees the order.
 //
-// Robots (dispatcher_robots.cpp, robot_sessions.h): Hello registers the robot at the map point
-// its pose snaps to; its reports go to the core, the core's messages (plans, Grants, Holds,
-// Resumes, PlanUpdates, cancels) to its stream, numbered over the robot's life. After every
-// batch the core's traffic gate steps (dispatcher_traffic.cpp); a robot blocked with no way
-// out, or offline for offline_grace after heartbeat_timeout of silence, loses its orders
-// (the core's PlanLoss: assigned ones are re-allocated, in-progress ones fail).
+// Robots (dispatcher_robots.cpp, robot_sessions.h; the stream's rules: robot_protocol.h):
+// Hello registers the robot at the map point its pose snaps to; its reports go to the core,
+// the core's messages (plans, Grants, Holds, Resumes, PlanUpdates, cancels) to its stream,
+// numbered over the robot's life. After every batch the core's traffic gate steps
+// (dispatcher_traffic.cpp; the closest approach of two robots: distance_watch.h); a robot
+// blocked with no way out, or offline for offline_grace after heartbeat_timeout of silence,
+// loses its orders (the core's PlanLoss: assigned ones are re-allocated, in-progress ones fail).
 //
 // Restart (restart_wait.h): robots stored offline are obstacles at their stored points until
 // they reconnect; until every robot the old process had on line has reported, or
@@ -56,6 +57,7 @@
 #include "server/command_queue.h"
 #include "server/core_journal_writer.h"
 #include "server/dispatch_clock.h"
+#include "server/distance_watch.h"
 #include "server/metrics.h"
 #include "server/order_views.h"
 #include "server/restart_wait.h"
@@ -269,8 +271,7 @@ class Dispatcher {
   // indexes per this many finishes, not one per finish).
   static constexpr std::size_t kRetireSlack = 64;
   RoundSchedule rounds_due_;  // when the next allocation round runs
-  engine::MinDistance min_distance_;
-  Clock::time_point next_distance_sample_{};
+  DistanceWatch distances_;   // the closest two robots so far
   RestartWait restart_wait_;  // see the top, "Restart"
   std::uint64_t implausible_ = 0;  // robot reports not taken (Implausible)
   // Route searches of new orders (SubmitOrder) and allocation rounds: off the loop thread.

@@ -1,14 +1,14 @@
 // Dispatcher: robot streams (hello, reports, progress events), heartbeats and the offline
-// grace that re-allocates a lost robot's orders. What a report means is the core's
-// (engine/dispatch/dispatch_core.h); here it is received, stored and answered.
+// grace that re-allocates a lost robot's orders (their rules: robot_protocol.h). What a report
+// means is the core's (engine/dispatch/dispatch_core.h); here it is received, stored and
+// answered.
 #include <spdlog/spdlog.h>
 
-#include <algorithm>
-#include <cmath>
 #include <optional>
 
 #include "engine/dispatch/robot_intake.h"
 #include "server/dispatcher.h"
+#include "server/robot_protocol.h"
 
 namespace dispatch::server {
 
@@ -22,18 +22,10 @@ void Dispatcher::OnRobotGone(std::shared_ptr<RobotLink> link) {
 
 void Dispatcher::DoRobotMessage(const std::shared_ptr<RobotLink>& link, const RobotInbound& m) {
   const std::string* known = sessions_.RobotOf(link.get());
-  if (m.kind == RobotInbound::Kind::kHello) {
-    if (known) {
-      CloseLink(link, MakeStatus(StatusCode::kInvalidArgument, "Hello sent twice on one stream"));
-      return;
-    }
-    DoHello(link, m);
-    return;
+  if (auto wrong = OutOfTurn(m.kind, known != nullptr)) {
+    return CloseLink(link, MakeStatus(StatusCode::kInvalidArgument, *wrong));
   }
-  if (!known) {
-    CloseLink(link, MakeStatus(StatusCode::kInvalidArgument, "the first message of a stream must be Hello"));
-    return;
-  }
+  if (m.kind == RobotInbound::Kind::kHello) return DoHello(link, m);
   const std::string id = *known;
   RobotSession* session = sessions_.Find(id);
   if (!session || session->link != link) return;  // a superseded stream
@@ -57,11 +49,7 @@ void Dispatcher::DoRobotMessage(const std::shared_ptr<RobotLink>& link, const Ro
       break;
     }
     case RobotInbound::Kind::kTaskEvent: DoTaskEvent(id, {m.order_id, m.dropped}); break;
-    case RobotInbound::Kind::kAck:
-      // An ack of a sequence never sent is ignored: believed, it would skip what is sent
-      // next and (beyond 2^63) make the robot's record unstorable.
-      if (m.sequence < s.next_sequence) s.last_acked_sequence = std::max(s.last_acked_sequence, m.sequence);
-      break;
+    case RobotInbound::Kind::kAck: TakeAck(s, m.sequence); break;
     case RobotInbound::Kind::kHeartbeat:
     case RobotInbound::Kind::kHello: break;
   }
@@ -78,11 +66,8 @@ void Dispatcher::DoHello(const std::shared_ptr<RobotLink>& link, const RobotInbo
   const std::string& id = hello.robot_id;
   const RobotSession* existing = sessions_.Find(id);
   if (existing && existing->link && existing->link != link) {
-    const std::chrono::duration<double> silent = Clock::now() - existing->last_heard;
-    if (silent.count() <= options_.heartbeat_timeout) {
-      return reject(StatusCode::kAlreadyExists,
-                    "robot " + id + " already has a live stream (heard " + engine::FormatFixed(silent.count()) +
-                        " s ago); retry after its heartbeat times out");
+    if (auto live = LiveStream(id, *existing, Clock::now(), options_.heartbeat_timeout)) {
+      return reject(StatusCode::kAlreadyExists, *live);
     }
     CloseLink(sessions_.Detach(id), MakeStatus(StatusCode::kUnavailable, "superseded by a new stream"));
   }
@@ -90,8 +75,7 @@ void Dispatcher::DoHello(const std::shared_ptr<RobotLink>& link, const RobotInbo
   if (auto valid = engine::ValidateRobot(record.robot); !valid.ok()) {
     return reject(StatusCode::kInvalidArgument, valid.error().message);
   }
-  const engine::BookRobot* known = core_->robot(id);
-  const bool resend = known && known->has_assignment && !known->assignment.order_ids.empty();
+  const bool resend = HasOrders(core_->robot(id));
   storage::RobotRecord stored = record;
   stored.next_sequence += resend ? 2 : 1;  // Welcome (+ the current plan)
   if (auto saved = store_.UpsertRobot(stored); !saved.ok()) {
@@ -177,19 +161,9 @@ void Dispatcher::Tick() {
   const auto now = Clock::now();
   for (auto& [id, s] : sessions_) {
     if (s.link) {
-      const std::chrono::duration<double> silent = now - s.last_heard;
-      if (silent.count() > options_.heartbeat_timeout) {
-        MarkOffline(id, "no message for " + engine::FormatFixed(silent.count()) + " s (heartbeat timeout " +
-                            engine::FormatFixed(options_.heartbeat_timeout) + " s)");
-      }
-      continue;
-    }
-    const engine::BookRobot* r = core_->robot(id);
-    if (!s.offline_since || !r || !r->has_assignment || r->assignment.order_ids.empty()) continue;
-    const std::chrono::duration<double> offline = now - *s.offline_since;
-    if (offline.count() < options_.offline_grace) continue;
-    if (LoseRobot(id, "robot " + id + " offline for more than " + engine::FormatFixed(options_.offline_grace) + " s")) {
-      s.offline_since.reset();
+      if (auto why = SilenceTimeout(s, now, options_.heartbeat_timeout)) MarkOffline(id, *why);
+    } else if (auto why = GraceOver(id, s, core_->robot(id), now, options_.offline_grace)) {
+      if (LoseRobot(id, *why)) s.offline_since.reset();
     }
   }
   rounds_due_.Tick();

@@ -48,15 +48,9 @@ void Dispatcher::StepTraffic() {
   for (auto& c : step.messages) {
     RobotSession* session = sessions_.Find(c.robot);
     if (!session) continue;
-    RobotSession& s = *session;
-    using Kind = RobotOutbound::Kind;
-    if (c.message.kind == Kind::kHold) {
-      if (!s.held_since) s.held_since = now;
-      spdlog::debug("hold {}: {}", c.robot, c.message.reason);
-    } else if (c.message.kind == Kind::kGrant || c.message.kind == Kind::kResume) {
-      if (s.held_since && options_.metrics) options_.metrics->ObserveGrantWait(now - *s.held_since);
-      s.held_since.reset();
-    }
+    if (c.message.kind == RobotOutbound::Kind::kHold) spdlog::debug("hold {}: {}", c.robot, c.message.reason);
+    const std::optional<double> waited = TrackHold(*session, c.message.kind, now);
+    if (waited && options_.metrics) options_.metrics->ObserveGrantWait(*waited);
     SendTo(c.robot, std::move(c.message));
   }
   for (const engine::Assignment& a : step.rewritten) {
@@ -73,17 +67,13 @@ void Dispatcher::StepTraffic() {
     LoseRobot(id, "robot " + id + " blocked: " + why);
   }
   for (const std::string& note : step.notes) spdlog::info("{}", note);
-  if (const auto wall = Clock::now(); wall >= next_distance_sample_) {  // 20 Hz: reports come at ~10
-    core_->SampleDistances(now);
-    next_distance_sample_ = wall + std::chrono::milliseconds(50);
-  }
+  if (distances_.SampleDue(Clock::now())) core_->SampleDistances(now);
   const engine::MinDistance& d = gate->min_distance();
-  if (d.distance != min_distance_.distance || d.time != min_distance_.time) {
+  if (distances_.Update(d)) {
     if (d.distance < options_.traffic.point_clearance - 1e-6) {
       spdlog::warn("robots {} and {} {:.3f} m apart (closer than eps1): {} | {}", d.a, d.b, d.distance,
                    gate->Describe(d.a), gate->Describe(d.b));
     }
-    min_distance_ = d;
     effects_.MarkChanged();
   }
 }

@@ -32,6 +32,18 @@ std::shared_ptr<RobotLink> RobotSessions::Detach(const std::string& robot_id) {
   return std::exchange(s->link, nullptr);
 }
 
+std::optional<double> TrackHold(RobotSession& session, RobotOutbound::Kind kind, double now) {
+  using Kind = RobotOutbound::Kind;
+  if (kind == Kind::kHold) {
+    if (!session.held_since) session.held_since = now;
+    return std::nullopt;
+  }
+  if (kind != Kind::kGrant && kind != Kind::kResume) return std::nullopt;
+  const std::optional<double> held_since = std::exchange(session.held_since, std::nullopt);
+  if (!held_since) return std::nullopt;
+  return now - *held_since;
+}
+
 storage::RobotRecord RecordOf(const engine::BookRobot* robot, const RobotSession* session) {
   storage::RobotRecord rec;
   if (robot) rec.robot = robot->robot;

@@ -2,7 +2,7 @@
 // stream (RobotLink), the message sequences of the robot protocol, when it was last heard and
 // since when it is offline - and which stream belongs to which robot. A robot's record as
 // stored (storage::RobotRecord) is the core's robot plus its session (RecordOf), and a Hello
-// updates that record in one place (HelloRecord).
+// updates that record in one place (HelloRecord). TrackHold times the traffic holds.
 //
 // Not thread-safe: the dispatcher's loop owns it.
 #pragma once
@@ -61,6 +61,10 @@ class RobotSessions {
   std::unordered_map<const RobotLink*, std::string> link_robot_;
 };
 
+// A traffic message about to go to the robot: a Hold starts its wait (unless one is in force
+// already), a Grant or Resume ends it. Returns how long it stood held (dispatcher seconds,
+// dispatch_grant_wait_seconds) when this message ended a wait.
+std::optional<double> TrackHold(RobotSession& session, RobotOutbound::Kind kind, double now);
 // The robot as stored: the core's robot (if it knows it) and its session (if any).
 storage::RobotRecord RecordOf(const engine::BookRobot* robot, const RobotSession* session);
 // The session's part of a stored record (recovery).

@@ -1,8 +1,8 @@
 // The dispatcher's parts on their own: robot sessions and what a Hello makes of a robot's
 // record (server/robot_sessions.h), the core journal's writer (server/core_journal_writer.h),
 // what a core change stores (server/change_store.h), the loop's bookkeeping (command_queue.h,
-// batch_effects.h, dispatch_clock.h, round_schedule.h), the round worker (round_worker.h) and
-// recovery at start-up (state_recovery.h).
+// batch_effects.h, dispatch_clock.h, round_schedule.h, distance_watch.h), the round worker
+// (round_worker.h) and recovery at start-up (state_recovery.h).
 #include <gtest/gtest.h>
 
 #include <future>
@@ -18,6 +18,7 @@
 #include "server/command_queue.h"
 #include "server/core_journal_writer.h"
 #include "server/dispatch_clock.h"
+#include "server/distance_watch.h"
 #include "server/explanation.h"
 #include "server/json_convert.h"
 #include "server/restart_wait.h"
@@ -344,6 +345,42 @@ TEST(RoundScheduleTest, OneRoundAtATimeAndWhatBecameDueMeanwhileRunsAfterIt) {
   ASSERT_TRUE(rounds.Begin());
   rounds.Tick();
   EXPECT_FALSE(rounds.due());
+}
+
+TEST(DistanceWatchTest, SamplesAtMostEveryFiftyMillisecondsAndTellsAChange) {
+  using Clock = DistanceWatch::Clock;
+  const Clock::time_point t0 = Clock::now();
+  DistanceWatch watch;
+  EXPECT_TRUE(watch.SampleDue(t0));
+  EXPECT_FALSE(watch.SampleDue(t0 + std::chrono::milliseconds(49)));
+  EXPECT_TRUE(watch.SampleDue(t0 + DistanceWatch::kSampleEvery));
+  engine::MinDistance closest;
+  EXPECT_FALSE(watch.Update(closest));  // none seen yet, as before
+  closest.distance = 0.8;
+  closest.a = "R1";
+  closest.b = "R2";
+  closest.time = 3.0;
+  EXPECT_TRUE(watch.Update(closest));
+  EXPECT_FALSE(watch.Update(closest));
+  EXPECT_EQ(watch.closest().a, "R1");
+  closest.time = 4.0;  // as close again, later
+  EXPECT_TRUE(watch.Update(closest));
+}
+
+TEST(RobotSessionsTest, AHoldIsTimedUntilTheGrantOrResumeThatEndsIt) {
+  using Kind = RobotOutbound::Kind;
+  RobotSession s;
+  EXPECT_FALSE(TrackHold(s, Kind::kGrant, 1.0).has_value());  // not held
+  EXPECT_FALSE(TrackHold(s, Kind::kHold, 2.0).has_value());
+  EXPECT_FALSE(TrackHold(s, Kind::kHold, 3.0).has_value());  // the first Hold counts
+  EXPECT_FALSE(TrackHold(s, Kind::kAssignment, 4.0).has_value());
+  ASSERT_TRUE(s.held_since.has_value());
+  const std::optional<double> waited = TrackHold(s, Kind::kGrant, 5.5);
+  ASSERT_TRUE(waited.has_value());
+  EXPECT_DOUBLE_EQ(*waited, 3.5);
+  EXPECT_FALSE(s.held_since.has_value());
+  TrackHold(s, Kind::kHold, 6.0);
+  EXPECT_DOUBLE_EQ(TrackHold(s, Kind::kResume, 7.0).value_or(-1.0), 1.0);
 }
 
 engine::Bid BidOf(const std::string& robot, double value) {
