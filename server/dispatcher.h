@@ -21,7 +21,7 @@
 // the round worker (round_worker.h), which runs the strategy (engine::RoundRunner) off the
 // loop; back on the loop the awards that still hold are committed, a few per loop turn. So
 // traffic control never waits for an auction. New orders' route searches run on another
-// worker before the loop sees the order.
+// worker before the loop sees the order; what the order commands answer is order_replies.h.
 //
 // Robots (dispatcher_robots.cpp, robot_sessions.h; the stream's rules: robot_protocol.h):
 // Hello registers the robot at the map point its pose snaps to; its reports go to the core,
@@ -59,6 +59,7 @@
 #include "server/dispatch_clock.h"
 #include "server/distance_watch.h"
 #include "server/metrics.h"
+#include "server/order_replies.h"
 #include "server/order_views.h"
 #include "server/restart_wait.h"
 #include "server/robot_link.h"
@@ -106,17 +107,6 @@ struct DispatcherOptions {
 
 // The dispatch core the dispatcher builds for `options` (its journal's setup records the same).
 engine::CoreOptions CoreOptionsOf(const DispatcherOptions& options);
-
-struct SubmitReply {
-  ServiceStatus status;
-  std::shared_ptr<const OrderView> order;
-  bool created = false;
-};
-
-struct OrderReply {
-  ServiceStatus status;
-  std::shared_ptr<const OrderView> order;
-};
 
 using engine::OrderRoutes;
 using engine::RouteWaypoint;

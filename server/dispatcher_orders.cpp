@@ -60,45 +60,23 @@ void Dispatcher::DoSubmit(const engine::OrderRequest& request,
     return done(std::move(reply));
   }
   engine::Order order = std::move(admitted).value();
-  if (auto existing = book_.FindClient(order.client_id)) {
-    if (storage::OrderContentHash(order) == existing->record.content_hash) {
-      reply.order = existing;
-      reply.created = false;
-      return done(std::move(reply));
-    }
-    reply.status = MakeStatus(
-        StatusCode::kAlreadyExists,
-        "client_order_id '" + order.client_id + "' already names order " +
-            existing->record.order.id + " with different content; this submission (picks, drop, "
-            "formation, priority, work time or release time) differs from it");
-    return done(std::move(reply));
-  }
+  if (auto existing = book_.FindClient(order.client_id)) return done(AnswerRepeat(std::move(existing), order));
   // Not in memory: new, or finished long ago (retired). The store decides which.
   auto inserted = store_.InsertOrder(order);
   if (!inserted.ok()) {
-    reply.status = inserted.error().code == engine::ErrorCode::kFailedPrecondition
-                       ? MakeStatus(StatusCode::kAlreadyExists, inserted.error().message)
-                       : FromEngineError(inserted.error());
-    if (reply.status.code == StatusCode::kUnavailable) {
-      reply.status.message = "order '" + order.client_id + "' was NOT accepted: " + reply.status.message;
-    }
+    reply.status = NotInserted(inserted.error(), order.client_id);
     spdlog::warn("submit {}: {}", order.client_id, reply.status.message);
     return done(std::move(reply));
   }
-  auto view = std::make_shared<OrderView>();
-  view->record = inserted->record;
-  if (!inserted->created) {  // a repeat of a retired order: answered from the store
-    if (engine::IsTerminal(view->record.order.state)) view->finished_time = view->record.updated_time;
-    reply.order = view;
-    reply.created = false;
-    return done(std::move(reply));
-  }
+  auto view = StoredView(inserted->record);
+  reply.order = view;
+  reply.created = inserted->created;
+  // A repeat of a retired order is answered from the store; a new one joins the book and the core.
+  if (!inserted->created) return done(std::move(reply));
   ++last_order_number_;
   book_.Put(view);
   effects_.MarkChanged();
   core_->AddOrder(std::move(order));
-  reply.order = view;
-  reply.created = inserted->created;
   done(std::move(reply));
   storage::EventQuery first;
   first.order_id = view->record.order.id;
@@ -121,21 +99,7 @@ void Dispatcher::DoCancel(const std::string& order_id, const std::string& reason
     }
     view = *stored;
   }
-  if (!view) {
-    reply.status = MakeStatus(StatusCode::kNotFound, "no order with id '" + order_id + "'");
-    return done(std::move(reply));
-  }
-  const engine::OrderState state = view->record.order.state;
-  if (state == engine::OrderState::kCancelled) {
-    reply.order = view;
-    return done(std::move(reply));
-  }
-  if (engine::IsTerminal(state)) {
-    reply.status = MakeStatus(StatusCode::kFailedPrecondition,
-                              "order " + order_id + " is already " +
-                                  engine::OrderStateName(state) + "; only open orders can be cancelled");
-    return done(std::move(reply));
-  }
+  if (auto answer = AnswerCancelOfClosed(view, order_id)) return done(std::move(*answer));
   const std::string why = reason.empty() ? "cancelled by client" : reason;
   auto change = core_->PlanCancel(order_id, why, Now());
   if (!change.ok()) {  // open in the views, not in the core: cannot happen

@@ -10,6 +10,13 @@
 
 namespace dispatch::server {
 
+std::shared_ptr<OrderView> StoredView(storage::OrderRecord record) {
+  auto view = std::make_shared<OrderView>();
+  view->record = std::move(record);
+  if (engine::IsTerminal(view->record.order.state)) view->finished_time = view->record.updated_time;
+  return view;
+}
+
 std::shared_ptr<const OrderView> OrderViews::Find(const std::string& order_id) const {
   auto it = by_id_.find(order_id);
   return it == by_id_.end() ? nullptr : orders_[it->second];
@@ -43,9 +50,7 @@ engine::Result<std::shared_ptr<const OrderView>> OrderViews::FromStore(storage::
     if (record.error().code == engine::ErrorCode::kNotFound) return std::shared_ptr<const OrderView>();
     return record.error();
   }
-  auto view = std::make_shared<OrderView>();
-  view->record = std::move(record).value();
-  if (engine::IsTerminal(view->record.order.state)) view->finished_time = view->record.updated_time;
+  auto view = StoredView(std::move(record).value());
   if (explain) {  // the latest allocation detail in its journal
     storage::EventQuery events;
     events.order_id = view->record.order.id;
@@ -127,9 +132,7 @@ engine::Result<LoadedOrders> OrderViews::Load(storage::Store& store) {
     auto page = store.ListOrders(query);
     if (!page.ok()) return page.error();
     for (const auto& record : page->orders) {
-      auto view = std::make_shared<OrderView>();
-      view->record = record;
-      if (engine::IsTerminal(record.order.state)) view->finished_time = record.updated_time;
+      auto view = StoredView(record);
       out.latest_time = std::max({out.latest_time, record.updated_time, record.order.created_time});
       const std::string& id = record.order.id;
       if (id.rfind("ord-", 0) == 0) {

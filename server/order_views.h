@@ -29,6 +29,10 @@ struct LoadedOrders {
   std::int64_t last_order_number = 0;  // of the "ord-N" ids
 };
 
+// The view of an order as stored, before any change follows it: finished at its last update
+// when it is terminal.
+std::shared_ptr<OrderView> StoredView(storage::OrderRecord record);
+
 class OrderViews {
  public:
   explicit OrderViews(std::size_t retained) : retained_(retained) {}
