@@ -202,6 +202,11 @@ Status TrafficController::Place(std::size_t r, PointId at) {
   s.OccupyGuard(r);
   return Ok{};
 }
+void TrafficController::HoldGrantAt(std::size_t r, PointId at) {
+  Impl& s = *impl_;
+  if (r >= s.robots.size() || at < 0 || static_cast<std::size_t>(at) >= s.M().point_count()) return;
+  s.OccupyGuard(r, s.M().IntersectionOf(at));
+}
 bool TrafficController::removed(std::size_t r) const { return impl_->robots.at(r).removed; }
 int TrafficController::HolderOf(PointId p) const { return impl_->holder.at(static_cast<std::size_t>(p)); }
 int TrafficController::BlockerOf(PointId p, std::size_t r, double envelope) const {

@@ -152,6 +152,12 @@ class TrafficController {
   // owner reuses indices instead of adding robots). Errors: not removed, unknown point, the
   // point (or one within point_clearance) held by another robot.
   Status Place(std::size_t r, PointId at);
+  // Robot r (on the floor or not) stands inside the intersection of point `at`: it holds that
+  // intersection's grant from now on (IntersectionGrants::Occupy), until it is placed on a
+  // point outside it, leaves it or is removed. For a formation breaking up inside an
+  // intersection: its members take the grant over before the team's agent lets it go, so no
+  // crossing movement is granted in between. No-op when `at` is in no intersection.
+  void HoldGrantAt(std::size_t r, PointId at);
   bool removed(std::size_t r) const;
   // The robot holding point p (standing there, driving to it, or not yet clear of it), or -1.
   int HolderOf(PointId p) const;

@@ -152,8 +152,10 @@ struct TrafficController::Impl {
   void ReconcileCorridors(std::size_t r);
   void ReleaseGuard(std::size_t r);
   // A robot placed on a point of an intersection holds its grant at once (it stands inside:
-  // no crossing movement may be granted around it until it has left).
-  void OccupyGuard(std::size_t r);
+  // no crossing movement may be granted around it until it has left); placed elsewhere, it
+  // lets go of one it held. OccupyGuard(r, g): it stands inside intersection g (-1: none).
+  void OccupyGuard(std::size_t r) { OccupyGuard(r, M().IntersectionOf(robots[r].at)); }
+  void OccupyGuard(std::size_t r, int g);
   void ClearWait(RobotState& x);
   TrafficDecision Wait(std::size_t r, WaitKind kind, int on, double t, std::string why);
 

@@ -81,11 +81,12 @@ void TrafficController::Impl::ReleaseGuard(std::size_t r) {
   x.granted = false;
 }
 
-void TrafficController::Impl::OccupyGuard(std::size_t r) {
+void TrafficController::Impl::OccupyGuard(std::size_t r, int g) {
   RobotState& x = robots[r];
-  const int g = config.intersection_grants ? M().IntersectionOf(x.at) : -1;
-  if (g < 0 || (x.guard == g && x.granted)) return;
+  if (!config.intersection_grants) g = -1;
+  if (g >= 0 && x.guard == g && x.granted) return;
   ReleaseGuard(r);
+  if (g < 0) return;
   (void)grants.Occupy(static_cast<std::size_t>(g), x.id);
   x.guard = g;
   x.granted = true;

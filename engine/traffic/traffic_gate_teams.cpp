@@ -79,6 +79,14 @@ void GateImpl::BreakTeam(GateTeam& team) {
   PointId at = kNoPoint;
   if (TeamAgentOnFloor(team)) {
     at = ctl.At(static_cast<std::size_t>(team.ctl));
+    // Inside an intersection, the members in their slots take the team's grant over before
+    // the agent lets it go: else a robot waiting for a crossing movement was granted it the
+    // moment the agent was removed, around a member not back on the floor yet (found by the
+    // core's safety check: 300 random orders with 30% formations, seed 5, 195.5 s).
+    for (const std::string& id : team.members) {
+      const GateBot* m = Find(id);
+      if (m && m->team == team.order && m->ctl >= 0 && !OnFloor(*m)) ctl.HoldGrantAt(static_cast<std::size_t>(m->ctl), at);
+    }
     ctl.Remove(static_cast<std::size_t>(team.ctl));
   }
   if (team.ctl >= 0) team_pool.push_back(static_cast<std::size_t>(team.ctl));

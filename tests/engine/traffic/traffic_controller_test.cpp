@@ -245,6 +245,23 @@ TEST(TrafficControllerTest, IntersectionNeedsAGrantAndReleasesItBehind) {
   again.Remove(d);
   ASSERT_TRUE(again.Place(d, P(*map, "C1")).ok());
   EXPECT_EQ(again.grants().Holders(0), (std::vector<std::string>{"S", "D"}));
+
+  // A robot off the floor takes a grant over for where it stands (a formation member in its
+  // slot when its team breaks up) before the holder lets it go: the waiting crosser is not
+  // granted in between; placed outside the intersection, it lets the grant go.
+  TrafficController third = Make(map);
+  const std::size_t team = *third.AddRobot("T", P(*map, "C1"));
+  const std::size_t member = *third.AddRobot("M", P(*map, "E"));
+  const std::size_t cross = *third.AddRobot("X", P(*map, "S"));
+  third.Remove(member);
+  ASSERT_TRUE(third.SetRoute(cross, Route(*map, {"S", "C2", "N"})).ok());
+  EXPECT_EQ(third.Request(cross, 0.0), TrafficDecision::kWait);  // T stands inside
+  third.HoldGrantAt(member, P(*map, "C1"));
+  third.Remove(team);
+  EXPECT_EQ(third.Request(cross, 1.0), TrafficDecision::kWait);
+  EXPECT_EQ(third.grants().Holders(0), std::vector<std::string>{"M"});
+  ASSERT_TRUE(third.Place(member, P(*map, "E")).ok());  // it stands outside after all
+  EXPECT_EQ(third.Request(cross, 2.0), TrafficDecision::kGo);
 }
 
 TEST(TrafficControllerTest, RejectsBadConfig) {
