@@ -52,7 +52,11 @@ RoundResult RoundRunner::Run(const RoundInput& input) {
   }
   FleetState state = std::move(fleet).value();
   zone_index_ = state.zone_index();  // one floor, one index: the next round skips the grid
-  for (std::size_t i = 0; i < input.robots.size(); ++i) ReplayQueue(state, i, input.robots[i], out.notes);
+  for (std::size_t i = 0; i < input.robots.size(); ++i) {
+    if (input.robots[i].assignment.order_ids.empty()) continue;
+    ReplayQueue(state, i, input.robots[i], out.notes);
+    state.Publish(i);  // the predictor sees the queue once, not once per order
+  }
   std::vector<bool> queued(input.robots.size());  // has orders (before or from this round)
   for (std::size_t i = 0; i < input.robots.size(); ++i) queued[i] = !input.robots[i].assignment.order_ids.empty();
   for (const auto& pending : input.pending) {
@@ -94,7 +98,6 @@ bool RoundRunner::ReplayQueue(FleetState& fleet, std::size_t index, const RoundR
     if (k >= r.queue.size() || !r.queue[k]) {
       notes.push_back("allocation: queue of " + r.id + " replayed up to " + plan.order_ids[k] +
                       " only: the order is not known");
-      fleet.Publish(index);
       return false;
     }
     const Order& order = *r.queue[k];
@@ -127,18 +130,15 @@ bool RoundRunner::ReplayQueue(FleetState& fleet, std::size_t index, const RoundR
     }
     const PlanTask task = fleet.TaskOf(picks, order.drop, order.work_time);
     Status assigned = InvalidArgument("no stored waypoints");
-    // The predictor sees the replayed queue once, at the end (AssignSingle, which routes,
-    // publishes what is there so far).
+    // Unpublished: the caller gives the predictor the whole replayed queue once.
     if (segment.size() >= 2) assigned = fleet.AssignPlanned(index, order.id, task, std::move(segment), false);
     if (!assigned.ok()) assigned = fleet.AssignSingle(index, order.id, task);
     if (!assigned.ok()) {
       notes.push_back("allocation: queue of " + r.id + " replayed up to " + order.id + " only: " +
                       assigned.error().message);
-      fleet.Publish(index);
       return false;
     }
   }
-  if (!plan.order_ids.empty()) fleet.Publish(index);
   return true;
 }
 

@@ -73,7 +73,9 @@ class RoundRunner {
 
  private:
   // Appends the robot's remaining orders (the first from the picks it has not reached yet)
-  // to its queue in `fleet`. False (with a note) when a part of the queue could not be replayed.
+  // to its queue in `fleet`, not yet published to its traffic predictor (FleetState::Publish:
+  // the caller, once per robot). False (with a note) when a part of the queue could not be
+  // replayed.
   bool ReplayQueue(FleetState& fleet, std::size_t index, const RoundRobot& robot,
                    std::vector<std::string>& notes) const;
 
