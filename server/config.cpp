@@ -51,6 +51,7 @@ std::vector<Key> Keys() {
       MakeKey("t_w1", &ServerConfig::t_w1),
       MakeKey("t_w2", &ServerConfig::t_w2),
       MakeKey("blocked_after", &ServerConfig::blocked_after),
+      MakeKey("blocked_recovery", &ServerConfig::blocked_recovery),
       MakeKey("route_cache_mb", &ServerConfig::route_cache_mb),
       MakeKey("finished_retained", &ServerConfig::finished_retained),
       MakeKey("journal_runs", &ServerConfig::journal_runs),
@@ -123,6 +124,9 @@ engine::Status ValidateServerConfig(const ServerConfig& c) {
   for (auto [name, v] : {std::pair{"t_w1", c.t_w1}, {"t_w2", c.t_w2}, {"blocked_after", c.blocked_after}}) {
     if (!positive(v)) return InvalidArgument(std::string(name) + " must be > 0 seconds");
   }
+  if (!(c.blocked_recovery >= 0.0) || !std::isfinite(c.blocked_recovery)) {
+    return InvalidArgument("blocked_recovery must be >= 0 seconds (0: a blocked robot stays in fault)");
+  }
   if (c.route_cache_mb < 1) return InvalidArgument("route_cache_mb must be >= 1");
   if (c.finished_retained < 0) return InvalidArgument("finished_retained must be >= 0");
   if (c.max_queue < 0) return InvalidArgument("max_queue must be >= 0 (0: no limit)");
@@ -165,6 +169,9 @@ engine::Result<ParsedCommandLine> ParseCommandLine(int argc, char** argv) {
       ->capture_default_str();
   app.add_option("--blocked-after", flags.blocked_after,
                  "Waiting with no alternative this long marks a robot blocked, dispatcher s")
+      ->capture_default_str();
+  app.add_option("--blocked-recovery", flags.blocked_recovery,
+                 "A blocked robot is back in service after this long in fault, dispatcher s (0: after its next Hello)")
       ->capture_default_str();
   app.add_option("--route-cache-mb", flags.route_cache_mb,
                  "Lazy route table cache bound, MiB (large grid floors)")->capture_default_str();

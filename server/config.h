@@ -35,6 +35,7 @@ struct ServerConfig {
   double t_w1 = 10.0;           // s: head-on (single-lane) wait before re-planning (Wang2019)
   double t_w2 = 20.0;           // s: wait on a held point or grant before re-planning
   double blocked_after = 120.0; // s of waiting with no alternative -> robot blocked (fault)
+  double blocked_recovery = 60.0;  // s a blocked robot stays in fault (0: until its next Hello)
   // Bound of the lazy route table's per-destination cache (large grid floors, where a dense
   // all-pairs table does not fit), MiB. It should hold the destinations in use at once (every
   // robot's next stop): on a 38k-cell floor one destination takes 0.46 MB.

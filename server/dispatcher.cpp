@@ -25,6 +25,7 @@ engine::CoreOptions CoreOptionsOf(const DispatcherOptions& options) {
   core.traffic_control = options.traffic_control;
   core.traffic = options.traffic;
   core.one_formation_per_pick = options.one_formation_per_pick;
+  core.blocked_recovery = options.blocked_recovery;
   return core;
 }
 

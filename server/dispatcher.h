@@ -93,6 +93,7 @@ struct DispatcherOptions {
   bool traffic_control = true;
   engine::TrafficControllerConfig traffic;
   bool one_formation_per_pick = false;  // engine::CoreOptions::one_formation_per_pick
+  double blocked_recovery = 60.0;       // engine::CoreOptions::blocked_recovery
   // Where allocation latency and grant waits are observed (optional; must outlive the
   // dispatcher).
   ServiceMetrics* metrics = nullptr;

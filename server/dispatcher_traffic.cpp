@@ -66,6 +66,7 @@ void Dispatcher::StepTraffic() {
     effects_.MarkChanged();
     LoseRobot(id, "robot " + id + " blocked: " + why);
   }
+  if (!step.recovered.empty()) effects_.MarkChanged();  // fault -> idle shows on the map
   for (const std::string& note : step.notes) spdlog::info("{}", note);
   if (distances_.SampleDue(Clock::now())) core_->SampleDistances(now);
   const engine::MinDistance& d = gate->min_distance();

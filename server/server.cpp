@@ -153,6 +153,7 @@ engine::Result<std::unique_ptr<DispatchServer>> DispatchServer::Start(const Serv
   options.finished_retained = static_cast<std::size_t>(config.finished_retained);
   options.traffic_control = config.traffic_control;
   options.one_formation_per_pick = config.one_formation_per_pick;
+  options.blocked_recovery = config.blocked_recovery;
   options.traffic.speed = allocation.speed;
   options.traffic.t_w1 = config.t_w1;
   options.traffic.t_w2 = config.t_w2;

@@ -140,6 +140,7 @@ Result<std::string> EncodeRunSetup(const RunSetup& s) {
     j["core"] = {{"robot_snap_tolerance", s.core.robot_snap_tolerance},
                  {"traffic_control", s.core.traffic_control},
                  {"one_formation_per_pick", s.core.one_formation_per_pick},
+                 {"blocked_recovery", s.core.blocked_recovery},
                  {"speed", t.speed},
                  {"point_clearance", t.point_clearance},
                  {"t_w1", t.t_w1},
@@ -184,6 +185,7 @@ Result<RunSetup> DecodeRunSetup(const std::string& text) {
     s.core.robot_snap_tolerance = k.at("robot_snap_tolerance").get<double>();
     s.core.traffic_control = k.at("traffic_control").get<bool>();
     s.core.one_formation_per_pick = k.value("one_formation_per_pick", false);
+    s.core.blocked_recovery = k.value("blocked_recovery", 0.0);  // journals before it: never
     engine::TrafficControllerConfig& t = s.core.traffic;
     t.speed = k.at("speed").get<double>();
     t.point_clearance = k.at("point_clearance").get<double>();

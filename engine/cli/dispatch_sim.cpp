@@ -157,6 +157,7 @@ struct StreamArgs {
   std::uint64_t seed = 1;
   double interval = 2.0, zeta = 100.0, dt = 0.1, max_time = 36000.0, formations = 0.0;
   bool check_safety = false, one_formation_per_pick = false;
+  double blocked_recovery = 60.0;  // core model: CoreOptions::blocked_recovery
   std::vector<std::string> trace;  // robots to trace (core model)
   double trace_from = 0.0, trace_to = std::numeric_limits<double>::infinity();
   // "core": the service's dispatch core with robots following its messages (core_stream.h);
@@ -222,6 +223,7 @@ StreamConfig ConfigOf(const StreamArgs& a, const std::string& strategy, double z
   c.allocation.zeta = zeta;
   c.allocation.max_queue = a.max_queue;
   c.one_formation_per_pick = a.one_formation_per_pick;
+  c.blocked_recovery = a.blocked_recovery;
   c.check_safety = a.check_safety;
   c.trace_robots = a.trace;
   c.trace_from = a.trace_from;
@@ -275,6 +277,9 @@ void PrintSummary(const std::string& label, const StreamResult& r) {
   }
   for (std::size_t i = 0; i < r.blocked.size() && i < 5; ++i) {
     std::printf("  blocked: %s\n", r.blocked[i].c_str());
+  }
+  if (!r.recovered.empty()) {
+    std::printf("  back in service after a block: %zu (first %s)\n", r.recovered.size(), r.recovered.front().c_str());
   }
   std::size_t shown = 0;
   for (const StreamOrderOutcome& o : r.orders) {
@@ -396,6 +401,10 @@ int Main(int argc, char** argv) {
         ->capture_default_str();
     c->add_flag("--one-formation-per-pick", a.one_formation_per_pick,
                 "Allocate a formation only while no other is heading for its first pick (core model)");
+    c->add_option("--blocked-recovery", a.blocked_recovery,
+                  "s a blocked robot stays in fault before it is back in service (core model; 0: never)")
+        ->capture_default_str()
+        ->check(CLI::NonNegativeNumber);
     c->add_flag("--check-safety", a.check_safety,
                 "Run CheckSafety over every step (eps1 spacing, crossings in intersections)");
     c->add_option("--trace", a.trace,

@@ -259,6 +259,7 @@ int RunReplay(const ReplayArgs& a) {
     c.allocation.zeta = zeta;
     c.traffic = loaded->setup.core.traffic;
     c.one_formation_per_pick = loaded->setup.core.one_formation_per_pick;
+    c.blocked_recovery = loaded->setup.core.blocked_recovery;
     c.check_safety = false;
     c.record_series = false;
     return SimulateOnCore(loaded->replay.map, loaded->replay.routes,

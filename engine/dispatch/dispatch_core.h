@@ -57,6 +57,11 @@ struct CoreOptions {
   // A formation order is allocated only while no other formation is still heading for its
   // first pick (MakeRound).
   bool one_formation_per_pick = false;
+  // Seconds a robot the traffic controller found blocked stays in fault (an obstacle where it
+  // stands, out of every auction) before it is back in service (idle, allocatable again; the
+  // controller may block it again). A block is a traffic verdict, not a fault of the robot: it
+  // still reports and drives. 0: it stays in fault until it says Hello again.
+  double blocked_recovery = 60.0;
 };
 
 // An open order as the core dispatches it.
@@ -73,6 +78,7 @@ struct BookRobot {
   bool has_assignment = false;
   Assignment assignment;  // plan.waypoints[0] anchors; then one segment per order
   RobotProgress progress;
+  double blocked_at = -1.0;  // >= 0: in fault since then because the controller blocked it
 };
 
 // One order's line in a Change: a state transition (to) or a journal note only.
@@ -158,6 +164,8 @@ struct StepOutcome {
   // Robots the controller found blocked with no alternative, with why: now in fault; the owner
   // gives their orders back (PlanLoss).
   std::vector<std::pair<std::string, std::string>> blocked;
+  // Robots blocked for CoreOptions::blocked_recovery with no orders left: idle again.
+  std::vector<std::string> recovered;
   std::vector<std::string> notes;  // formations formed, broken up, leaving (for the owner's log)
 };
 
@@ -246,7 +254,8 @@ class DispatchCore {
   // --- Applying and traffic --------------------------------------------------------------
   // Applies a stored Change: order states, plans, the gate; returns the plan messages.
   std::vector<RobotCommand> Apply(const Change& change);
-  // Runs the traffic controller (no-op without traffic control).
+  // Runs the traffic controller (no-op without traffic control) and puts robots blocked for
+  // CoreOptions::blocked_recovery back in service.
   StepOutcome Step(double now);
   // Updates the gate's minimum distance from the robots' last positions.
   void SampleDistances(double now);
@@ -269,6 +278,7 @@ class DispatchCore {
   void SyncGate(const BookRobot& r);
   RobotMessage PlanMessage(const BookRobot& r, bool full, std::uint64_t from_sequence) const;
   void ApplyOrder(const OrderChange& line);
+  void Recover(double now, StepOutcome& out);
 
   const std::shared_ptr<const WarehouseMap> map_;
   const std::shared_ptr<const RouteTable> routes_;
@@ -279,6 +289,7 @@ class DispatchCore {
   // robots_ by id in one hash lookup (every report and arrival looks its robot up).
   std::unordered_map<std::string, BookRobot*> robot_index_;
   CoreCounts counts_;
+  std::vector<BookRobot*> blocked_;  // in fault since the controller blocked them
   bool allocation_due_ = false;
 };
 

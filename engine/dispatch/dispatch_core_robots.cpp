@@ -2,6 +2,7 @@
 // gate's releases, holds, re-plans and blocked robots).
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 
 #include "engine/dispatch/dispatch_core.h"
 #include "engine/dispatch/robot_intake.h"
@@ -37,6 +38,7 @@ std::vector<RobotCommand> DispatchCore::Connect(Robot robot, double /*now*/) {
   r.robot = std::move(robot);
   r.robot.task_queue = r.has_assignment ? r.assignment.order_ids : std::vector<std::string>{};
   r.connected = true;
+  r.blocked_at = -1.0;  // a Hello ends a block's fault (Recover drops it from blocked_)
   allocation_due_ = true;
   if (gate_) {
     gate_->Connect(id, r.robot.pose.position, r.robot.current_point);
@@ -208,12 +210,38 @@ StepOutcome DispatchCore::Step(double now) {
       }
       case GateEffect::Kind::kBlocked:
         r->robot.state = RobotState::kFault;
+        if (r->blocked_at < 0.0) blocked_.push_back(r);
+        r->blocked_at = now;
         out.blocked.emplace_back(e.robot, e.reason);
         break;
     }
   }
   out.notes = gate_->TakeNotes();
+  Recover(now, out);
   return out;
+}
+
+void DispatchCore::Recover(double now, StepOutcome& out) {
+  if (options_.blocked_recovery <= 0.0) return;
+  std::erase_if(blocked_, [&](BookRobot* r) {
+    if (r->blocked_at < 0.0 || r->robot.state != RobotState::kFault) {  // said Hello again
+      r->blocked_at = -1.0;
+      return true;
+    }
+    // Its orders are given back first (the owner's PlanLoss); one still held waits for that.
+    if (now - r->blocked_at < options_.blocked_recovery || (r->has_assignment && !r->assignment.order_ids.empty())) {
+      return false;
+    }
+    r->robot.state = RobotState::kIdle;
+    r->blocked_at = -1.0;
+    allocation_due_ = true;
+    out.recovered.push_back(r->robot.id);
+    char note[160];
+    std::snprintf(note, sizeof note, "robot %s back in service after %.0f s blocked", r->robot.id.c_str(),
+                  options_.blocked_recovery);
+    out.notes.emplace_back(note);
+    return true;
+  });
 }
 
 void DispatchCore::SampleDistances(double now) {

@@ -169,6 +169,11 @@ class CoreRun {
       out_.blocked.push_back(id + ": blocked: " + why);
       Commit(core_->PlanLoss(id, "robot " + id + " blocked: " + why, t));
     }
+    for (const std::string& id : step.recovered) {
+      char at[32];
+      std::snprintf(at, sizeof at, " at %.1f s", t);
+      out_.recovered.push_back(id + at);
+    }
     core_->SampleDistances(t);
     const TrafficGate* gate = core_->gate();
     if (!gate) return;
@@ -320,6 +325,7 @@ CoreOptions CoreOptionsOf(const StreamConfig& config) {
   options.traffic = config.traffic;
   options.traffic.speed = config.allocation.speed;
   options.one_formation_per_pick = config.one_formation_per_pick;
+  options.blocked_recovery = config.blocked_recovery;
   return options;
 }
 

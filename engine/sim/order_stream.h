@@ -86,6 +86,9 @@ struct StreamConfig {
   bool record_frames = false;
   // SimulateOnCore: CoreOptions::one_formation_per_pick (the stream model ignores it).
   bool one_formation_per_pick = false;
+  // SimulateOnCore: CoreOptions::blocked_recovery (the stream model takes a blocked robot off
+  // the floor for good).
+  double blocked_recovery = 60.0;
   // SimulateOnCore: for these robots, every step in [trace_from, trace_to] one line each in
   // StreamResult::trace (true position, motion state, the gate's view), and the gate's notes
   // (formations formed, broken up, leaving) of those steps: for debugging traffic.
@@ -116,6 +119,9 @@ struct StreamResult {
   std::size_t stops = 0;              // moving -> traffic wait transitions
   TrafficStats traffic;               // re-plans, grants, deadlocks resolved, head-on log
   std::vector<std::string> blocked;   // "R3: blocked after ..." for robots taken off
+  // SimulateOnCore: "R3 at 245.0 s" for each blocked robot back in service
+  // (StreamConfig::blocked_recovery).
+  std::vector<std::string> recovered;
   // SimulateOnCore: each time the closest pair came nearer than eps1, the two robots' traffic
   // state then (as the service logs it).
   std::vector<std::string> too_close;

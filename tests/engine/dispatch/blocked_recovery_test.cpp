@@ -1,0 +1,156 @@
+// DispatchCore's blocked robots (CoreOptions::blocked_recovery): a robot the traffic controller
+// blocks is in fault, an obstacle out of every auction, and its orders go back; after
+// blocked_recovery seconds it is in service again (0: it stays in fault until its next Hello).
+#include <gtest/gtest.h>
+
+#include <functional>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "dispatch_test_support.h"
+#include "engine/dispatch/dispatch_core.h"
+#include "engine/dispatch/strategy.h"
+
+namespace dispatch::engine {
+namespace {
+
+using testing_util::Chu2024;
+using testing_util::Chu2024Routes;
+using testing_util::PointsOfKind;
+
+constexpr double kBlockedAfter = 5.0;
+
+class BlockedRecoveryTest : public ::testing::Test {
+ protected:
+  // R1 at a parking point gets an order whose pick an offline robot stands on: it waits there
+  // with no alternative and is blocked after kBlockedAfter.
+  void Build(double recovery) {
+    CoreOptions options;
+    options.traffic.blocked_after = kBlockedAfter;
+    options.blocked_recovery = recovery;
+    auto core = DispatchCore::Create(Chu2024(), Chu2024Routes(), options);
+    ASSERT_TRUE(core.ok()) << core.error().message;
+    core_ = std::move(core).value();
+    auto allocator = MakeAllocator("auction");
+    ASSERT_TRUE(allocator.ok());
+    rounds_ = std::make_unique<RoundRunner>(Chu2024(), Chu2024Routes(), AllocationConfig{}, std::move(allocator).value());
+
+    const PointId pick = PointsOfKind(*Chu2024(), PointKind::kPick).at(3);
+    Robot ghost;
+    ghost.id = "G";
+    ghost.current_point = pick;
+    ghost.pose.position = Chu2024()->point(pick).position;
+    core_->RestoreRobot(std::move(ghost), std::nullopt, /*place=*/true);
+
+    Robot r1;
+    r1.id = "R1";
+    r1.current_point = PointsOfKind(*Chu2024(), PointKind::kPark).at(0);
+    r1.pose.position = Chu2024()->point(r1.current_point).position;
+    (void)core_->Connect(std::move(r1), now_);
+
+    Order o;
+    o.id = o.client_id = "O1";
+    o.picks = {pick};
+    o.drop = PointsOfKind(*Chu2024(), PointKind::kDrop).at(1);
+    core_->AddOrder(std::move(o));
+    ASSERT_TRUE(RunRound());
+    ASSERT_EQ(core_->order("O1")->robots, std::vector<std::string>{"R1"});
+  }
+
+  // One allocation round, every award applied; false when there was nothing to allocate.
+  bool RunRound() {
+    RoundCommit commit;
+    std::optional<RoundInput> input = core_->MakeRound(now_, commit);
+    if (!input) return false;
+    commit.awards = rounds_->Run(*input).awards;
+    (void)core_->Apply(core_->PlanAwards(commit, commit.awards.size(), now_));
+    return true;
+  }
+
+  // R1 drives at once to every waypoint released to it, then reports.
+  void Drive() {
+    const BookRobot* r = core_->robot("R1");
+    (void)core_->Report("R1", r->robot.pose, std::nullopt, RobotState::kIdle, std::nullopt, r->progress.last_reached, now_);
+    if (!r->has_assignment) return;
+    const std::uint64_t released = core_->ReleasedUpTo("R1");
+    for (const Waypoint& w : std::vector<Waypoint>(r->assignment.plan.waypoints)) {
+      const auto seq = static_cast<std::uint64_t>(w.seq);
+      if (seq <= core_->robot("R1")->progress.last_reached || seq > released) continue;
+      const ReportOutcome reached = core_->Reached("R1", seq, Pose{w.xy, 0.0}, now_);
+      ASSERT_TRUE(reached.taken) << reached.why;
+      if (reached.change) (void)core_->Apply(*reached.change);
+    }
+  }
+
+  // Steps every 0.5 s until `until` (or the time limit); the owner's part of a block is done
+  // as the service does it (PlanLoss, stored and applied).
+  void RunUntil(double limit, const std::function<bool(const StepOutcome&)>& until) {
+    while (now_ < limit) {
+      now_ += 0.5;
+      Drive();
+      StepOutcome step = core_->Step(now_);
+      for (const auto& [id, why] : step.blocked) {
+        blocked_at_ = now_;
+        (void)core_->Apply(core_->PlanLoss(id, "robot " + id + " blocked: " + why, now_));
+      }
+      if (until(step)) return;
+    }
+  }
+
+  std::unique_ptr<DispatchCore> core_;
+  std::unique_ptr<RoundRunner> rounds_;
+  double now_ = 0.0;
+  std::optional<double> blocked_at_;
+};
+
+TEST_F(BlockedRecoveryTest, ABlockedRobotIsBackInServiceAfterTheRecoveryTime) {
+  Build(10.0);
+  std::optional<double> recovered_at;
+  RunUntil(200.0, [&](const StepOutcome& step) {
+    for (const std::string& id : step.recovered) {
+      if (id == "R1") recovered_at = now_;
+    }
+    if (blocked_at_ && !recovered_at) {  // in fault meanwhile: an obstacle out of the auction
+      EXPECT_EQ(core_->robot("R1")->robot.state, RobotState::kFault);
+      RoundCommit commit;
+      EXPECT_FALSE(core_->MakeRound(now_, commit).has_value()) << "a faulted robot must not bid";
+    }
+    return recovered_at.has_value();
+  });
+  ASSERT_TRUE(blocked_at_.has_value()) << core_->gate()->Describe("R1");
+  ASSERT_TRUE(recovered_at.has_value());
+  EXPECT_GE(*blocked_at_, kBlockedAfter);
+  EXPECT_GE(*recovered_at - *blocked_at_, 10.0);
+  EXPECT_LE(*recovered_at - *blocked_at_, 10.5);
+  EXPECT_EQ(core_->robot("R1")->robot.state, RobotState::kIdle);
+  // Its order went back when it was blocked; now R1 bids for it again.
+  EXPECT_EQ(core_->order("O1")->order->state, OrderState::kAccepted);
+  EXPECT_TRUE(core_->TakeAllocationDue());
+  ASSERT_TRUE(RunRound());
+  EXPECT_EQ(core_->order("O1")->robots, std::vector<std::string>{"R1"});
+}
+
+TEST_F(BlockedRecoveryTest, WithoutRecoveryABlockedRobotStaysInFaultUntilItsNextHello) {
+  Build(0.0);
+  RunUntil(300.0, [&](const StepOutcome& step) {
+    EXPECT_TRUE(step.recovered.empty());
+    return false;
+  });
+  ASSERT_TRUE(blocked_at_.has_value());
+  EXPECT_EQ(core_->robot("R1")->robot.state, RobotState::kFault);
+  // A report does not end the fault; a Hello does.
+  const BookRobot* r = core_->robot("R1");
+  (void)core_->Report("R1", r->robot.pose, std::nullopt, RobotState::kIdle, std::nullopt, r->progress.last_reached, now_);
+  EXPECT_EQ(core_->robot("R1")->robot.state, RobotState::kFault);
+  Robot hello = core_->robot("R1")->robot;
+  hello.state = RobotState::kIdle;
+  (void)core_->Connect(std::move(hello), now_);
+  EXPECT_EQ(core_->robot("R1")->robot.state, RobotState::kIdle);
+  RoundCommit commit;
+  EXPECT_TRUE(core_->MakeRound(now_, commit).has_value());
+}
+
+}  // namespace
+}  // namespace dispatch::engine
