@@ -58,6 +58,7 @@
 #include "server/core_journal_writer.h"
 #include "server/dispatch_clock.h"
 #include "server/distance_watch.h"
+#include "server/memory_trim.h"
 #include "server/metrics.h"
 #include "server/order_replies.h"
 #include "server/order_views.h"
@@ -263,6 +264,7 @@ class Dispatcher {
   static constexpr std::size_t kRetireSlack = 64;
   RoundSchedule rounds_due_;  // when the next allocation round runs
   DistanceWatch distances_;   // the closest two robots so far
+  MemoryTrim memory_trim_;    // the threads' malloc arenas trimmed every 10 s
   RestartWait restart_wait_;  // see the top, "Restart"
   std::uint64_t implausible_ = 0;  // robot reports not taken (Implausible)
   // Route searches of new orders (SubmitOrder) and allocation rounds: off the loop thread.

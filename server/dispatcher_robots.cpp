@@ -167,6 +167,7 @@ void Dispatcher::Tick() {
     }
   }
   rounds_due_.Tick();
+  memory_trim_.Tick(now);
 }
 
 }  // namespace dispatch::server
