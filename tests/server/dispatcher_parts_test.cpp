@@ -1,7 +1,7 @@
 // The dispatcher's parts on their own: robot sessions and what a Hello makes of a robot's
 // record (server/robot_sessions.h), the core journal's writer (server/core_journal_writer.h),
 // what a core change stores (server/change_store.h), the loop's bookkeeping (command_queue.h,
-// batch_effects.h, dispatch_clock.h, round_schedule.h, distance_watch.h), the round worker
+// batch_effects.h, dispatch_clock.h, round_schedule.h, distance_watch.h, memory_trim.h), the round worker
 // (round_worker.h) and recovery at start-up (state_recovery.h).
 #include <gtest/gtest.h>
 
@@ -20,6 +20,7 @@
 #include "server/dispatch_clock.h"
 #include "server/distance_watch.h"
 #include "server/explanation.h"
+#include "server/memory_trim.h"
 #include "server/json_convert.h"
 #include "server/restart_wait.h"
 #include "server/robot_sessions.h"
@@ -365,6 +366,20 @@ TEST(DistanceWatchTest, SamplesAtMostEveryFiftyMillisecondsAndTellsAChange) {
   EXPECT_EQ(watch.closest().a, "R1");
   closest.time = 4.0;  // as close again, later
   EXPECT_TRUE(watch.Update(closest));
+}
+
+TEST(MemoryTrimTest, TrimsAtOnceThenAtMostEveryTenSeconds) {
+  using Clock = MemoryTrim::Clock;
+  const Clock::time_point t0 = Clock::now();
+  MemoryTrim trim;
+  {
+    std::vector<std::unique_ptr<char[]>> blocks;  // something freed for it to give back
+    for (int i = 0; i < 64; ++i) blocks.push_back(std::make_unique<char[]>(64 * 1024));
+  }
+  EXPECT_TRUE(trim.Tick(t0));
+  EXPECT_FALSE(trim.Tick(t0 + std::chrono::seconds(9)));
+  EXPECT_TRUE(trim.Tick(t0 + MemoryTrim::kEvery));
+  EXPECT_FALSE(trim.Tick(t0 + MemoryTrim::kEvery + std::chrono::seconds(1)));
 }
 
 TEST(RobotSessionsTest, AHoldIsTimedUntilTheGrantOrResumeThatEndsIt) {
