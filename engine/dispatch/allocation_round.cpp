@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cctype>
+#include <cmath>
 
 namespace dispatch::engine {
 
@@ -45,7 +46,15 @@ RoundResult RoundRunner::Run(const RoundInput& input) {
   RoundResult out;
   std::vector<FleetRobot> fleet_robots;
   for (const RoundRobot& r : input.robots) fleet_robots.push_back({r.id, r.start, input.now});
-  auto fleet = FleetState::Create(map_, routes_, fleet_robots, config_, zone_index_);
+  // The prediction's buckets start at the round's bucket, not at time 0: the same bucket
+  // times (a whole number of buckets later), without counts for the hours already past (a
+  // round late in a run allocated and cleared zones x buckets since the start).
+  AllocationConfig config = config_;
+  TrafficPredictionConfig& prediction = config.traffic;
+  if (prediction.bucket_seconds > 0.0 && input.now > prediction.origin_time) {
+    prediction.origin_time += std::floor((input.now - prediction.origin_time) / prediction.bucket_seconds) * prediction.bucket_seconds;
+  }
+  auto fleet = FleetState::Create(map_, routes_, fleet_robots, config, zone_index_);
   if (!fleet.ok()) {
     out.notes.push_back("allocation: " + fleet.error().message);
     return out;

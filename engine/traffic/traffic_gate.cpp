@@ -62,6 +62,14 @@ GateImpl::GateImpl(std::shared_ptr<const WarehouseMap> m,
 }
 
 long GateImpl::IndexOf(const GateBot& b, std::uint64_t seq) {
+  // Plans are mostly numbered without gaps: try where seq would be then, before the index.
+  const auto& w = b.plan.waypoints;
+  if (!w.empty()) {
+    const auto first = static_cast<std::uint64_t>(w.front().seq);
+    if (seq >= first && seq - first < w.size() && static_cast<std::uint64_t>(w[seq - first].seq) == seq) {
+      return static_cast<long>(seq - first);
+    }
+  }
   auto it = b.index.find(seq);
   return it == b.index.end() ? -1 : static_cast<long>(it->second);
 }
@@ -249,7 +257,8 @@ std::vector<GateEffect> TrafficGate::Step(double t) {
   // A reconnected robot may still obey a Hold whose Resume was lost with its old stream: it
   // gets a Resume with its horizon (the horizon, not the Hold, is what keeps it safe), and a
   // Hold again if it must still wait.
-  for (auto& [id, b] : s.bots) {
+  for (GateBot* bot : s.in_order) {
+    GateBot& b = *bot;
     if (!b.resume_pending || !b.connected) continue;
     b.resume_pending = false;
     b.held = true;  // sent as a Resume
@@ -257,10 +266,11 @@ std::vector<GateEffect> TrafficGate::Step(double t) {
   }
   s.PlaceStrays();
   s.StepTeams(t, out);
-  for (auto& [id, b] : s.bots) s.StepSolo(b, t, out);
+  for (GateBot* b : s.in_order) s.StepSolo(*b, t, out);
   // Deadlock breaking and nudges re-route standing robots: their legs follow.
   s.ctl.ResolveDeadlocks(t);
-  for (auto& [id, b] : s.bots) {
+  for (GateBot* bot : s.in_order) {
+    GateBot& b = *bot;
     if (!b.team.empty() || !s.OnFloor(b) || !b.connected || b.leg_stale) continue;
     const auto r = static_cast<std::size_t>(b.ctl);
     if (s.ctl.Next(r) == kNoPoint && !s.ctl.RemainingRouteIs(r, b.leg)) s.AdoptRoute(b, t, out);

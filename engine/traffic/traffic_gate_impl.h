@@ -39,6 +39,12 @@ struct GateBot {
   bool synced = false;  // a state report since it connected (its last waypoint is known)
   GatePlan plan;
   std::unordered_map<std::uint64_t, std::size_t> index;  // waypoint sequence -> plan index
+  std::uint64_t plan_version = 0;  // counts the plan's changes (Reindex)
+  // Driving to run_next from plan index run_idx of plan version run_version, clear of the point
+  // behind, it was released everything it may drive to there (StepSolo: nothing to do).
+  PointId run_next = kNoPoint;
+  long run_idx = -2;
+  std::uint64_t run_version = 0;
   long idx = -1;                 // plan index of the last waypoint reached (-1: none)
   std::uint64_t reached_seq = 0;  // highest waypoint sequence reached
   double reach_time = 0.0;        // when it reached idx
@@ -100,6 +106,9 @@ struct GateImpl {
   TrafficController ctl;
   std::map<std::string, GateBot> bots;  // never erased: bot_index points into it
   std::unordered_map<std::string, GateBot*> bot_index;  // bots by id in one hash lookup
+  // bots in id order as a flat array: every step walks all of them (Step, SampleDistances)
+  // without chasing the map's tree nodes.
+  std::vector<GateBot*> in_order;
   GateBot* Find(const std::string& id) {
     auto it = bot_index.find(id);
     return it == bot_index.end() ? nullptr : it->second;
@@ -114,6 +123,9 @@ struct GateImpl {
     GateBot& b = bots[id];
     b.id = id;
     bot_index.emplace(id, &b);
+    in_order.insert(std::lower_bound(in_order.begin(), in_order.end(), id,
+                                     [](const GateBot* x, const std::string& k) { return x->id < k; }),
+                    &b);
     return b;
   }
   std::map<std::string, GateTeam> teams;  // by formation order id

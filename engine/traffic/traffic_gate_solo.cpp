@@ -132,6 +132,7 @@ long GateImpl::RewriteLeg(GateBot& b, long cut, const std::vector<PointId>& rout
 }
 
 void GateImpl::Reindex(GateBot& b) {
+  ++b.plan_version;
   b.index.clear();
   for (std::size_t i = 0; i < b.plan.waypoints.size(); ++i) {
     b.index[static_cast<std::uint64_t>(b.plan.waypoints[i].seq)] = i;
@@ -173,7 +174,13 @@ void GateImpl::StepSolo(GateBot& b, double t, std::vector<GateEffect>& out) {
       b.left = true;
       if (!b.former_team.empty() && !strays.empty()) PlaceStrays();  // a teammate's slot may be at the point it left
     }
+    if (b.left && b.run_next == next && b.run_idx == b.idx && b.run_version == b.plan_version) return;
     Release(b, RunEnd(b, b.idx + 1, next, n), map->IntersectionOf(next), out);
+    if (b.left) {  // released up to the run at next: the same again would change nothing
+      b.run_next = next;
+      b.run_idx = b.idx;
+      b.run_version = b.plan_version;
+    }
     return;
   }
   if (!b.connected || !b.synced) return;
@@ -438,7 +445,8 @@ void GateImpl::SampleDistances(double t) {
   };
   std::vector<Item>& items = distance_items;
   items.clear();
-  for (auto& [id, b] : bots) {
+  for (GateBot* bot : in_order) {
+    GateBot& b = *bot;
     if (!b.has_xy || !b.connected) continue;
     // Off the grid (a pose the floor's margin does not cover): the nearest border cell.
     const Eigen::Vector2d xy = b.xy.cwiseMax(distance_origin).cwiseMin(
