@@ -72,7 +72,7 @@ ReportOutcome DispatchCore::Report(const std::string& id, const Pose& pose, std:
   if (arc_id && *arc_id >= 0 && static_cast<std::size_t>(*arc_id) < map_->arcs().size()) {
     r->robot.current_point = map_->arc(*arc_id).to;
   } else {
-    r->robot.current_point = map_->NearestPoint(pose.position);
+    r->robot.current_point = map_->NearestPointFrom(pose.position, r->robot.current_point);
   }
   if (state && *state != RobotState::kOffline && r->robot.state != RobotState::kFault) r->robot.state = *state;
   if (battery && *battery >= 0.0 && *battery <= 1.0) r->robot.battery = *battery;

@@ -41,9 +41,34 @@ PointGrid::PointGrid(const std::vector<Point>& points) {
   }
   xy_.reserve(ids_.size());
   for (PointId i : ids_) xy_.push_back(points[static_cast<std::size_t>(i)].position);
+  by_id_.reserve(points.size());
+  for (const Point& p : points) by_id_.push_back(p.position);
+  half_gap_.assign(points.size(), 0.0);
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    PointId other = kNoPoint;
+    double gap = 0.0;
+    if (Search(by_id_[i], static_cast<PointId>(i), &other, &gap) && other != kNoPoint) half_gap_[i] = 0.5 * gap;
+  }
+}
+
+bool PointGrid::NearestFrom(const Eigen::Vector2d& xy, PointId hint, PointId* id, double* distance) const {
+  if (hint >= 0 && static_cast<std::size_t>(hint) < half_gap_.size()) {
+    // Any other point q: |xy - q| >= |hint - q| - |xy - hint| >= 2 half_gap - d > d.
+    const double d = (by_id_[static_cast<std::size_t>(hint)] - xy).norm();
+    if (d < half_gap_[static_cast<std::size_t>(hint)] * (1.0 - 1e-9)) {  // a margin for rounding
+      *id = hint;
+      *distance = d;
+      return true;
+    }
+  }
+  return Nearest(xy, id, distance);
 }
 
 bool PointGrid::Nearest(const Eigen::Vector2d& xy, PointId* id, double* distance) const {
+  return Search(xy, kNoPoint, id, distance);
+}
+
+bool PointGrid::Search(const Eigen::Vector2d& xy, PointId exclude, PointId* id, double* distance) const {
   if (ids_.empty() || !xy.allFinite()) return false;
   if (xy.x() < lo_.x() || xy.y() < lo_.y() || xy.x() > hi_.x() || xy.y() > hi_.y()) return false;
   const long cx = std::min(cols_ - 1, static_cast<long>((xy.x() - lo_.x()) * inv_cell_));
@@ -55,6 +80,7 @@ bool PointGrid::Nearest(const Eigen::Vector2d& xy, PointId* id, double* distance
     const auto c = static_cast<std::size_t>(y * cols_ + x);
     for (std::uint32_t k = begin_[c]; k < begin_[c + 1]; ++k) {
       const PointId i = ids_[k];
+      if (i == exclude) continue;
       const double d = (xy_[k] - xy).norm();
       if (d < best || (d == best && i < best_id)) {
         best = d;

@@ -28,6 +28,9 @@ class PointGrid {
   // its distance. False when the grid cannot answer: no points, or xy not finite or outside
   // the points' bounding box (the caller scans instead).
   bool Nearest(const Eigen::Vector2d& xy, PointId* id, double* distance) const;
+  // The same answer, first trying `hint` (the point a moving robot was nearest to last): a
+  // point closer to xy than half the gap to its nearest neighbour is the only nearest one.
+  bool NearestFrom(const Eigen::Vector2d& xy, PointId hint, PointId* id, double* distance) const;
 
  private:
   Eigen::Vector2d lo_ = Eigen::Vector2d::Zero(), hi_ = Eigen::Vector2d::Zero();
@@ -36,6 +39,9 @@ class PointGrid {
   std::vector<std::uint32_t> begin_;  // per cell (row-major), then one past the end
   std::vector<PointId> ids_;          // point ids by cell, ascending within a cell
   std::vector<Eigen::Vector2d> xy_;   // their positions, side by side (no Point read per query)
+  std::vector<Eigen::Vector2d> by_id_;  // positions by point id
+  std::vector<double> half_gap_;        // by point id: half the distance to its nearest other point
+  bool Search(const Eigen::Vector2d& xy, PointId exclude, PointId* id, double* distance) const;
 };
 
 }  // namespace dispatch::engine

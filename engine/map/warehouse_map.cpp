@@ -95,6 +95,13 @@ Result<ArcPosition> WarehouseMap::NearestArcPosition(const Eigen::Vector2d& xy,
   return best_pos;
 }
 
+PointId WarehouseMap::NearestPointFrom(const Eigen::Vector2d& xy, PointId hint) const {
+  PointId id = kNoPoint;
+  double d = 0.0;
+  if (point_grid_.NearestFrom(xy, hint, &id, &d)) return id;
+  return NearestPoint(xy);
+}
+
 PointId WarehouseMap::NearestPoint(const Eigen::Vector2d& xy, std::optional<PointKind> kind,
                                    double* distance) const {
   double best = std::numeric_limits<double>::infinity();

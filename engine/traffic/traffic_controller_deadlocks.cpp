@@ -15,7 +15,7 @@
 namespace dispatch::engine {
 
 std::size_t traffic_detail::RouteQueryHash::operator()(const traffic_detail::RouteQuery& q) const {
-  std::size_t h = std::hash<double>{}(q.bound);
+  std::size_t h = 0;  // the bound is not part of the key
   for (long long v : {static_cast<long long>(q.from), static_cast<long long>(q.to),
                       static_cast<long long>(q.ban_point), static_cast<long long>(q.ban_corridor),
                       static_cast<long long>(q.ban_guard)}) {
@@ -32,9 +32,23 @@ std::size_t traffic_detail::RouteQueryHash::operator()(const traffic_detail::Rou
 Detour TrafficController::Impl::Route(PointId from, PointId to, PointId ban_point, int ban_corridor,
                                       int ban_guard, double bound) {
   const traffic_detail::RouteQuery q{from, to, ban_point, ban_corridor, ban_guard, bound};
-  if (auto known = route_memo.find(q); known != route_memo.end()) return known->second;
-  if (route_memo.size() >= kRouteMemo) route_memo.clear();
-  return route_memo.emplace(q, Search(q)).first->second;
+  if (to == ban_point || from == to) return Search(q);
+  // A* pops in increasing cost (the heuristic is consistent), so a search under any bound
+  // runs as the unbounded one until it stops: it finds the cheapest route when that costs at
+  // most the bound, else none. One answer per query serves every bound (a head-on's bound is
+  // the wait it saves, new at each conflict).
+  auto known = route_memo.find(q);
+  if (known != route_memo.end()) {
+    const traffic_detail::RouteAnswer& a = known->second;
+    if (!a.detour.points.empty()) return a.detour.cost <= bound ? a.detour : Detour{};
+    if (bound <= a.bound) return Detour{};
+  } else if (route_memo.size() >= kRouteMemo) {
+    route_memo.clear();
+  }
+  traffic_detail::RouteAnswer& a = route_memo[q];
+  a.detour = Search(q);
+  a.bound = bound;
+  return a.detour;
 }
 
 // Search: Route without the memo.

@@ -65,11 +65,17 @@ struct Detour {
 struct RouteQuery {
   PointId from, to, ban_point;
   int ban_corridor, ban_guard;
-  double bound;
+  double bound;  // not part of the memo's key (RouteAnswer)
   bool operator==(const RouteQuery& o) const {
     return from == o.from && to == o.to && ban_point == o.ban_point && ban_corridor == o.ban_corridor &&
-           ban_guard == o.ban_guard && bound == o.bound;
+           ban_guard == o.ban_guard;
   }
+};
+// What a search under `bound` found: the cheapest route (then the answer to every bound at
+// least its cost, and none below), or none (the answer to every bound up to this one).
+struct RouteAnswer {
+  Detour detour;
+  double bound = 0.0;
 };
 struct RouteQueryHash {
   std::size_t operator()(const RouteQuery& q) const;
@@ -115,7 +121,7 @@ struct TrafficController::Impl {
   std::uint32_t stamp = 0;
   // Route's recent answers (cleared when full: kRouteMemo entries bound its memory).
   static constexpr std::size_t kRouteMemo = 4096;
-  std::unordered_map<traffic_detail::RouteQuery, Detour, traffic_detail::RouteQueryHash> route_memo;
+  std::unordered_map<traffic_detail::RouteQuery, traffic_detail::RouteAnswer, traffic_detail::RouteQueryHash> route_memo;
 
   const WarehouseMap& M() const { return *map; }
   double ArcTime(ArcId a) const {

@@ -1,6 +1,7 @@
 // PointGrid answers nearest-point queries exactly as a scan in id order would: the nearest
 // point, the lowest id among equally near ones, on random point sets (clustered, on a line,
-// with duplicates) and for queries anywhere in the bounding box, on points and on cell edges.
+// with duplicates) and for queries anywhere in the bounding box, on points and on cell edges;
+// with a hint (NearestFrom) the same answers.
 #include "engine/map/point_grid.h"
 
 #include <gtest/gtest.h>
@@ -54,6 +55,41 @@ TEST(PointGridTest, AgreesWithAScanInIdOrder) {
         const auto [want, want_d] = Scan(points, xy);
         ASSERT_EQ(id, want) << "shape " << shape << " n " << n << " at " << xy.transpose();
         ASSERT_EQ(d, want_d);
+      }
+    }
+  }
+}
+
+TEST(PointGridTest, AHintGivesTheSameAnswerAsTheSearch) {
+  // NearestFrom with any hint (the right point, a neighbour, a far one, none) answers as
+  // Nearest: queries near points (a robot on its way) and anywhere in the box.
+  std::mt19937 rng(11);
+  for (int shape = 0; shape < 4; ++shape) {
+    for (int n : {1, 2, 17, 500}) {
+      const std::vector<Point> points = RandomPoints(rng, n, shape);
+      const PointGrid grid(points);
+      Eigen::Vector2d lo = points[0].position, hi = lo;
+      for (const auto& p : points) lo = lo.cwiseMin(p.position), hi = hi.cwiseMax(p.position);
+      std::uniform_real_distribution<double> ux(lo.x(), hi.x()), uy(lo.y(), hi.y()), jitter(-0.6, 0.6);
+      for (int q = 0; q < 400; ++q) {
+        const Eigen::Vector2d& near = points[rng() % points.size()].position;
+        const Eigen::Vector2d xy = q % 2 == 0 ? Eigen::Vector2d(near + Eigen::Vector2d(jitter(rng), jitter(rng)))
+                                              : Eigen::Vector2d(ux(rng), uy(rng));
+        PointId want = kNoPoint, id = kNoPoint;
+        double want_d = 0, d = 0;
+        const bool answered = grid.Nearest(xy, &want, &want_d);
+        PointId hints[] = {want, static_cast<PointId>(rng() % points.size()), kNoPoint, static_cast<PointId>(n + 3)};
+        for (PointId hint : hints) {
+          const bool got = grid.NearestFrom(xy, hint, &id, &d);
+          if (!answered && got) {  // outside the box the hint may answer; then it is the scan's
+            ASSERT_EQ(id, Scan(points, xy).first) << "shape " << shape << " n " << n;
+            continue;
+          }
+          ASSERT_EQ(got, answered);
+          if (!got) continue;
+          ASSERT_EQ(id, want) << "shape " << shape << " n " << n << " hint " << hint << " at " << xy.transpose();
+          ASSERT_DOUBLE_EQ(d, want_d);
+        }
       }
     }
   }
