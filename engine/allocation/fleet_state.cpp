@@ -12,7 +12,7 @@ Result<FleetState> FleetState::Create(std::shared_ptr<const WarehouseMap> map,
                                       std::shared_ptr<const RouteTable> routes,
                                       const std::vector<FleetRobot>& robots,
                                       const AllocationConfig& config,
-                                      std::shared_ptr<const ZoneIndex> zones) {
+                                      std::shared_ptr<const ZoneIndex> zones, bool publish) {
   if (!map) return InvalidArgument("fleet state: null map");
   if (!routes) return InvalidArgument("fleet state: null route table");
   if (Status s = ValidateAllocationConfig(config); !s.ok()) return s.error();
@@ -51,7 +51,9 @@ Result<FleetState> FleetState::Create(std::shared_ptr<const WarehouseMap> map,
     state.index_.emplace(r.id, state.robots_.size());
     state.robots_.push_back(std::move(e));
   }
-  for (RobotEntry& e : state.robots_) state.Publish(e);
+  if (publish) {
+    for (RobotEntry& e : state.robots_) state.Publish(e);
+  }
   return state;
 }
 

@@ -66,12 +66,14 @@ class FleetState {
   // routes, empty or duplicate robot ids, unknown start points, non-finite ready times, a
   // zone index with another zone count or cell size. `zones`: the predictor's ZoneIndex,
   // built for this map (a previous state's zone_index(), so a state rebuilt every round
-  // does not re-grid the floor); null builds one.
+  // does not re-grid the floor); null builds one. With publish = false the predictor sees
+  // no robot until Publish(robot) (a caller that gives most robots a queue first: their start
+  // alone would be predicted for hold_seconds, then taken back).
   static Result<FleetState> Create(std::shared_ptr<const WarehouseMap> map,
                                    std::shared_ptr<const RouteTable> routes,
                                    const std::vector<FleetRobot>& robots,
                                    const AllocationConfig& config = {},
-                                   std::shared_ptr<const ZoneIndex> zones = nullptr);
+                                   std::shared_ptr<const ZoneIndex> zones = nullptr, bool publish = true);
 
   FleetState(FleetState&&) = default;
   FleetState& operator=(FleetState&&) = default;

@@ -54,17 +54,18 @@ RoundResult RoundRunner::Run(const RoundInput& input) {
   if (prediction.bucket_seconds > 0.0 && input.now > prediction.origin_time) {
     prediction.origin_time += std::floor((input.now - prediction.origin_time) / prediction.bucket_seconds) * prediction.bucket_seconds;
   }
-  auto fleet = FleetState::Create(map_, routes_, fleet_robots, config, zone_index_);
+  auto fleet = FleetState::Create(map_, routes_, fleet_robots, config, zone_index_, /*publish=*/false);
   if (!fleet.ok()) {
     out.notes.push_back("allocation: " + fleet.error().message);
     return out;
   }
   FleetState state = std::move(fleet).value();
   zone_index_ = state.zone_index();  // one floor, one index: the next round skips the grid
+  // The predictor sees each robot once: its replayed queue (not once per order, nor its
+  // start first), or its start.
   for (std::size_t i = 0; i < input.robots.size(); ++i) {
-    if (input.robots[i].assignment.order_ids.empty()) continue;
-    ReplayQueue(state, i, input.robots[i], out.notes);
-    state.Publish(i);  // the predictor sees the queue once, not once per order
+    if (!input.robots[i].assignment.order_ids.empty()) ReplayQueue(state, i, input.robots[i], out.notes);
+    state.Publish(i);
   }
   std::vector<bool> queued(input.robots.size());  // has orders (before or from this round)
   for (std::size_t i = 0; i < input.robots.size(); ++i) queued[i] = !input.robots[i].assignment.order_ids.empty();
