@@ -138,13 +138,16 @@ struct GateImpl {
   // position (clamped onto the grid), 1 m cell, index and team keys once needed; the grid over
   // the floor (built on first use) with a list head per cell and a next link per robot.
   struct DistanceItem {
-    Eigen::Vector2d xy;
-    long long cell;
-    std::size_t order;
+    Eigen::Vector2d xy;  // the robot's position (not clamped)
+    long long cx, cy;    // its cell
     const GateBot* bot;
-    mutable std::optional<GateTeamKeys> keys;
   };
   std::vector<DistanceItem> distance_items;
+  // Per item, its team keys once a close pair needed them (valid while the stamp is the
+  // sample's).
+  std::vector<GateTeamKeys> distance_keys;
+  std::vector<std::uint32_t> distance_keys_stamp;
+  std::uint32_t distance_stamp = 0;
   Eigen::Vector2d distance_origin = Eigen::Vector2d::Zero();
   std::size_t distance_cols = 0, distance_rows = 0;
   std::vector<int> distance_head, distance_next;

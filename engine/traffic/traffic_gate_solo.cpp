@@ -424,25 +424,7 @@ void GateImpl::SampleDistances(double t) {
     distance_rows = static_cast<std::size_t>(std::ceil(hi.y() - distance_origin.y())) + 3;
     distance_head.assign(distance_cols * distance_rows, -1);
   }
-  auto cell_of = [&](const Eigen::Vector2d& xy, long long dx, long long dy) -> long long {
-    const long long cx = static_cast<long long>(std::floor(xy.x() - distance_origin.x())) + dx;
-    const long long cy = static_cast<long long>(std::floor(xy.y() - distance_origin.y())) + dy;
-    if (cx < 0 || cy < 0 || cx >= static_cast<long long>(distance_cols) || cy >= static_cast<long long>(distance_rows)) {
-      return -1;
-    }
-    return cy * static_cast<long long>(distance_cols) + cx;
-  };
-  auto keys_of = [this](const Item& i) -> const GateTeamKeys& {
-    if (!i.keys) i.keys = TeamKeys(*i.bot);
-    return *i.keys;
-  };
-  auto same_agent = [&](const Item& a, const Item& b) {
-    const GateTeamKeys& kb = keys_of(b);
-    for (const std::string& x : keys_of(a)) {
-      if (!x.empty() && std::find(kb.begin(), kb.end(), x) != kb.end()) return true;
-    }
-    return false;
-  };
+  const auto cols = static_cast<long long>(distance_cols), rows = static_cast<long long>(distance_rows);
   std::vector<Item>& items = distance_items;
   items.clear();
   for (GateBot* bot : in_order) {
@@ -451,28 +433,51 @@ void GateImpl::SampleDistances(double t) {
     // Off the grid (a pose the floor's margin does not cover): the nearest border cell.
     const Eigen::Vector2d xy = b.xy.cwiseMax(distance_origin).cwiseMin(
         distance_origin + Eigen::Vector2d(static_cast<double>(distance_cols) - 1e-6, static_cast<double>(distance_rows) - 1e-6));
-    items.push_back({xy, cell_of(xy, 0, 0), items.size(), &b, std::nullopt});
+    const long long cx = std::clamp(static_cast<long long>(std::floor(xy.x() - distance_origin.x())), 0LL, cols - 1);
+    const long long cy = std::clamp(static_cast<long long>(std::floor(xy.y() - distance_origin.y())), 0LL, rows - 1);
+    items.push_back({b.xy, cx, cy, &b});
   }
+  if (++distance_stamp == 0) {
+    std::fill(distance_keys_stamp.begin(), distance_keys_stamp.end(), 0);
+    distance_stamp = 1;
+  }
+  if (distance_keys.size() < items.size()) {
+    distance_keys.resize(items.size());
+    distance_keys_stamp.resize(items.size(), 0);
+  }
+  auto keys_of = [this](std::size_t k) -> const GateTeamKeys& {
+    if (distance_keys_stamp[k] != distance_stamp) {
+      distance_keys[k] = TeamKeys(*distance_items[k].bot);
+      distance_keys_stamp[k] = distance_stamp;
+    }
+    return distance_keys[k];
+  };
+  auto same_agent = [&](std::size_t a, std::size_t b) {
+    const GateTeamKeys& kb = keys_of(b);
+    for (const std::string& x : keys_of(a)) {
+      if (!x.empty() && std::find(kb.begin(), kb.end(), x) != kb.end()) return true;
+    }
+    return false;
+  };
   distance_next.assign(items.size(), -1);
-  for (const Item& me : items) {
-    const auto c = static_cast<std::size_t>(me.cell);
-    const Eigen::Vector2d& xy = me.xy;
-    for (long long dx = -1; dx <= 1; ++dx) {
-      for (long long dy = -1; dy <= 1; ++dy) {
-        const long long n = cell_of(xy, dx, dy);
-        if (n < 0) continue;
-        for (int j = distance_head[static_cast<std::size_t>(n)]; j >= 0; j = distance_next[static_cast<std::size_t>(j)]) {
-          const Item& o = items[static_cast<std::size_t>(j)];
-          const double d = (o.bot->xy - me.bot->xy).norm();
-          if (d >= min_distance.distance || same_agent(o, me)) continue;
-          min_distance = {d, o.bot->id, me.bot->id, t};
+  for (std::size_t k = 0; k < items.size(); ++k) {
+    const Item& me = items[k];
+    for (long long x = std::max(me.cx - 1, 0LL); x <= std::min(me.cx + 1, cols - 1); ++x) {
+      for (long long y = std::max(me.cy - 1, 0LL); y <= std::min(me.cy + 1, rows - 1); ++y) {
+        for (int j = distance_head[static_cast<std::size_t>(y * cols + x)]; j >= 0;
+             j = distance_next[static_cast<std::size_t>(j)]) {
+          const auto jo = static_cast<std::size_t>(j);
+          const double d = (items[jo].xy - me.xy).norm();
+          if (d >= min_distance.distance || same_agent(jo, k)) continue;
+          min_distance = {d, items[jo].bot->id, me.bot->id, t};
         }
       }
     }
-    distance_next[me.order] = distance_head[c];  // the earlier robots only: each pair once
-    distance_head[c] = static_cast<int>(me.order);
+    const auto c = static_cast<std::size_t>(me.cy * cols + me.cx);
+    distance_next[k] = distance_head[c];  // the earlier robots only: each pair once
+    distance_head[c] = static_cast<int>(k);
   }
-  for (const Item& me : items) distance_head[static_cast<std::size_t>(me.cell)] = -1;
+  for (const Item& me : items) distance_head[static_cast<std::size_t>(me.cy * cols + me.cx)] = -1;
 }
 
 }  // namespace dispatch::engine
