@@ -13,7 +13,9 @@
 //  3. Every robot advances to t and reports (arrivals, picks, drops, then a state report);
 //     the core's changes are applied and its messages delivered at once (no network).
 //  4. The gate steps (grants, holds, re-plans); a blocked robot gives its orders back (started
-//     ones fail, the others are re-allocated) and stays where it stands, in fault.
+//     ones fail, the others are re-allocated) and stays where it stands, in fault, for
+//     blocked_recovery seconds (CoreOptions::blocked_recovery; then it is idle again, listed in
+//     StreamResult::recovered).
 // Orders not finished by max_time fail ("not finished by ...").
 //
 // StreamResult: per order, the leader (robots[0] of the award), the team, completion time or
