@@ -77,7 +77,7 @@ void Simulate(benchmark::State& state, double formation_share, bool on_core = fa
   config.record_series = false;
   double simulated = 0;
   std::size_t completed = 0, total = 0, deadlocks = 0, replans = 0, blocked = 0;
-  double waiting = 0.0, completion = 0.0, recovered = 0.0;
+  double waiting = 0.0, completion = 0.0, recovered = 0.0, head_on = 0.0;
   for (auto _ : state) {
     auto r = on_core ? SimulateOnCore(f.map, f.routes, *robots, *orders, config)
                      : SimulateOrderStream(f.map, f.routes, *robots, *orders, config);
@@ -91,6 +91,7 @@ void Simulate(benchmark::State& state, double formation_share, bool on_core = fa
     waiting += r->total_waiting_time;
     completion += r->mean_completion;
     recovered += static_cast<double>(r->recovered.size());
+    head_on += static_cast<double>(r->traffic.head_on_conflicts);
   }
   state.counters["speedup"] = benchmark::Counter(simulated, benchmark::Counter::kIsRate);
   state.counters["completed"] = static_cast<double>(completed) / static_cast<double>(state.iterations());
@@ -101,6 +102,7 @@ void Simulate(benchmark::State& state, double formation_share, bool on_core = fa
   // Robot-seconds held by the traffic control, and the mean release-to-completion time (s).
   state.counters["waiting"] = waiting / static_cast<double>(state.iterations());
   state.counters["mean_done"] = completion / static_cast<double>(state.iterations());
+  state.counters["head_on"] = head_on / static_cast<double>(state.iterations());
   if (on_core) state.counters["recovered"] = recovered / static_cast<double>(state.iterations());
 }
 
