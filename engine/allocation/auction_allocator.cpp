@@ -147,10 +147,10 @@ double AuctionAllocator::FlowBound(const FleetState& state, std::size_t robot, P
                                    RouteSampler& sampler,
                                    TrafficPredictor::DensityAccumulator& density,
                                    const ZoneRun* runs, std::size_t run_count,
-                                   const double* times) {
+                                   const double* times, double known_to_go) {
   const QueueSummary& s = state.summary(robot);
   const TrafficPredictor& predictor = state.predictor();
-  const double to_go = sampler.TimeToTarget(s.end_point, first);
+  const double to_go = known_to_go >= 0.0 ? known_to_go : sampler.TimeToTarget(s.end_point, first);
   if (!std::isfinite(to_go)) return 0.0;  // priced in time order, found unreachable there
   density.Reset(state.prediction(robot));
   // The leg's first sample exactly: its start point when it leaves (AddLegSamples' first).
@@ -171,6 +171,11 @@ double AuctionAllocator::FlowBound(const FleetState& state, std::size_t robot, P
     }
   }
   return density.Flow();
+}
+
+bool AuctionAllocator::CostsAreSampledTimes(const RouteTable& routes, double speed) {
+  const RouteTableBuildInfo info = routes.build_info();
+  return info.method == "lazy" && !info.turn_expanded && info.speed == speed;
 }
 
 RouteSampler& AuctionAllocator::Sampler(const FleetState& state) {
@@ -250,6 +255,10 @@ std::vector<Bid> AuctionAllocator::ComputeBids(const FleetState& state, const Pl
   const PointId first = task.picks.front();
   std::vector<Bid> bids;
   bids.reserve(state.robot_count());
+  // The flow bound needs each robot's time to the first pick: its leg's cost when the table's
+  // costs are the sampler's times (then the same value), else the sampler's walk.
+  const bool legs_are_times = CostsAreSampledTimes(routes, c.speed);
+  legs_.assign(state.robot_count(), -1.0);
   for (std::size_t i = 0; i < state.robot_count(); ++i) {
     const QueueSummary& s = state.summary(i);
     if (!state.HasRoom(i)) {
@@ -257,6 +266,7 @@ std::vector<Bid> AuctionAllocator::ComputeBids(const FleetState& state, const Pl
       continue;
     }
     const double leg = routes.Cost(s.end_point, first);
+    if (legs_are_times && std::isfinite(leg)) legs_[i] = leg;
     if (!std::isfinite(leg) || !std::isfinite(task_travel)) {
       bids.push_back(UnreachableBid(state.robot_id(i), s.end_time));
       continue;
@@ -272,7 +282,7 @@ std::vector<Bid> AuctionAllocator::ComputeBids(const FleetState& state, const Pl
   // The lower bound of F: the leg's first sample and some of the order's own route.
   auto bound = [&](std::size_t i) {
     return FlowBound(state, i, first, sampler, density, shared_runs_.data(), shared_runs_.size(),
-                     shared_times_.data());
+                     shared_times_.data(), legs_[i]);
   };
   PriceLowest(c, bids, keep, bound, [&](std::size_t i) {
     const QueueSummary& s = state.summary(i);

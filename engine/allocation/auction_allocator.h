@@ -54,6 +54,11 @@ class AuctionAllocator final : public Allocator {
   std::vector<Bid> ComputeReachBids(const FleetState& state, PointId first_pick,
                                     std::size_t keep = 0);
 
+  // True when the table's costs are exactly the sampler's travel times: a lazy table (double
+  // sums, from the destination outward as RouteSampler::TimeToTarget adds them), no turn
+  // penalty, the allocation's speed.
+  static bool CostsAreSampledTimes(const RouteTable& routes, double speed);
+
  private:
   // Feeds the samples of the leg from -> to (leaving at `depart`: RouteSampler::AppendLeg's
   // samples) to `density`; returns the arrival time (+infinity if unreachable). A sample on
@@ -90,14 +95,16 @@ class AuctionAllocator final : public Allocator {
   // A lower bound of robot `robot`'s F over samples of its leg to `first` and of the runs
   // (their times in `times`, from t = 0 at the first pick) shifted to its arrival (see
   // FlowBound in the .cpp).
+  // `to_go`: the robot's time to `first` when known (< 0: the sampler walks its route).
   double FlowBound(const FleetState& state, std::size_t robot, PointId first,
                    RouteSampler& sampler, TrafficPredictor::DensityAccumulator& density,
-                   const ZoneRun* runs, std::size_t run_count, const double* times);
+                   const ZoneRun* runs, std::size_t run_count, const double* times, double to_go = -1.0);
 
   std::vector<std::pair<double, std::size_t>> order_;  // PriceLowest's heap of (bound, robot)
   std::vector<double> flow_bounds_;  // PriceLowest's bound(i) per robot (0 until taken)
   std::vector<bool> bounded_;        // PriceLowest: bound(i) taken
   std::vector<double> kept_;        // PriceLowest's k lowest full bids, ascending
+  std::vector<double> legs_;        // ComputeBids: per robot its route cost to the first pick
 
   struct MixedSample {
     double f = std::numeric_limits<double>::quiet_NaN();  // NaN: empty (never equal)

@@ -96,6 +96,7 @@ Result<MapCostGraph> BuildMapCostGraph(const WarehouseMap& map, const RouteTable
   MapCostGraph g;
   g.point_count = map.point_count();
   g.expanded = options.turn_penalty_s > 0.0;
+  g.speed = options.speed;
   std::vector<CostArc> cost_arcs;
   std::size_t vertex_count = g.point_count;
   if (!g.expanded) {

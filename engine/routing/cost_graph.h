@@ -72,6 +72,7 @@ struct MapCostGraph {
   CostGraph graph;
   std::size_t point_count = 0;
   bool expanded = false;        // turn penalty: the arc-expanded graph described above
+  double speed = 0.0;           // the cruise speed of its arc costs
   std::vector<ArcId> map_arc;   // per graph arc: the map arc it drives along
 
   bool IsPointVertex(VertexId v) const { return static_cast<std::size_t>(v) < point_count; }

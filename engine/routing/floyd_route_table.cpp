@@ -94,7 +94,8 @@ RouteTableBuildInfo FloydRouteTable::build_info() const {
           graph_.graph.arc_count(),
           graph_.expanded,
           table_.bytes() + point_cost_.size() * sizeof(float) +
-              point_arrival_.size() * sizeof(VertexId)};
+              point_arrival_.size() * sizeof(VertexId),
+          graph_.speed};
 }
 
 }  // namespace dispatch::engine

@@ -110,7 +110,7 @@ Result<Route> LazyRouteTable::Path(PointId from, PointId to) const {
 
 RouteTableBuildInfo LazyRouteTable::build_info() const {
   return {"lazy", graph_.point_count, graph_.graph.vertex_count(), graph_.graph.arc_count(),
-          graph_.expanded, cache_bytes_};
+          graph_.expanded, cache_bytes_, graph_.speed};
 }
 
 std::size_t LazyRouteTable::cached_destinations() const {

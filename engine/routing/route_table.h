@@ -39,6 +39,7 @@ struct RouteTableBuildInfo {
   std::size_t arc_count = 0;       // searched graph arcs
   bool turn_expanded = false;      // the arc-expanded graph is used (turn_penalty_s > 0)
   std::size_t table_bytes = 0;     // dense tables; for lazy: the cache bound
+  double speed = 0.0;              // the cruise speed of its costs (0: not known)
 };
 
 class RouteTable {

@@ -4,7 +4,9 @@
 // end to the first pick, then the order's own route from the arrival), every sample priced by
 // TrafficPredictor::Density (ZoneAt + CountAt of the other robots). Every field of every Bid
 // must be equal (==, no tolerance) on random fleets of grid floors and the Chu2024 floor,
-// under several prediction / sampling settings, round after round of awards.
+// under several prediction / sampling settings, round after round of awards. On a lazy route
+// table the flow bounds take each robot's leg cost as its time to the first pick: the costs are
+// checked to be the sampler's times, and the pruned awards the same as with the sampler's walk.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -267,6 +269,61 @@ TEST(AuctionEquivalenceTest, OddSpacingGridMatchesReference) {
 
 TEST(AuctionEquivalenceTest, Chu2024FloorMatchesReference) {
   CheckFloor(Chu2024(), "chu2024", 18, 15, 400);
+}
+
+// A route table that answers as `inner` but tells nothing of how it was built (so the auction
+// walks the sampler for every robot's time to the first pick).
+class OpaqueRoutes : public RouteTable {
+ public:
+  explicit OpaqueRoutes(std::shared_ptr<const RouteTable> inner) : inner_(std::move(inner)) {}
+  std::size_t point_count() const override { return inner_->point_count(); }
+  double Cost(PointId from, PointId to) const override { return inner_->Cost(from, to); }
+  PointId NextHop(PointId from, PointId to) const override { return inner_->NextHop(from, to); }
+  Result<Route> Path(PointId from, PointId to) const override { return inner_->Path(from, to); }
+  std::string_view method() const override { return "opaque"; }
+
+ private:
+  std::shared_ptr<const RouteTable> inner_;
+};
+
+TEST(AuctionEquivalenceTest, ALazyTablesCostsAreTheSamplersTimesAndItsAwardsTheSame) {
+  const Floor floor = TiledGridFloor(40, 10, 1);
+  RouteTableOptions options;
+  options.method = RouteTableMethod::kLazy;
+  auto made = MakeRouteTable(floor.map, options);
+  ASSERT_TRUE(made.ok()) << made.error().message;
+  const std::shared_ptr<const RouteTable> lazy = std::move(made).value();
+  const auto opaque = std::make_shared<const OpaqueRoutes>(lazy);
+  EXPECT_TRUE(AuctionAllocator::CostsAreSampledTimes(*lazy, 1.0));
+  EXPECT_FALSE(AuctionAllocator::CostsAreSampledTimes(*lazy, 2.0));
+  EXPECT_FALSE(AuctionAllocator::CostsAreSampledTimes(*opaque, 1.0));
+  EXPECT_FALSE(AuctionAllocator::CostsAreSampledTimes(*floor.routes, 1.0));  // a dense table
+  std::mt19937 rng(500);
+  RouteSampler sampler(*floor.map, *lazy, 1.0, 0.5);
+  for (int k = 0; k < 400; ++k) {
+    const auto from = static_cast<PointId>(rng() % floor.map->point_count());
+    const auto to = static_cast<PointId>(rng() % floor.map->point_count());
+    ASSERT_EQ(sampler.TimeToTarget(from, to), lazy->Cost(from, to)) << from << " -> " << to;
+  }
+  // The same fleet on both tables, rounds of pruned auctions (only bids that can win priced).
+  std::vector<FleetRobot> robots;
+  for (int i = 0; i < 60; ++i) {
+    robots.push_back({"R" + std::to_string(i + 1), static_cast<PointId>(rng() % floor.map->point_count()),
+                      0.5 * static_cast<double>(rng() % 20)});
+  }
+  FleetState a = testing_util::MakeFleet(floor.map, lazy, robots);
+  FleetState b = testing_util::MakeFleet(floor.map, opaque, robots);
+  AuctionAllocator on_lazy, on_opaque;
+  for (int k = 0; k < 20; ++k) {
+    const Order order = RandomOrder(floor, rng, k);
+    auto got = on_lazy.Allocate(order, a);
+    auto want = on_opaque.Allocate(order, b);
+    ASSERT_TRUE(got.ok() && want.ok()) << k;
+    const std::string where = "round " + std::to_string(k);
+    EXPECT_EQ(got->winners, want->winners) << where;
+    ExpectSameBids(got->bids, want->bids, where);
+    ExpectSameBids(got->companion_bids, want->companion_bids, where + " companions");
+  }
 }
 
 }  // namespace
