@@ -62,13 +62,11 @@ GateImpl::GateImpl(std::shared_ptr<const WarehouseMap> m,
 }
 
 long GateImpl::IndexOf(const GateBot& b, std::uint64_t seq) {
-  // Plans are mostly numbered without gaps: try where seq would be then, before the index.
-  const auto& w = b.plan.waypoints;
-  if (!w.empty()) {
+  if (b.gapless) {
+    const auto& w = b.plan.waypoints;
+    if (w.empty()) return -1;
     const auto first = static_cast<std::uint64_t>(w.front().seq);
-    if (seq >= first && seq - first < w.size() && static_cast<std::uint64_t>(w[seq - first].seq) == seq) {
-      return static_cast<long>(seq - first);
-    }
+    return seq >= first && seq - first < w.size() ? static_cast<long>(seq - first) : -1;
   }
   auto it = b.index.find(seq);
   return it == b.index.end() ? -1 : static_cast<long>(it->second);

@@ -134,9 +134,14 @@ long GateImpl::RewriteLeg(GateBot& b, long cut, const std::vector<PointId>& rout
 void GateImpl::Reindex(GateBot& b) {
   ++b.plan_version;
   b.index.clear();
-  for (std::size_t i = 0; i < b.plan.waypoints.size(); ++i) {
-    b.index[static_cast<std::uint64_t>(b.plan.waypoints[i].seq)] = i;
-    b.plan.next_sequence = std::max<std::uint64_t>(b.plan.next_sequence, b.plan.waypoints[i].seq + 1);
+  const auto& w = b.plan.waypoints;
+  b.gapless = true;
+  for (std::size_t i = 0; i < w.size(); ++i) {
+    if (w[i].seq < 0 || w[i].seq != w.front().seq + static_cast<int>(i)) b.gapless = false;
+    b.plan.next_sequence = std::max<std::uint64_t>(b.plan.next_sequence, w[i].seq + 1);
+  }
+  if (!b.gapless) {  // the map only for plans with gaps (no node allocations per plan change)
+    for (std::size_t i = 0; i < w.size(); ++i) b.index[static_cast<std::uint64_t>(w[i].seq)] = i;
   }
   b.spans.clear();
   for (const auto& team : b.plan.teams) b.spans.emplace(team.first, FindSpan(b, team.first));
