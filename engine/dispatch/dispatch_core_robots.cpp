@@ -38,10 +38,12 @@ std::vector<RobotCommand> DispatchCore::Connect(Robot robot, double /*now*/) {
   r.robot = std::move(robot);
   r.robot.task_queue = r.has_assignment ? r.assignment.order_ids : std::vector<std::string>{};
   r.connected = true;
+  const bool was_blocked = r.blocked_at >= 0.0;
   r.blocked_at = -1.0;  // a Hello ends a block's fault (Recover drops it from blocked_)
   allocation_due_ = true;
   if (gate_) {
     gate_->Connect(id, r.robot.pose.position, r.robot.current_point);
+    if (was_blocked) gate_->Unblock(id);
     SyncGate(r);
   }
   if (!r.has_assignment || r.assignment.order_ids.empty()) return {};
@@ -234,6 +236,7 @@ void DispatchCore::Recover(double now, StepOutcome& out) {
     }
     r->robot.state = RobotState::kIdle;
     r->blocked_at = -1.0;
+    gate_->Unblock(r->robot.id);
     allocation_due_ = true;
     out.recovered.push_back(r->robot.id);
     char note[160];

@@ -227,6 +227,13 @@ void TrafficGate::SetPlan(const std::string& robot, GatePlan plan) {
   s.SyncTeams(b);
 }
 
+void TrafficGate::Unblock(const std::string& robot) {
+  GateBot* b = impl_->Find(robot);
+  if (!b) return;
+  b->blocked = false;
+  if (b->team.empty() && impl_->OnFloor(*b)) impl_->ctl.WaitOn(static_cast<std::size_t>(b->ctl), -1, 0.0, {});
+}
+
 void TrafficGate::Reached(const std::string& robot, std::uint64_t sequence, double t,
                           const std::optional<Eigen::Vector2d>& xy) {
   GateBot* bot = impl_->Find(robot);

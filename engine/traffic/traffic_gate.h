@@ -123,6 +123,9 @@ class TrafficGate {
   void Disconnect(const std::string& robot);
   // The robot's plan changed (award, cancel, drop trimmed, restart).
   void SetPlan(const std::string& robot, GatePlan plan);
+  // A robot reported blocked (kBlocked) is in service again: its next wait is a new one (timed
+  // from its start, reported blocked again after blocked_after).
+  void Unblock(const std::string& robot);
   // The robot arrived at waypoint `sequence`; `xy`, the pose it reported with the arrival, is
   // where it is seen from then on (a state report may be up to a report interval older, and
   // the minimum distance must not pair one robot's fresh position with another's stale one).
