@@ -231,7 +231,6 @@ void TrafficGate::Unblock(const std::string& robot) {
   GateBot* b = impl_->Find(robot);
   if (!b) return;
   b->blocked = false;
-  if (b->team.empty() && impl_->OnFloor(*b)) impl_->ctl.WaitOn(static_cast<std::size_t>(b->ctl), -1, 0.0, {});
 }
 
 void TrafficGate::Reached(const std::string& robot, std::uint64_t sequence, double t,
