@@ -22,6 +22,12 @@ namespace traffic_detail {
 inline constexpr double kInf = std::numeric_limits<double>::infinity();
 enum class WaitKind { kNone, kPoint, kCorridor, kGrant };
 
+// The facts a wait's reason is formatted from (site, and up to three ids); site 0: none.
+struct WhyKey {
+  int site = 0, a = -1, b = -1, c = -1;
+  bool operator==(const WhyKey&) const = default;
+};
+
 struct RobotState {
   std::string id;
   PointId at = kNoPoint;
@@ -47,6 +53,9 @@ struct RobotState {
   int wait_corridor = -1;
   int head_on_decided = -1;  // corridor whose head-on was decided in this wait
   std::string why;
+  // What `why` was formatted from when a keyed wait wrote it (WaitFor): the same key again
+  // leaves the text as it is (a waiting robot asks every step); any other write clears it.
+  WhyKey why_key;
 };
 
 struct CorridorState {
@@ -88,6 +97,7 @@ using traffic_detail::Detour;
 using traffic_detail::kInf;
 using traffic_detail::RobotState;
 using traffic_detail::WaitKind;
+using traffic_detail::WhyKey;
 
 struct TrafficController::Impl {
   std::shared_ptr<const WarehouseMap> map;
@@ -164,6 +174,15 @@ struct TrafficController::Impl {
   void OccupyGuard(std::size_t r, int g);
   void ClearWait(RobotState& x);
   TrafficDecision Wait(std::size_t r, WaitKind kind, int on, double t, std::string why);
+  // Wait with a reason made by `why()` only when `key` differs from the one it was last made
+  // from (the text depends on the key alone).
+  template <typename Why>
+  TrafficDecision WaitFor(std::size_t r, WaitKind kind, int on, double t, const WhyKey& key, Why why) {
+    RobotState& x = robots[r];
+    if (x.why_key == key) return Wait(r, kind, on, t, std::move(x.why), key);
+    return Wait(r, kind, on, t, why(), key);
+  }
+  TrafficDecision Wait(std::size_t r, WaitKind kind, int on, double t, std::string why, const WhyKey& key);
 
   double RouteCost(const RobotState& x) const;
   double ClearTime(std::size_t h, int c, double now) const;

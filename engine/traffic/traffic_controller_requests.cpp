@@ -100,7 +100,13 @@ void TrafficController::Impl::ClearWait(RobotState& x) {
 
 TrafficDecision TrafficController::Impl::Wait(std::size_t r, WaitKind kind, int on, double t,
                                               std::string why) {
+  return Wait(r, kind, on, t, std::move(why), WhyKey{});
+}
+
+TrafficDecision TrafficController::Impl::Wait(std::size_t r, WaitKind kind, int on, double t, std::string why,
+                                              const WhyKey& key) {
   RobotState& x = robots[r];
+  x.why_key = key;
   if (x.wait == WaitKind::kNone) {
     x.wait_start = t;
     x.next_detour_try = 0.0;
@@ -192,14 +198,15 @@ TrafficDecision TrafficController::Impl::HeadOn(std::size_t r, int c, int oncomi
       return TrafficDecision::kReplanned;
     }
   }
-  return Wait(r, WaitKind::kCorridor, oncoming, t,
-              "head-on: corridor held by " + robots[static_cast<std::size_t>(oncoming)].id);
+  return WaitFor(r, WaitKind::kCorridor, oncoming, t, WhyKey{1, oncoming},
+                 [&] { return "head-on: corridor held by " + robots[static_cast<std::size_t>(oncoming)].id; });
 }
 
 TrafficDecision TrafficController::Impl::Request(std::size_t r, double t) {
   RobotState& x = robots[r];
   if (x.removed || x.next != kNoPoint || x.pos + 1 >= x.route.size()) {
     x.why = "nothing to request";
+    x.why_key = {};
     return TrafficDecision::kWait;
   }
   const PointId q = x.route[x.pos + 1];
@@ -222,6 +229,7 @@ TrafficDecision TrafficController::Impl::Request(std::size_t r, double t) {
     std::snprintf(buf, sizeof buf, "blocked after waiting %.0f s at %s with no alternative: ",
                   waited, M().point(x.at).name.c_str());
     x.why = buf + x.why;
+    x.why_key = {};
     return TrafficDecision::kBlocked;
   }
   return TrafficDecision::kWait;
@@ -258,8 +266,8 @@ TrafficDecision TrafficController::Impl::Check(std::size_t r, PointId q, double 
   const int blocker = PointBlocker(q, r);
   if (blocker >= 0) {
     x.wait_point = q;
-    return Wait(r, WaitKind::kPoint, blocker, t,
-                "point " + Name(q) + " held by " + robots[static_cast<std::size_t>(blocker)].id);
+    return WaitFor(r, WaitKind::kPoint, blocker, t, WhyKey{2, q, blocker},
+                   [&] { return "point " + Name(q) + " held by " + robots[static_cast<std::size_t>(blocker)].id; });
   }
   for (std::size_t k = x.pos; k < x.arcs.size() && k < x.pos + 2; ++k) {
     const int c = CorridorOf(x.arcs[k]);
@@ -283,10 +291,12 @@ TrafficDecision TrafficController::Impl::Check(std::size_t r, PointId q, double 
     ReleaseGuard(r);
     const RobotState& o = robots[static_cast<std::size_t>(w)];
     x.wait_point = o.at;
-    return Wait(r, WaitKind::kPoint, w, t,
-                (entering && o.at == exit ? "exit of " + M().intersections()[static_cast<std::size_t>(g)].name + ": "
-                                          : std::string("no turn-off before ")) +
-                    Name(o.at) + " held by " + o.id + " at work");
+    const bool at_exit = entering && o.at == exit;
+    return WaitFor(r, WaitKind::kPoint, w, t, WhyKey{3, w, o.at, at_exit ? g : -1}, [&] {
+      return (at_exit ? "exit of " + M().intersections()[static_cast<std::size_t>(g)].name + ": "
+                      : std::string("no turn-off before ")) +
+             Name(o.at) + " held by " + o.id + " at work";
+    });
   }
   if (entering) {
     if (x.guard != g) {
@@ -300,8 +310,8 @@ TrafficDecision TrafficController::Impl::Check(std::size_t r, PointId q, double 
       const auto holders = grants.Holders(static_cast<std::size_t>(g));
       int on = -1;
       if (!holders.empty()) on = static_cast<int>(index.at(holders.front()));
-      return Wait(r, WaitKind::kGrant, on, t,
-                  "waiting for a grant at " + M().intersections()[static_cast<std::size_t>(g)].name);
+      return WaitFor(r, WaitKind::kGrant, on, t, WhyKey{4, g},
+                     [&] { return "waiting for a grant at " + M().intersections()[static_cast<std::size_t>(g)].name; });
     }
     if (!x.granted) {
       x.granted = true;
