@@ -52,16 +52,20 @@ PointGrid::PointGrid(const std::vector<Point>& points) {
 }
 
 bool PointGrid::NearestFrom(const Eigen::Vector2d& xy, PointId hint, PointId* id, double* distance) const {
-  if (hint >= 0 && static_cast<std::size_t>(hint) < half_gap_.size()) {
-    // Any other point q: |xy - q| >= |hint - q| - |xy - hint| >= 2 half_gap - d > d.
-    const double d = (by_id_[static_cast<std::size_t>(hint)] - xy).norm();
-    if (d < half_gap_[static_cast<std::size_t>(hint)] * (1.0 - 1e-9)) {  // a margin for rounding
-      *id = hint;
-      *distance = d;
-      return true;
-    }
+  if (Owns(xy, hint, distance)) {
+    *id = hint;
+    return true;
   }
   return Nearest(xy, id, distance);
+}
+
+bool PointGrid::Owns(const Eigen::Vector2d& xy, PointId p, double* distance) const {
+  if (p < 0 || static_cast<std::size_t>(p) >= half_gap_.size()) return false;
+  // Any other point q: |xy - q| >= |p - q| - |xy - p| >= 2 half_gap - d > d.
+  const double d = (by_id_[static_cast<std::size_t>(p)] - xy).norm();
+  if (!(d < half_gap_[static_cast<std::size_t>(p)] * (1.0 - 1e-9))) return false;  // a margin for rounding
+  *distance = d;
+  return true;
 }
 
 bool PointGrid::Nearest(const Eigen::Vector2d& xy, PointId* id, double* distance) const {

@@ -31,6 +31,9 @@ class PointGrid {
   // The same answer, first trying `hint` (the point a moving robot was nearest to last): a
   // point closer to xy than half the gap to its nearest neighbour is the only nearest one.
   bool NearestFrom(const Eigen::Vector2d& xy, PointId hint, PointId* id, double* distance) const;
+  // True when `p` is certainly the only nearest point to xy (closer than half the gap to its
+  // nearest neighbour), with its distance; false says nothing.
+  bool Owns(const Eigen::Vector2d& xy, PointId p, double* distance) const;
 
  private:
   Eigen::Vector2d lo_ = Eigen::Vector2d::Zero(), hi_ = Eigen::Vector2d::Zero();

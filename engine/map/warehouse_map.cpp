@@ -96,9 +96,18 @@ Result<ArcPosition> WarehouseMap::NearestArcPosition(const Eigen::Vector2d& xy,
 }
 
 PointId WarehouseMap::NearestPointFrom(const Eigen::Vector2d& xy, PointId hint) const {
-  PointId id = kNoPoint;
   double d = 0.0;
-  if (point_grid_.NearestFrom(xy, hint, &id, &d)) return id;
+  if (point_grid_.Owns(xy, hint, &d)) return hint;
+  // A robot driving on from its last point is on one of that point's arcs: past half way the
+  // arc's other end is the one it is nearest to.
+  if (hint >= 0 && static_cast<std::size_t>(hint) < points_.size()) {
+    for (ArcId a : out_arcs_[static_cast<std::size_t>(hint)]) {
+      if (const PointId q = arcs_[static_cast<std::size_t>(a)].to; point_grid_.Owns(xy, q, &d)) return q;
+    }
+    for (ArcId a : in_arcs_[static_cast<std::size_t>(hint)]) {
+      if (const PointId q = arcs_[static_cast<std::size_t>(a)].from; point_grid_.Owns(xy, q, &d)) return q;
+    }
+  }
   return NearestPoint(xy);
 }
 

@@ -140,7 +140,8 @@ class WarehouseMap {
   // among points at the same distance. Without a kind: a grid lookup (point_grid.h).
   PointId NearestPoint(const Eigen::Vector2d& xy, std::optional<PointKind> kind = std::nullopt,
                        double* distance = nullptr) const;
-  // NearestPoint(xy), trying `hint` first (a robot's last point: most reports are near it).
+  // NearestPoint(xy), trying `hint` first, then the points one arc from it (a robot's last
+  // point and where it drives: most reports are near one of them).
   PointId NearestPointFrom(const Eigen::Vector2d& xy, PointId hint) const;
 
  private:

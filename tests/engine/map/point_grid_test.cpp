@@ -9,6 +9,8 @@
 #include <limits>
 #include <random>
 
+#include "engine/map/chu2024_floor.h"
+#include "engine/map/grid_floor.h"
 #include "engine/map/warehouse_map.h"
 
 namespace dispatch::engine {
@@ -89,6 +91,33 @@ TEST(PointGridTest, AHintGivesTheSameAnswerAsTheSearch) {
           if (!got) continue;
           ASSERT_EQ(id, want) << "shape " << shape << " n " << n << " hint " << hint << " at " << xy.transpose();
           ASSERT_DOUBLE_EQ(d, want_d);
+        }
+      }
+    }
+  }
+}
+
+TEST(PointGridTest, TheMapsHintedLookupAnswersAsTheSearchAlongEveryArc) {
+  // WarehouseMap::NearestPointFrom tries the hint and the points one arc from it: a robot on
+  // any arc, hinted with either end, a point two arcs away or a far one, gets NearestPoint's
+  // answer (the Chu2024 floor: uneven gaps, docks off the lanes; a grid floor: ties midway).
+  GridFloorOptions small;
+  small.shelf_cols = 3;
+  small.shelf_rows = 3;
+  for (auto built : {BuildChu2024Floor(), BuildGridFloor(small)}) {
+    ASSERT_TRUE(built.ok()) << built.error().message;
+    const WarehouseMap& map = *built;
+    std::mt19937 rng(5);
+    std::uniform_real_distribution<double> along(0.0, 1.0), jitter(-0.05, 0.05);
+    for (const Arc& a : map.arcs()) {
+      const Eigen::Vector2d from = map.point(a.from).position, to = map.point(a.to).position;
+      const PointId beyond = map.out_arcs(a.to).empty() ? a.to : map.arc(map.out_arcs(a.to).front()).to;
+      for (double f : {0.0, 0.25, 0.5, 0.75, 1.0, along(rng)}) {
+        const Eigen::Vector2d xy = from + f * (to - from) + Eigen::Vector2d(jitter(rng), jitter(rng));
+        const PointId want = map.NearestPoint(xy);
+        for (PointId hint : {a.from, a.to, beyond, static_cast<PointId>(rng() % map.point_count()), kNoPoint}) {
+          ASSERT_EQ(map.NearestPointFrom(xy, hint), want) << "arc " << map.point(a.from).name << " -> "
+                                                          << map.point(a.to).name << " at " << f << " hint " << hint;
         }
       }
     }
