@@ -80,14 +80,15 @@ void GateImpl::PlaceStrays() {
 // route's last point it stands for that point (a stop keeps its action and dwell).
 long GateImpl::RewriteLeg(GateBot& b, long cut, const std::vector<PointId>& route, long resume, double t,
                           std::vector<GateEffect>& out, const Offset& offset) {
-  const std::vector<Waypoint> old = b.plan.waypoints;
-  const std::vector<std::string> old_orders = b.plan.order_of;
+  double clock = std::max(t, cut >= 0 ? Departure(b, cut) : t);
+  // The plan is rebuilt from its old self, taken out (not copied).
+  const std::vector<Waypoint> old = std::move(b.plan.waypoints);
+  const std::vector<std::string> old_orders = std::move(b.plan.order_of);
   std::vector<Waypoint> w(old.begin(), old.begin() + (cut + 1));
   std::vector<std::string> ow(old_orders.begin(), old_orders.begin() + (cut + 1));
   const std::uint64_t from = cut + 1 < static_cast<long>(old.size())
                                  ? static_cast<std::uint64_t>(old[static_cast<std::size_t>(cut + 1)].seq)
                                  : b.plan.next_sequence;
-  double clock = std::max(t, cut >= 0 ? Departure(b, cut) : t);
   const std::string order = resume >= 0 ? old_orders[static_cast<std::size_t>(resume)] : std::string();
   auto move = [&](PointId p, PointId prev) {
     Waypoint m;
