@@ -225,8 +225,13 @@ struct GateImpl {
   void StepTeamsAfterDeadlocks(double t, std::vector<GateEffect>& out);
   void BreakTeam(GateTeam& team);
   // b leaves (or never joins) `order`'s team at `at` (kNoPoint: until its next point): exempt
-  // from its members until it has driven off; a former team it still had moves to older_former.
-  static void BecomeFormer(GateBot& b, const std::string& order, PointId at);
+  // from its members until it has driven off; a former team it still had moves to older_former,
+  // which makes way, unless one of its members still stands beside b and none of the newer
+  // one's does (then the newer one makes way).
+  void BecomeFormer(GateBot& b, const std::string& order, PointId at);
+  // A robot of team `order` (in it, approaching it or having left it) other than b stands
+  // within the formation's envelope (eps1 + the formation's radius) of b.
+  bool TeammateBeside(const GateBot& b, const std::string& order) const;
   bool StepLeaving(GateTeam& team, double t, std::vector<GateEffect>& out);  // traffic_gate_leaving.cpp
 };
 

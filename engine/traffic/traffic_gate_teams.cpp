@@ -63,9 +63,27 @@ void GateImpl::SyncTeams(GateBot& b) {
 }
 
 void GateImpl::BecomeFormer(GateBot& b, const std::string& order, PointId at) {
-  if (!b.former_team.empty() && b.former_team != order) b.older_former = b.former_team;
+  // Three keys at most (the controller's three groups). Found by the core's safety check
+  // (Table 1 x5 with blocked robots back in service): a robot blocked on a team's point while
+  // two members of that team stood in their slots around it (off the floor: the point was
+  // its) was in two more teams in turn that broke up, dropped the first one and stood 0.231 m
+  // from those members as a stranger.
+  if (!b.former_team.empty() && b.former_team != order &&
+      (b.older_former.empty() || !TeammateBeside(b, b.older_former) || TeammateBeside(b, b.former_team))) {
+    b.older_former = b.former_team;
+  }
   b.former_team = order;
   b.former_at = at;
+}
+
+bool GateImpl::TeammateBeside(const GateBot& b, const std::string& order) const {
+  if (!b.has_xy) return false;
+  const double envelope = config.point_clearance + FormationRadius();
+  for (const auto& [id, o] : bots) {
+    if (&o == &b || !o.has_xy || (o.xy - b.xy).norm() >= envelope - 1e-9) continue;
+    if (o.team == order || o.former_team == order || o.older_former == order || o.approach == order) return true;
+  }
+  return false;
 }
 
 void GateImpl::BreakTeam(GateTeam& team) {

@@ -246,7 +246,11 @@ TEST(CoreStreamTest, MembersOfABrokenUpTeamStayExemptUntilAllHaveDrivenOff) {
 // still in its slot (t = 378.3 s). The same run had a member that joined its team on a point
 // of intersection 33 recorded as the team's agent while it still drove to its slot on its own
 // controller agent, a crossing the controller had not allowed (112.3 s): a member is recorded
-// with its team once the team's agent stands for it (GateRobotState::moved_by_team).
+// with its team once the team's agent stands for it (GateRobotState::moved_by_team). And of its
+// two former teams the one whose members still stand beside it is kept: once blocked robots'
+// waits were timed afresh after their recovery, a robot blocked on a team's point, with two
+// members of that team in their slots around it, was in two more teams in turn that broke up,
+// dropped the first team and stood 0.231 m from those members (t = 663.8 s).
 TEST(CoreStreamTest, ARobotCountsWithItsNextTeamAndTheTwoItLeft) {
   const World w = Chu();
   ExpectSafeToTheEnd(w, Repeated(w, {"chu2024-table1.csv"}, 5));
