@@ -32,7 +32,7 @@ void DispatchCore::Place(const std::string& id) {
   gate_->Disconnect(id);
 }
 
-std::vector<RobotCommand> DispatchCore::Connect(Robot robot, double /*now*/) {
+std::vector<RobotCommand> DispatchCore::Connect(Robot robot, double now) {
   const std::string id = robot.id;
   BookRobot& r = Book(id);
   r.robot = std::move(robot);
@@ -43,7 +43,7 @@ std::vector<RobotCommand> DispatchCore::Connect(Robot robot, double /*now*/) {
   allocation_due_ = true;
   if (gate_) {
     gate_->Connect(id, r.robot.pose.position, r.robot.current_point);
-    if (was_blocked) gate_->Unblock(id);
+    if (was_blocked) gate_->Unblock(id, now);
     SyncGate(r);
   }
   if (!r.has_assignment || r.assignment.order_ids.empty()) return {};
@@ -236,7 +236,7 @@ void DispatchCore::Recover(double now, StepOutcome& out) {
     }
     r->robot.state = RobotState::kIdle;
     r->blocked_at = -1.0;
-    gate_->Unblock(r->robot.id);
+    gate_->Unblock(r->robot.id, now);
     allocation_due_ = true;
     out.recovered.push_back(r->robot.id);
     char note[160];

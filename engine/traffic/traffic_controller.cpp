@@ -224,6 +224,12 @@ void TrafficController::WaitOn(std::size_t r, int other, double t, const std::st
   }
   (void)impl_->Wait(r, WaitKind::kPoint, other, t, why);
 }
+void TrafficController::RestartWaitClock(std::size_t r, double t) {
+  RobotState& x = impl_->robots.at(r);
+  if (x.wait == WaitKind::kNone) return;
+  x.wait_start = t;
+  x.next_detour_try = 0.0;
+}
 const std::string& TrafficController::why(std::size_t r) const { return impl_->robots.at(r).why; }
 std::string TrafficController::Describe(std::size_t r) const {
   const Impl& s = *impl_;

@@ -171,6 +171,9 @@ class TrafficController {
   // on robot `other` since t (-1: no longer). ResolveDeadlocks then breaks cycles through it
   // like any other (a working r is never moved; otherwise r may be backed off too).
   void WaitOn(std::size_t r, int other, double t, const std::string& why);
+  // Robot r's wait (if any) counts from t for its timeouts (re-plan, blocked_after); what it
+  // waits on stays (ResolveDeadlocks still sees it).
+  void RestartWaitClock(std::size_t r, double t);
   const std::string& why(std::size_t r) const;  // reason of the last kWait / kBlocked
   // "R3 at 'c9' -> 'c8' route 'c9' 'c8' ... waiting on R4 (point 'c8' held by R4)".
   std::string Describe(std::size_t r) const;

@@ -227,10 +227,11 @@ void TrafficGate::SetPlan(const std::string& robot, GatePlan plan) {
   s.SyncTeams(b);
 }
 
-void TrafficGate::Unblock(const std::string& robot) {
+void TrafficGate::Unblock(const std::string& robot, double t) {
   GateBot* b = impl_->Find(robot);
   if (!b) return;
   b->blocked = false;
+  if (b->team.empty() && impl_->OnFloor(*b)) impl_->ctl.RestartWaitClock(static_cast<std::size_t>(b->ctl), t);
 }
 
 void TrafficGate::Reached(const std::string& robot, std::uint64_t sequence, double t,

@@ -123,11 +123,10 @@ class TrafficGate {
   void Disconnect(const std::string& robot);
   // The robot's plan changed (award, cancel, drop trimmed, restart).
   void SetPlan(const std::string& robot, GatePlan plan);
-  // A robot reported blocked (kBlocked) is in service again: a block is reported again. The
-  // controller's wait clock goes on: a robot still standing where it was blocked is reported at
-  // its next request (its new orders go back at once). Clearing the controller's wait there
-  // made formation members come within eps1 in two core_stream tests.
-  void Unblock(const std::string& robot);
+  // A robot reported blocked (kBlocked) is in service again at t: a block is reported again,
+  // and a wait it still stands in is timed from t (reported blocked again after blocked_after).
+  // What it waits on stays for the controller's deadlock breaking.
+  void Unblock(const std::string& robot, double t);
   // The robot arrived at waypoint `sequence`; `xy`, the pose it reported with the arrival, is
   // where it is seen from then on (a state report may be up to a report interval older, and
   // the minimum distance must not pair one robot's fresh position with another's stale one).

@@ -130,12 +130,13 @@ TEST_F(BlockedRecoveryTest, ABlockedRobotIsBackInServiceAfterTheRecoveryTime) {
   EXPECT_TRUE(core_->TakeAllocationDue());
   ASSERT_TRUE(RunRound());
   EXPECT_EQ(core_->order("O1")->robots, std::vector<std::string>{"R1"});
-  // The pick is still taken: R1, still waiting where it was blocked, is reported blocked again
-  // (before, never: it kept the order) and the order goes back.
+  // The pick is still taken: R1 waits again, timed from its recovery, and is reported blocked
+  // again after blocked_after (not at once, nor never: its order must not stay with it).
   const double reassigned = now_;
   blocked_at_.reset();
   RunUntil(reassigned + 100.0, [&](const StepOutcome&) { return blocked_at_.has_value(); });
   ASSERT_TRUE(blocked_at_.has_value()) << core_->gate()->Describe("R1");
+  EXPECT_GE(*blocked_at_ - *recovered_at, kBlockedAfter);
   EXPECT_EQ(core_->order("O1")->order->state, OrderState::kAccepted);
   EXPECT_EQ(core_->robot("R1")->robot.state, RobotState::kFault);
 }
@@ -156,14 +157,16 @@ TEST_F(BlockedRecoveryTest, WithoutRecoveryABlockedRobotStaysInFaultUntilItsNext
   hello.state = RobotState::kIdle;
   (void)core_->Connect(std::move(hello), now_);
   EXPECT_EQ(core_->robot("R1")->robot.state, RobotState::kIdle);
-  // In service again: it gets the order back and, the pick still taken, is reported blocked
-  // again (its order goes back).
+  // In service again: it gets the order back and, the pick still taken, waits again, timed
+  // from the Hello, and is reported blocked again after blocked_after (its order goes back).
+  const double hello_at = now_;
   ASSERT_TRUE(RunRound());
   EXPECT_EQ(core_->order("O1")->robots, std::vector<std::string>{"R1"});
   const double reassigned = now_;
   blocked_at_.reset();
   RunUntil(reassigned + 100.0, [&](const StepOutcome&) { return blocked_at_.has_value(); });
   ASSERT_TRUE(blocked_at_.has_value()) << core_->gate()->Describe("R1");
+  EXPECT_GE(*blocked_at_ - hello_at, kBlockedAfter);
   EXPECT_EQ(core_->order("O1")->order->state, OrderState::kAccepted);
 }
 
