@@ -56,19 +56,7 @@ std::int64_t HighestNumbered(const Assignment& a) {
 }
 
 std::size_t FindWaypoint(const Assignment& a, std::uint64_t seq) {
-  const auto& w = a.plan.waypoints;
-  // Plans are mostly numbered without gaps: try where seq would be then (the first match is
-  // the only one, sequences are unique in a plan).
-  if (!w.empty() && w.front().seq >= 0) {
-    const auto first = static_cast<std::uint64_t>(w.front().seq);
-    if (seq >= first && seq - first < w.size() && static_cast<std::uint64_t>(w[seq - first].seq) == seq) {
-      return static_cast<std::size_t>(seq - first);
-    }
-  }
-  for (std::size_t i = 0; i < w.size(); ++i) {
-    if (static_cast<std::uint64_t>(w[i].seq) == seq) return i;
-  }
-  return static_cast<std::size_t>(-1);
+  return FindSequence(a.plan.waypoints, seq);
 }
 
 std::vector<std::string> CutPlan(Assignment& a, const std::string& order_id) {

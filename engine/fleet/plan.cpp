@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <stdexcept>
 
 namespace dispatch::engine {
@@ -43,6 +44,21 @@ std::optional<WaypointAction> ParseWaypointAction(std::string_view name) {
     if (name == WaypointActionName(a)) return a;
   }
   return std::nullopt;
+}
+
+std::size_t FindSequence(const std::vector<Waypoint>& w, std::uint64_t seq) {
+  constexpr std::size_t kNone = static_cast<std::size_t>(-1);
+  if (w.empty() || seq > static_cast<std::uint64_t>(std::numeric_limits<int>::max())) return kNone;
+  const int s = static_cast<int>(seq);
+  const std::size_t guess = static_cast<std::size_t>(static_cast<std::int64_t>(s) - w.front().seq);
+  if (guess < w.size() && w[guess].seq == s) return guess;  // numbered without gaps
+  auto at = std::lower_bound(w.begin(), w.end(), s, [](const Waypoint& x, int v) { return x.seq < v; });
+  if (at != w.end() && at->seq == s) return static_cast<std::size_t>(at - w.begin());
+  // Not found by halving: absent, or a plan out of order (then only a scan finds it).
+  for (std::size_t i = 0; i < w.size(); ++i) {
+    if (w[i].seq == s) return i;
+  }
+  return kNone;
 }
 
 Eigen::Vector2d Plan::PositionAt(double t) const {

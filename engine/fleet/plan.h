@@ -18,6 +18,8 @@
 
 #include <Eigen/Core>
 
+#include <cstddef>
+#include <cstdint>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -46,6 +48,11 @@ struct Waypoint {
 
   double departure() const { return eta + dwell; }
 };
+
+// Index of the waypoint numbered `seq` in `w`, or npos. Plans are numbered in ascending order
+// (a plan is built 0, 1, 2, ... and re-plans append higher numbers), mostly without gaps:
+// O(1) then, O(log n) with gaps, a scan for a plan out of order.
+std::size_t FindSequence(const std::vector<Waypoint>& w, std::uint64_t seq);
 
 struct Plan {
   std::string robot_id;

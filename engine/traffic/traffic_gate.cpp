@@ -62,14 +62,8 @@ GateImpl::GateImpl(std::shared_ptr<const WarehouseMap> m,
 }
 
 long GateImpl::IndexOf(const GateBot& b, std::uint64_t seq) {
-  if (b.gapless) {
-    const auto& w = b.plan.waypoints;
-    if (w.empty()) return -1;
-    const auto first = static_cast<std::uint64_t>(w.front().seq);
-    return seq >= first && seq - first < w.size() ? static_cast<long>(seq - first) : -1;
-  }
-  auto it = b.index.find(seq);
-  return it == b.index.end() ? -1 : static_cast<long>(it->second);
+  const std::size_t i = FindSequence(b.plan.waypoints, seq);
+  return i == static_cast<std::size_t>(-1) ? -1 : static_cast<long>(i);
 }
 
 long GateImpl::RunEnd(const GateBot& b, long from, PointId p, long limit) {

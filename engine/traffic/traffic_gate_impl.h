@@ -38,10 +38,6 @@ struct GateBot {
   bool connected = false;
   bool synced = false;  // a state report since it connected (its last waypoint is known)
   GatePlan plan;
-  // Waypoint sequence -> plan index: w[seq - w[0].seq] when the plan is numbered without gaps
-  // (gapless, as plans mostly are), else this map.
-  bool gapless = true;
-  std::unordered_map<std::uint64_t, std::size_t> index;
   std::uint64_t plan_version = 0;  // counts the plan's changes (Reindex)
   // Driving to run_next from plan index run_idx of plan version run_version, clear of the point
   // behind, it was released everything it may drive to there (StepSolo: nothing to do).

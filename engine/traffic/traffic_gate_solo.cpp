@@ -7,6 +7,7 @@
 #include <cmath>
 #include <limits>
 #include <unordered_map>
+#include <iterator>
 #include <utility>
 
 #include "engine/fleet/formation.h"
@@ -83,9 +84,12 @@ long GateImpl::RewriteLeg(GateBot& b, long cut, const std::vector<PointId>& rout
   double clock = std::max(t, cut >= 0 ? Departure(b, cut) : t);
   // The plan is rebuilt from its old self, taken out (not copied).
   const std::vector<Waypoint> old = std::move(b.plan.waypoints);
-  const std::vector<std::string> old_orders = std::move(b.plan.order_of);
+  std::vector<std::string> old_orders = std::move(b.plan.order_of);
   std::vector<Waypoint> w(old.begin(), old.begin() + (cut + 1));
-  std::vector<std::string> ow(old_orders.begin(), old_orders.begin() + (cut + 1));
+  std::vector<std::string> ow(std::make_move_iterator(old_orders.begin()),
+                              std::make_move_iterator(old_orders.begin() + (cut + 1)));
+  w.reserve(old.size() + route.size());
+  ow.reserve(old.size() + route.size());
   const std::uint64_t from = cut + 1 < static_cast<long>(old.size())
                                  ? static_cast<std::uint64_t>(old[static_cast<std::size_t>(cut + 1)].seq)
                                  : b.plan.next_sequence;
@@ -117,7 +121,7 @@ long GateImpl::RewriteLeg(GateBot& b, long cut, const std::vector<PointId>& rout
       m.seq = static_cast<int>(b.plan.next_sequence++);
       m.eta += shift;
       w.push_back(m);
-      ow.push_back(old_orders[static_cast<std::size_t>(i)]);
+      ow.push_back(std::move(old_orders[static_cast<std::size_t>(i)]));
     }
   }
   b.plan.waypoints = std::move(w);
@@ -134,15 +138,8 @@ long GateImpl::RewriteLeg(GateBot& b, long cut, const std::vector<PointId>& rout
 
 void GateImpl::Reindex(GateBot& b) {
   ++b.plan_version;
-  b.index.clear();
-  const auto& w = b.plan.waypoints;
-  b.gapless = true;
-  for (std::size_t i = 0; i < w.size(); ++i) {
-    if (w[i].seq < 0 || w[i].seq != w.front().seq + static_cast<int>(i)) b.gapless = false;
-    b.plan.next_sequence = std::max<std::uint64_t>(b.plan.next_sequence, w[i].seq + 1);
-  }
-  if (!b.gapless) {  // the map only for plans with gaps (no node allocations per plan change)
-    for (std::size_t i = 0; i < w.size(); ++i) b.index[static_cast<std::uint64_t>(w[i].seq)] = i;
+  for (const Waypoint& w : b.plan.waypoints) {
+    b.plan.next_sequence = std::max<std::uint64_t>(b.plan.next_sequence, w.seq + 1);
   }
   b.spans.clear();
   for (const auto& team : b.plan.teams) b.spans.emplace(team.first, FindSpan(b, team.first));
