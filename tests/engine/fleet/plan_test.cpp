@@ -181,5 +181,26 @@ TEST(WaypointActionTest, NamesRoundTrip) {
   EXPECT_FALSE(ParseWaypointAction("fly").has_value());
 }
 
+TEST(FindSequenceTest, FindsAWaypointInAPlanWithOrWithoutGapsOrOutOfOrder) {
+  auto plan = [](std::vector<int> seqs) {
+    std::vector<Waypoint> w;
+    for (int s : seqs) {
+      Waypoint x;
+      x.seq = s;
+      w.push_back(x);
+    }
+    return w;
+  };
+  const std::size_t none = static_cast<std::size_t>(-1);
+  EXPECT_EQ(FindSequence(plan({4, 5, 6, 7}), 6), 2u);
+  EXPECT_EQ(FindSequence(plan({4, 5, 6, 7}), 8), none);
+  EXPECT_EQ(FindSequence(plan({4, 5, 6, 7}), 3), none);
+  EXPECT_EQ(FindSequence(plan({2, 3, 9, 10, 11}), 10), 3u);  // re-planned: a gap
+  EXPECT_EQ(FindSequence(plan({2, 3, 9, 10, 11}), 4), none);
+  EXPECT_EQ(FindSequence(plan({7, 3, 5}), 5), 2u);  // out of order: still found
+  EXPECT_EQ(FindSequence(plan({}), 0), none);
+  EXPECT_EQ(FindSequence(plan({0, 1}), 1ull << 40), none);
+}
+
 }  // namespace
 }  // namespace dispatch::engine
