@@ -9,6 +9,14 @@
 // Counters: solved (1/0), soc (sum of costs, steps; 0 when unsolved), lower_bound (the sum
 // of the agents' shortest paths alone), conflicts (independent paths only), nodes (CBS: tree nodes; elimination: conflicts
 // eliminated), searches (single-agent searches); an unsolved run's label says why.
+//   BM_TimeWindowFleet/N: N robots planned one by one in priority order into an empty
+//   ReservationTable (engine/planning/window_planner.h, Wang2019's time windows): each from a
+//   random start to a random pick (2 s work) and a random drop where it stays, on a
+//   16 x 24-shelf grid floor (98 x 98 cells, 6,532 free; all lanes bidirectional single lanes).
+//   BM_TimeWindowPlan/N: one more robot planned into the table holding those N robots' windows
+//   (issue 16's target: N = 500 at <= 1 ms median), over a pool of 64 requests; the route table
+//   (lazy) is warmed on the requests' stops first, as the service's is on its pick and drop points.
+//   Counters: median_ms (per plan), planned / failed, expanded (SIPP states per plan).
 // Run from a Release build:
 //   cmake --build build-bench --target planning_bench && build-bench/tests/benchmarks/planning_bench
 #include <benchmark/benchmark.h>
@@ -16,6 +24,7 @@
 #include <algorithm>
 #include <chrono>
 #include <functional>
+#include <memory>
 #include <random>
 #include <stdexcept>
 #include <string>
@@ -25,6 +34,8 @@
 #include "engine/planning/cbs.h"
 #include "engine/planning/conflict_elimination.h"
 #include "engine/planning/space_time_astar.h"
+#include "engine/planning/window_planner.h"
+#include "engine/routing/route_table.h"
 
 namespace dispatch::engine {
 namespace {
@@ -117,9 +128,101 @@ void BM_Cbs(benchmark::State& state) {
   });
 }
 
+struct WindowFloor {
+  std::shared_ptr<const WarehouseMap> map;
+  std::unique_ptr<RouteTable> routes;
+};
+
+const WindowFloor& LargeWindowFloor() {
+  static const WindowFloor floor = [] {
+    GridFloorOptions options;
+    options.shelf_rows = 24;
+    options.shelf_cols = 16;
+    auto map = BuildGridFloor(options);
+    if (!map.ok()) throw std::runtime_error(map.error().message);
+    WindowFloor f;
+    f.map = std::make_shared<const WarehouseMap>(std::move(map).value());
+    auto routes = MakeRouteTable(f.map, {});
+    if (!routes.ok()) throw std::runtime_error(routes.error().message);
+    f.routes = std::move(routes).value();
+    return f;
+  }();
+  return floor;
+}
+
+// n requests: distinct starts and distinct drops (where they stay), random picks; release
+// times spread over a minute. Points that are starts or drops are never picks.
+std::vector<WindowRequest> WindowRequests(std::size_t n, std::uint64_t seed) {
+  const WindowFloor& f = LargeWindowFloor();
+  std::vector<PointId> cells(f.map->point_count());
+  for (std::size_t i = 0; i < cells.size(); ++i) cells[i] = static_cast<PointId>(i);
+  std::mt19937_64 random(seed);
+  std::shuffle(cells.begin(), cells.end(), random);
+  std::vector<WindowRequest> out;
+  for (std::size_t i = 0; i < n; ++i) {
+    WindowRequest r;
+    r.robot = static_cast<int>(i);
+    r.start = cells[i];
+    r.stops = {{cells[2 * n + random() % (cells.size() - 2 * n)], 2.0}, {cells[n + i], 2.0}};
+    r.release_time = static_cast<double>(random() % 60);
+    out.push_back(r);
+  }
+  return out;
+}
+
+void BM_TimeWindowFleet(benchmark::State& state) {
+  const WindowFloor& f = LargeWindowFloor();
+  const auto requests = WindowRequests(static_cast<std::size_t>(state.range(0)), 11);
+  for (const auto& r : requests) f.routes->Prepare(r.stops[0].point), f.routes->Prepare(r.stops[1].point);
+  std::size_t planned = 0, expanded = 0;
+  for (auto _ : state) {
+    ReservationTable table(f.map, {});
+    auto plans = PlanInPriorityOrder(table, *f.routes, requests);
+    if (!plans.ok()) throw std::runtime_error(plans.error().message);
+    planned = 0;
+    for (const auto& r : plans.value().routes) planned += r.empty() ? 0 : 1;
+    expanded = plans.value().expanded;
+  }
+  state.counters["planned"] = static_cast<double>(planned);
+  state.counters["failed"] = static_cast<double>(requests.size() - planned);
+  state.counters["expanded"] = static_cast<double>(expanded) / static_cast<double>(requests.size());
+}
+
+void BM_TimeWindowPlan(benchmark::State& state) {
+  const WindowFloor& f = LargeWindowFloor();
+  const auto n = static_cast<std::size_t>(state.range(0));
+  auto requests = WindowRequests(n + 64, 11);
+  const std::vector<WindowRequest> fleet(requests.begin(), requests.begin() + static_cast<long>(n));
+  std::vector<WindowRequest> pool(requests.begin() + static_cast<long>(n), requests.end());
+  for (const auto& r : requests) f.routes->Prepare(r.stops[0].point), f.routes->Prepare(r.stops[1].point);
+  ReservationTable table(f.map, {});
+  if (!PlanInPriorityOrder(table, *f.routes, fleet).ok()) throw std::runtime_error("fleet not planned");
+  std::vector<double> ms;
+  std::size_t k = 0, failed = 0, expanded = 0;
+  for (auto _ : state) {
+    WindowRequest r = pool[k++ % pool.size()];
+    r.start_time = 0.0;
+    const auto t0 = std::chrono::steady_clock::now();
+    auto plan = PlanInWindows(table, *f.routes, r);
+    ms.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
+    if (plan.ok()) {
+      expanded += plan.value().expanded;
+    } else {
+      ++failed;
+    }
+  }
+  std::nth_element(ms.begin(), ms.begin() + static_cast<long>(ms.size() / 2), ms.end());
+  state.counters["median_ms"] = ms[ms.size() / 2];
+  state.counters["failed"] = static_cast<double>(failed) / static_cast<double>(state.iterations());
+  const auto solved = static_cast<double>(state.iterations()) - static_cast<double>(failed);
+  state.counters["expanded"] = solved > 0 ? static_cast<double>(expanded) / solved : 0.0;
+}
+
 BENCHMARK(BM_IndependentPaths)->Arg(10)->Arg(50)->Arg(100)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_ConflictElimination)->Arg(10)->Arg(50)->Arg(100)->Unit(benchmark::kMillisecond)->Iterations(3);
 BENCHMARK(BM_Cbs)->Arg(10)->Arg(50)->Arg(100)->Unit(benchmark::kMillisecond)->Iterations(1);
+BENCHMARK(BM_TimeWindowFleet)->Arg(100)->Arg(500)->Unit(benchmark::kMillisecond)->Iterations(1);
+BENCHMARK(BM_TimeWindowPlan)->Arg(100)->Arg(500)->Unit(benchmark::kMillisecond);
 
 }  // namespace
 }  // namespace dispatch::engine
