@@ -41,6 +41,8 @@ std::vector<Key> Keys() {
       MakeKey("max_queue", &ServerConfig::max_queue),
       MakeKey("one_formation_per_pick", &ServerConfig::one_formation_per_pick),
       MakeKey("zeta", &ServerConfig::zeta),
+      MakeKey("planner", &ServerConfig::planner),
+      MakeKey("turn_time", &ServerConfig::turn_time),
       MakeKey("alpha", &ServerConfig::alpha),
       MakeKey("beta", &ServerConfig::beta),
       MakeKey("time_scale", &ServerConfig::time_scale),
@@ -109,7 +111,12 @@ engine::Status ValidateServerConfig(const ServerConfig& c) {
   if (c.bind.empty()) return InvalidArgument("bind must not be empty");
   if (c.db.empty()) return InvalidArgument("db must name a SQLite file");
   if (auto strategy = engine::MakeAllocator(c.strategy); !strategy.ok()) return strategy.error();
-  for (auto [name, v] : {std::pair{"zeta", c.zeta}, {"alpha", c.alpha}, {"beta", c.beta}}) {
+  if (!engine::ParsePlanner(c.planner)) {
+    std::string names;
+    for (const std::string& n : engine::PlannerNames()) names += (names.empty() ? "" : ", ") + n;
+    return InvalidArgument("planner must be one of " + names + ", got '" + c.planner + "'");
+  }
+  for (auto [name, v] : {std::pair{"zeta", c.zeta}, {"alpha", c.alpha}, {"beta", c.beta}, {"turn_time", c.turn_time}}) {
     if (!std::isfinite(v) || v < 0) return InvalidArgument(std::string(name) + " must be finite and >= 0");
   }
   auto positive = [](double v) { return std::isfinite(v) && v > 0; };
@@ -150,6 +157,9 @@ engine::Result<ParsedCommandLine> ParseCommandLine(int argc, char** argv) {
   app.add_option("--map", flags.map, "chu2024 | map.json | MovingAI .map")->capture_default_str();
   app.add_option("--strategy", flags.strategy, "auction | greedy")->capture_default_str();
   app.add_option("--zeta", flags.zeta, "Traffic weight (Chu2024 eq. 5)")->capture_default_str();
+  app.add_option("--planner", flags.planner, "rules | time-windows (Wang2019 time windows)")->capture_default_str();
+  app.add_option("--turn-time", flags.turn_time, "Time-window planner: turning time per 90 degrees, s")
+      ->capture_default_str();
   app.add_option("--alpha", flags.alpha, "Weight of T_t (Chu2024 eq. 1)")->capture_default_str();
   app.add_option("--beta", flags.beta, "Weight of T_d (Chu2024 eq. 1)")->capture_default_str();
   app.add_option("--time-scale", flags.time_scale, "Dispatcher seconds per wall second")

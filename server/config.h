@@ -23,6 +23,10 @@ struct ServerConfig {
   int max_queue = 0;
   bool one_formation_per_pick = false;
   double zeta = 100.0;            // Chu2024 eq. (5) traffic weight
+  // How awards get their routes (AllocationConfig::planner): rules | time-windows (Wang2019's
+  // time windows for single-robot orders; turn_time: seconds per 90 degrees of turning).
+  std::string planner = "rules";
+  double turn_time = 0.0;
   double alpha = 0.5;             // Chu2024 eq. (1) weight of T_t
   double beta = 0.5;              // Chu2024 eq. (1) weight of T_d
   double time_scale = 1.0;        // dispatcher seconds per wall-clock second

@@ -136,7 +136,11 @@ Result<std::string> EncodeRunSetup(const RunSetup& s) {
                        {"zone_cell_size", a.traffic.zone_cell_size},
                        {"formation_side", a.formation.side},
                        {"formation_base_angle", a.formation.base_angle},
-                       {"formation_max_rotation_step", a.formation.max_rotation_step}};
+                       {"formation_max_rotation_step", a.formation.max_rotation_step},
+                       {"planner", engine::PlannerName(a.planner)},
+                       {"windows_body_length", a.windows.body_length},
+                       {"windows_headway_s", a.windows.headway_s},
+                       {"windows_turn_s_per_90", a.windows.turn_s_per_90}};
     j["core"] = {{"robot_snap_tolerance", s.core.robot_snap_tolerance},
                  {"traffic_control", s.core.traffic_control},
                  {"one_formation_per_pick", s.core.one_formation_per_pick},
@@ -181,6 +185,14 @@ Result<RunSetup> DecodeRunSetup(const std::string& text) {
     c.formation.side = a.at("formation_side").get<double>();
     c.formation.base_angle = a.at("formation_base_angle").get<double>();
     c.formation.max_rotation_step = a.at("formation_max_rotation_step").get<double>();
+    // Journals before the planners were selectable ran the rules.
+    const std::string planner = a.value("planner", std::string("rules"));
+    const auto kind = engine::ParsePlanner(planner);
+    if (!kind) return Corrupt("run setup", "unknown planner " + planner);
+    c.planner = *kind;
+    c.windows.body_length = a.value("windows_body_length", c.windows.body_length);
+    c.windows.headway_s = a.value("windows_headway_s", c.windows.headway_s);
+    c.windows.turn_s_per_90 = a.value("windows_turn_s_per_90", c.windows.turn_s_per_90);
     const json& k = j.at("core");
     s.core.robot_snap_tolerance = k.at("robot_snap_tolerance").get<double>();
     s.core.traffic_control = k.at("traffic_control").get<bool>();

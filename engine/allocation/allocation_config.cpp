@@ -27,6 +27,11 @@ Status ValidateAllocationConfig(const AllocationConfig& config) {
                    positive("traffic zone_cell_size", config.traffic.zone_cell_size)}) {
     if (!s.ok()) return s;
   }
+  for (Status s : {positive("windows body_length", config.windows.body_length),
+                   non_negative("windows headway_s", config.windows.headway_s),
+                   non_negative("windows turn_s_per_90", config.windows.turn_s_per_90)}) {
+    if (!s.ok()) return s;
+  }
   if (config.work_time_override) {
     if (Status s = non_negative("work_time_override", *config.work_time_override); !s.ok()) {
       return s;
@@ -34,5 +39,22 @@ Status ValidateAllocationConfig(const AllocationConfig& config) {
   }
   return Ok{};
 }
+
+const char* PlannerName(PlannerKind planner) {
+  switch (planner) {
+    case PlannerKind::kRules: return "rules";
+    case PlannerKind::kTimeWindows: return "time-windows";
+  }
+  return "?";
+}
+
+std::optional<PlannerKind> ParsePlanner(std::string_view name) {
+  for (PlannerKind p : {PlannerKind::kRules, PlannerKind::kTimeWindows}) {
+    if (name == PlannerName(p)) return p;
+  }
+  return std::nullopt;
+}
+
+std::vector<std::string> PlannerNames() { return {PlannerName(PlannerKind::kRules), PlannerName(PlannerKind::kTimeWindows)}; }
 
 }  // namespace dispatch::engine

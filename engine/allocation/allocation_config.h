@@ -28,6 +28,11 @@
 //    robot has room, so a formation gets members that are nearly free instead of members
 //    that reach its rendezvous one by one behind long queues (the service froze with seed
 //    Tables 1 and 2 submitted ten times at once; README "Formations on the dispatch core").
+//  - planner = rules: each award's route is the route table's (Chu2024 §3.1) and conflicts are
+//    left to the traffic controller as they come. time_windows: each single-robot award is
+//    re-planned through the free time windows of every other robot's plan (Wang2019 §2-3,
+//    engine/planning/window_planner.h) with `windows` (its speed is `speed`); formations keep
+//    the route table's routes and are reserved as they are.
 //  - work_time_override: unset = every order's own t_w (Order::work_time, 5 s by default,
 //    see kDefaultWorkTime); set = one t_w for every order, as in the paper.
 // Plain value; validate with ValidateAllocationConfig. Thread-safe to share.
@@ -35,12 +40,19 @@
 
 #include <cstddef>
 #include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
 
 #include "engine/allocation/traffic_prediction.h"
 #include "engine/common/result.h"
 #include "engine/fleet/formation.h"
+#include "engine/planning/time_windows.h"
 
 namespace dispatch::engine {
+
+// How an award's robots get their routes (issue 16 §3).
+enum class PlannerKind { kRules, kTimeWindows };
 
 struct AllocationConfig {
   double alpha = 0.5;        // weight of T_t, total time (Chu2024 eq. (1))
@@ -56,7 +68,14 @@ struct AllocationConfig {
   std::size_t max_queue = 0;
   TrafficPredictionConfig traffic;
   FormationOptions formation;
+  PlannerKind planner = PlannerKind::kRules;
+  TimeWindowRules windows;  // planner kTimeWindows; windows.speed is replaced by `speed`
 };
+
+// "rules", "time-windows" (PlannerNames: in the order help texts list them).
+const char* PlannerName(PlannerKind planner);
+std::optional<PlannerKind> ParsePlanner(std::string_view name);
+std::vector<std::string> PlannerNames();
 
 // kInvalidArgument naming the field: weights must be finite and >= 0, h and v finite and > 0,
 // a work-time override finite and >= 0.

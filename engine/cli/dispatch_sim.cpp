@@ -6,10 +6,14 @@
 //       [--formations 0.2]) [--strategy auction|greedy] [--zeta 100] [--csv series.csv]
 //       [--orders-csv out.csv] [--check-safety] [--journal run.db] [--max-queue N]
 //       [--one-formation-per-pick] [--trace R1,R2 [--trace-from T] [--trace-to T]]
+//       [--planner rules|time-windows [--turn-time S]]
 //       an order stream with release times (formation orders too) under the online traffic
-//       controller.
+//       controller; with --planner time-windows single-robot awards are planned through the
+//       others' time windows (Wang2019, window_awards.h).
 //   dispatch-sim compare [--random 200 --seed 1 --robots 18 --map chu2024]
-//       auction zeta=100, auction zeta=0 and greedy on one random stream (issue 4 §4).
+//       [--planners rules,time-windows [--strategy S] [--zeta Z]]
+//       auction zeta=100, auction zeta=0 and greedy on one random stream (issue 4 §4), or the
+//       planners side by side.
 //   dispatch-sim headon
 //       seed 004 §4.3: a head-on conflict resolved by waiting vs. re-planning.
 //   dispatch-sim replay --db dispatch.db [--run N | --list] [--what-if [--strategy S] [--zeta Z]
@@ -150,6 +154,13 @@ int RunPlan(const PlanArgs& args) {
   return failed == 0 ? 0 : 2;
 }
 
+// "rules, time-windows" for messages and help texts.
+std::string PlannerList() {
+  std::string out;
+  for (const std::string& name : PlannerNames()) out += (out.empty() ? "" : ", ") + name;
+  return out;
+}
+
 struct StreamArgs {
   std::string map = "chu2024", csv, orders_csv, strategy = "auction", journal;
   std::vector<std::string> orders;  // task tables, submitted together
@@ -163,6 +174,9 @@ struct StreamArgs {
   // "core": the service's dispatch core with robots following its messages (core_stream.h);
   // "stream": the order-stream model (order_stream.h).
   std::string model = "core";
+  std::string planner = "rules";           // AllocationConfig::planner (core model)
+  std::vector<std::string> planners;       // compare: one column per planner
+  double turn_s = 0.0;                     // time windows: turning time per 90 degrees
 };
 
 struct Setup {
@@ -222,6 +236,8 @@ StreamConfig ConfigOf(const StreamArgs& a, const std::string& strategy, double z
   c.strategy = strategy == "greedy" ? AllocationStrategy::kGreedy : AllocationStrategy::kAuction;
   c.allocation.zeta = zeta;
   c.allocation.max_queue = a.max_queue;
+  c.allocation.planner = ParsePlanner(a.planner).value_or(PlannerKind::kRules);
+  c.allocation.windows.turn_s_per_90 = a.turn_s;
   c.one_formation_per_pick = a.one_formation_per_pick;
   c.blocked_recovery = a.blocked_recovery;
   c.check_safety = a.check_safety;
@@ -240,6 +256,10 @@ std::string TablesLabel(const StreamArgs& a) {
 }
 
 Result<StreamResult> Simulate(const StreamArgs& a, const Setup& s, const StreamConfig& c) {
+  if (!ParsePlanner(a.planner)) return InvalidArgument("--planner must be one of " + PlannerList());
+  if (a.model != "core" && c.allocation.planner != PlannerKind::kRules) {
+    return InvalidArgument("--planner " + a.planner + " plans in the dispatch core's rounds: --model core");
+  }
   if (a.model != "core") {
     if (!a.journal.empty()) return InvalidArgument("--journal records the dispatch core's calls: --model core");
     return SimulateOrderStream(s.map, s.routes, s.robots, s.orders, c);
@@ -332,21 +352,29 @@ int RunCompare(StreamArgs a) {
               a.orders.empty() ? ("random, seed " + std::to_string(a.seed)).c_str()
                                : TablesLabel(a).c_str(),
               setup->robots.size(), a.map.c_str(), a.dt);
-  std::printf("%-18s %9s %10s %12s %10s %10s %9s %8s %9s\n", "strategy", "completed",
-              "makespan", "throughput/h", "mean compl", "waiting s", "distance", "replans",
-              "deadlocks");
+  std::printf("%-18s %9s %10s %12s %10s %10s %9s %8s %9s %8s\n", a.planners.empty() ? "strategy" : "planner",
+              "completed", "makespan", "throughput/h", "mean compl", "waiting s", "distance", "replans",
+              "deadlocks", "min dist");
   int rc = 0;
-  for (auto [name, strategy, zeta] : {std::tuple{"auction zeta=100", "auction", 100.0},
-                                      std::tuple{"auction zeta=0", "auction", 0.0},
-                                      std::tuple{"greedy", "greedy", 0.0}}) {
-    StreamConfig c = ConfigOf(a, strategy, zeta);
+  std::vector<std::tuple<std::string, std::string, double, std::string>> columns;  // name, strategy, zeta, planner
+  if (a.planners.empty()) {
+    columns = {{"auction zeta=100", "auction", 100.0, a.planner},
+               {"auction zeta=0", "auction", 0.0, a.planner},
+               {"greedy", "greedy", 0.0, a.planner}};
+  } else {
+    for (const std::string& p : a.planners) columns.emplace_back(p, a.strategy, a.zeta, p);
+  }
+  for (const auto& [name, strategy, zeta, planner] : columns) {
+    StreamArgs with = a;
+    with.planner = planner;
+    StreamConfig c = ConfigOf(with, strategy, zeta);
     c.record_series = false;
-    auto r = Simulate(a, *setup, c);
+    auto r = Simulate(with, *setup, c);
     if (!r.ok()) return Fail(r.error().message);
-    std::printf("%-18s %5zu/%-3zu %10.1f %12.1f %10.1f %10.1f %9.1f %8zu %9zu\n", name,
+    std::printf("%-18s %5zu/%-3zu %10.1f %12.1f %10.1f %10.1f %9.1f %8zu %9zu %8.3f\n", name.c_str(),
                 r->completed, r->orders.size(), r->makespan, r->throughput_per_hour,
                 r->mean_completion, r->total_waiting_time, r->total_distance,
-                r->traffic.replans, r->traffic.deadlocks_resolved);
+                r->traffic.replans, r->traffic.deadlocks_resolved, r->overall_min_distance);
     if (!r->all_completed()) rc = 2;
   }
   return rc;
@@ -397,6 +425,10 @@ int Main(int argc, char** argv) {
     c->add_option("--model", a.model, "core (the service's dispatch core, robots following its messages) "
                                       "or stream (the order-stream model)")
         ->capture_default_str()->check(CLI::IsMember({"core", "stream"}));
+    c->add_option("--planner", a.planner, "How awards get their routes: " + PlannerList())
+        ->capture_default_str();
+    c->add_option("--turn-time", a.turn_s, "Time-window planner: turning time per 90 degrees, s")
+        ->capture_default_str()->check(CLI::NonNegativeNumber);
     c->add_option("--max-queue", a.max_queue, "Orders a robot may hold and still bid (0: no limit)")
         ->capture_default_str();
     c->add_flag("--one-formation-per-pick", a.one_formation_per_pick,
@@ -423,8 +455,15 @@ int Main(int argc, char** argv) {
   s->add_option("--journal", stream.journal,
                 "Journal the core's calls as a run of this SQLite file (dispatch-sim replay --db, SQL)");
   StreamArgs compare;
-  auto* c = app.add_subcommand("compare", "Auction zeta=100 / zeta=0 / greedy on one stream");
+  auto* c = app.add_subcommand("compare", "Auction zeta=100 / zeta=0 / greedy on one stream, or planners");
   add_stream(c, compare);
+  c->add_option("--planners", compare.planners, "Compare these planners (comma-separated: " + PlannerList() +
+                                                    ") with --strategy and --zeta, instead of the strategies")
+      ->delimiter(',')
+      ->check(CLI::IsMember(PlannerNames()));
+  c->add_option("--strategy", compare.strategy, "Strategy of a --planners comparison")->capture_default_str()
+      ->check(CLI::IsMember(AllocatorNames()));
+  c->add_option("--zeta", compare.zeta, "Traffic weight of a --planners comparison")->capture_default_str();
   auto* h = app.add_subcommand("headon", "Seed 004 §4.3: wait vs. re-plan on a head-on conflict");
   ReplayArgs replay;
   auto* r = app.add_subcommand("replay", "A run dispatchd recorded, through the dispatch core again; --what-if");

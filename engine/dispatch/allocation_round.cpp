@@ -1,5 +1,7 @@
 #include "engine/dispatch/allocation_round.h"
 
+#include "engine/dispatch/window_awards.h"
+
 #include <algorithm>
 #include <cctype>
 #include <cmath>
@@ -67,6 +69,9 @@ RoundResult RoundRunner::Run(const RoundInput& input) {
     if (!input.robots[i].assignment.order_ids.empty()) ReplayQueue(state, i, input.robots[i], out.notes);
     state.Publish(i);
   }
+  RoundSegments segments;  // where each robot's new work begins (the time-window planner)
+  segments.first_new.assign(input.robots.size(), static_cast<std::size_t>(-1));
+  segments.in_formation.assign(input.robots.size(), false);
   std::vector<bool> queued(input.robots.size());  // has orders (before or from this round)
   for (std::size_t i = 0; i < input.robots.size(); ++i) queued[i] = !input.robots[i].assignment.order_ids.empty();
   for (const auto& pending : input.pending) {
@@ -90,11 +95,16 @@ RoundResult RoundRunner::Run(const RoundInput& input) {
       // A robot without a queue gets the whole plan (its start waypoint included).
       const std::size_t from = queued[i] ? old_sizes[i] : 0;
       queued[i] = true;
+      segments.first_new[i] = std::min(segments.first_new[i], from);
+      if (award->winners.size() > 1) segments.in_formation[i] = true;
       a.segments.emplace_back(fp.begin() + static_cast<std::ptrdiff_t>(std::min(from, fp.size())), fp.end());
       a.after_departure.push_back(from > 0 && from <= fp.size() ? fp[from - 1].departure() : 0.0);
     }
     a.award = std::move(award).value();
     out.awards.push_back(std::move(a));
+  }
+  if (config_.planner == PlannerKind::kTimeWindows && !out.awards.empty()) {
+    PlanAwardsInWindows(map_, *routes_, config_, state, segments, input.now, out.awards, out.notes);
   }
   return out;
 }

@@ -212,7 +212,8 @@ Result<WindowPlan> PlanInWindows(const ReservationTable& table, const RouteTable
   Node at{request.start, first, -1, request.start_time, -1, 0.0};
   double since = request.start_time;
   std::vector<WindowStop> stops = request.stops;
-  if (stops.empty()) stops.push_back({request.start, 0.0});  // stays where it is
+  const bool stand = stops.empty();
+  if (stand) stops.push_back({request.start, 0.0});  // stays where it is
   for (std::size_t k = 0; k < stops.size(); ++k) {
     const bool last = k + 1 == stops.size();
     TimedRoute leg;
@@ -220,11 +221,13 @@ Result<WindowPlan> PlanInWindows(const ReservationTable& table, const RouteTable
     if (!reached.ok()) return Error{reached.error().code, who + ": " + reached.error().message};
     if (!out.route.empty()) out.route.pop_back();  // the stop's visit continues in this leg
     out.route.insert(out.route.end(), leg.begin(), leg.end());
+    out.stop_visits.push_back(out.route.size() - 1);
     at = reached.value();
     at.parent = -1;
     since = at.arrive;
     at.arrive += stops[k].work_s;  // ready to leave once the work is done
   }
+  if (stand) out.stop_visits.clear();
   return out;
 }
 

@@ -38,6 +38,7 @@ struct WindowRequest {
 
 struct WindowPlan {
   TimedRoute route;
+  std::vector<std::size_t> stop_visits;  // per stop: the visit of the route where it works
   std::size_t expanded = 0;  // search states expanded, over all stops
 };
 

@@ -19,7 +19,8 @@ engine::Result<ParsedCommandLine> Parse(std::vector<std::string> args) {
 TEST(ServerConfigTest, FlagsSetTheConfig) {
   auto parsed = Parse({"--grpc-port", "0", "--http-port", "8081", "--db", "x.db", "--map", "chu2024",
                        "--strategy", "greedy", "--zeta", "0", "--alpha", "0.3", "--beta", "0.7",
-                       "--time-scale", "10", "--bind", "127.0.0.1", "--ports-file", "p.json"});
+                       "--time-scale", "10", "--bind", "127.0.0.1", "--ports-file", "p.json",
+                       "--planner", "time-windows", "--turn-time", "1.5"});
   ASSERT_TRUE(parsed.ok()) << parsed.error().message;
   const ServerConfig& c = parsed->config;
   EXPECT_EQ(c.grpc_port, 0);
@@ -32,6 +33,8 @@ TEST(ServerConfigTest, FlagsSetTheConfig) {
   EXPECT_DOUBLE_EQ(c.time_scale, 10.0);
   EXPECT_EQ(c.bind, "127.0.0.1");
   EXPECT_EQ(c.ports_file, "p.json");
+  EXPECT_EQ(c.planner, "time-windows");
+  EXPECT_DOUBLE_EQ(c.turn_time, 1.5);
 }
 
 TEST(ServerConfigTest, FileKeysApplyAndFlagsWin) {
@@ -45,6 +48,7 @@ TEST(ServerConfigTest, FileKeysApplyAndFlagsWin) {
   EXPECT_EQ(parsed->config.db, "file.db");
   EXPECT_DOUBLE_EQ(parsed->config.zeta, 50.0);
   EXPECT_EQ(parsed->config.strategy, "auction");
+  EXPECT_EQ(parsed->config.planner, "rules");
 }
 
 TEST(ServerConfigTest, BadValuesAreNamed) {
@@ -57,6 +61,10 @@ TEST(ServerConfigTest, BadValuesAreNamed) {
   auto strategy = Parse({"--strategy", "random"});
   ASSERT_FALSE(strategy.ok());
   EXPECT_NE(strategy.error().message.find("random"), std::string::npos);
+  auto planner = Parse({"--planner", "cbs"});
+  ASSERT_FALSE(planner.ok());
+  EXPECT_NE(planner.error().message.find("planner must be one of rules, time-windows, got 'cbs'"), std::string::npos);
+  EXPECT_FALSE(Parse({"--turn-time", "-1"}).ok());
   auto port = Parse({"--grpc-port", "70000"});
   ASSERT_FALSE(port.ok());
   EXPECT_NE(port.error().message.find("grpc_port"), std::string::npos);

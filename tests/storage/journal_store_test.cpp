@@ -4,6 +4,7 @@
 #include "storage/journal_store.h"
 
 #include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
 
 #include <cmath>
 #include <limits>
@@ -273,6 +274,8 @@ TEST(JournalStoreTest, ARunSetupRoundTrips) {
   s.strategy = "greedy";
   s.allocation.zeta = 0.0;
   s.allocation.work_time_override = 7.5;
+  s.allocation.planner = engine::PlannerKind::kTimeWindows;
+  s.allocation.windows.turn_s_per_90 = 1.5;
   s.core.traffic.t_w1 = 3.25;
   s.core.traffic.head_on = engine::HeadOnPolicy::kAlwaysWait;
   s.core.traffic_control = false;
@@ -285,6 +288,8 @@ TEST(JournalStoreTest, ARunSetupRoundTrips) {
   EXPECT_EQ(back->strategy, "greedy");
   EXPECT_EQ(back->allocation.zeta, 0.0);
   EXPECT_EQ(back->allocation.work_time_override, 7.5);
+  EXPECT_EQ(back->allocation.planner, engine::PlannerKind::kTimeWindows);
+  EXPECT_EQ(back->allocation.windows.turn_s_per_90, 1.5);
   EXPECT_EQ(back->core.traffic.t_w1, 3.25);
   EXPECT_EQ(back->core.traffic.head_on, engine::HeadOnPolicy::kAlwaysWait);
   EXPECT_FALSE(back->core.traffic_control);
@@ -293,6 +298,14 @@ TEST(JournalStoreTest, ARunSetupRoundTrips) {
   ASSERT_TRUE(map.ok()) << map.error().message;
   EXPECT_EQ(engine::WriteMapJson(*map), s.map_json) << "the map reads back as written";
   EXPECT_FALSE(DecodeRunSetup("{\"version\": \"9\"}").ok());
+  // A journal written before the planners were selectable ran the rules.
+  auto old = nlohmann::json::parse(*text);
+  old["allocation"].erase("planner");
+  auto before = DecodeRunSetup(old.dump());
+  ASSERT_TRUE(before.ok()) << before.error().message;
+  EXPECT_EQ(before->allocation.planner, engine::PlannerKind::kRules);
+  old["allocation"]["planner"] = "magic";
+  EXPECT_FALSE(DecodeRunSetup(old.dump()).ok());
 }
 
 }  // namespace

@@ -109,6 +109,27 @@ TEST(CoreStreamTest, RandomStreamAuctionBeatsGreedyOnTheCore) {
   EXPECT_LT(makespan[1], makespan[2]);
 }
 
+// Issue 16 §3: the time-window planner is selectable in the simulator; on the random stream
+// every order completes with eps1 kept, the same orders by the same strategy, and the tables
+// complete with the safety check clean.
+TEST(CoreStreamTest, TheTimeWindowPlannerCompletesTheStreamAndTheTables) {
+  const World w = Chu();
+  const Stream s = ChuStream(w, 200, 1);
+  StreamConfig c = Config();
+  c.allocation.planner = PlannerKind::kTimeWindows;
+  auto r = SimulateOnCore(w.map, w.routes, s.robots, s.orders, c);
+  ASSERT_TRUE(r.ok()) << r.error().message;
+  ExpectCompleteAndClear(w, s.orders, *r, c);
+  c.check_safety = true;
+  for (const char* table : {"chu2024-table1.csv", "chu2024-table2.csv"}) {
+    SCOPED_TRACE(table);
+    const std::vector<Order> orders = TaskTable(w, table);
+    auto t = SimulateOnCore(w.map, w.routes, Fleet(w, 18), orders, c);
+    ASSERT_TRUE(t.ok()) << t.error().message;
+    ExpectCompleteAndClear(w, orders, *t, c);
+  }
+}
+
 TEST(CoreStreamTest, RunsAreDeterministic) {
   const World w = Chu();
   const Stream s = ChuStream(w, 40, 3);

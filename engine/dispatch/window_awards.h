@@ -1,0 +1,42 @@
+// The time-window planner in an allocation round (issue 16 §3, AllocationConfig::planner =
+// time-windows): after the strategy has awarded the round's orders, each single-robot award's
+// new segment is planned again through the free time windows of every other robot's plan
+// (Wang2019 §2-3; engine/planning/window_planner.h), awards in allocation order (the seed's
+// rule: earlier release first), each reserving its route for the next. Formation awards keep
+// their route-table routes and are reserved as they are; so are robots that win a formation in
+// the round.
+//
+// A re-planned segment keeps its stops, actions and work times; its waits become departures:
+// a robot reaching a waypoint ahead of plan waits for its planned departure (the robots'
+// rule, WaypointRobot and fleet-sim), so a move waypoint where it must wait carries the end of
+// the wait as its eta, and a stop the end of its work less the work time. When the planner
+// finds no route (a stop held for ever, say by a robot parked on it), the segment stays as
+// the strategy planned it and a note says why; the traffic controller stays the safety net.
+//
+// Pure; the caller's FleetState is read, the awards rewritten.
+#pragma once
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "engine/allocation/allocation_config.h"
+#include "engine/allocation/fleet_state.h"
+#include "engine/dispatch/allocation_round.h"
+#include "engine/routing/route_table.h"
+
+namespace dispatch::engine {
+
+// Per robot of `fleet` (its index): where this round's new waypoints begin in its plan
+// (npos: it won nothing), and whether it won a formation in the round.
+struct RoundSegments {
+  std::vector<std::size_t> first_new;
+  std::vector<bool> in_formation;
+};
+
+void PlanAwardsInWindows(const std::shared_ptr<const WarehouseMap>& map, const RouteTable& routes,
+                         const AllocationConfig& config,
+                         const FleetState& fleet, const RoundSegments& segments, double now,
+                         std::vector<RoundAward>& awards, std::vector<std::string>& notes);
+
+}  // namespace dispatch::engine
