@@ -4,6 +4,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <memory>
 #include <string>
 #include <vector>
@@ -262,6 +263,55 @@ TEST(TrafficControllerTest, IntersectionNeedsAGrantAndReleasesItBehind) {
   EXPECT_EQ(third.grants().Holders(0), std::vector<std::string>{"M"});
   ASSERT_TRUE(third.Place(member, P(*map, "E")).ok());  // it stands outside after all
   EXPECT_EQ(third.Request(cross, 2.0), TrafficDecision::kGo);
+}
+
+// Wang2019 §3.2 step 4: a robot waiting on a held point waits T_w2, then re-plans a route
+// around the point if one exists. Cells of a 5-wide grid are c<row * 5 + column>.
+TEST(TrafficControllerTest, AWaitOnAHeldPointRePlansAfterTw2) {
+  auto map = Grid({".....", ".@@@.", "....."});
+  TrafficControllerConfig c;
+  c.t_w2 = 20.0;
+  TrafficController ctl = Make(map, c);
+  const std::size_t a = *ctl.AddRobot("A", P(*map, "c0"));
+  ASSERT_TRUE(ctl.AddRobot("B", P(*map, "c2")).ok());  // stands in the way, no route
+  ASSERT_TRUE(ctl.SetRoute(a, Route(*map, {"c0", "c1", "c2", "c3", "c4"})).ok());
+  ASSERT_EQ(ctl.Request(a, 0.0), TrafficDecision::kGo);
+  ctl.Arrived(a, 1.0);
+  EXPECT_EQ(ctl.Request(a, 1.0), TrafficDecision::kWait);
+  EXPECT_NE(ctl.why(a).find("'c2' held by B"), std::string::npos) << ctl.why(a);
+  EXPECT_EQ(ctl.Request(a, 20.9), TrafficDecision::kWait);  // 19.9 s: not yet
+  EXPECT_EQ(ctl.RemainingRoute(a), Route(*map, {"c1", "c2", "c3", "c4"}));
+  EXPECT_EQ(ctl.Request(a, 21.0), TrafficDecision::kReplanned);  // 20 s: round the block
+  const std::vector<PointId> around = ctl.RemainingRoute(a);
+  EXPECT_EQ(around.front(), P(*map, "c1"));
+  EXPECT_EQ(around.back(), P(*map, "c4"));
+  EXPECT_EQ(std::count(around.begin(), around.end(), P(*map, "c2")), 0);
+  EXPECT_EQ(ctl.stats().replans, 1u);
+}
+
+// Wang2019 §3.2 step 3 with the single waiting strategy (§4.3): a robot that meets a corridor
+// held the other way waits T_w1, then re-plans around it. Two one-cell-wide corridors (rows 1
+// and 3, columns 2-5) join open ends; cells of this 8-wide grid are c<row * 8 + column>.
+TEST(TrafficControllerTest, AHeadOnWaitRePlansAfterTw1) {
+  auto map = Grid({"..@@@@..", "........", "..@@@@..", "........"});
+  TrafficControllerConfig c;
+  c.t_w1 = 10.0;
+  c.head_on = HeadOnPolicy::kAlwaysWait;
+  TrafficController ctl = Make(map, c);
+  const std::size_t a = *ctl.AddRobot("A", P(*map, "c9"));
+  const std::size_t b = *ctl.AddRobot("B", P(*map, "c13"));
+  ASSERT_TRUE(ctl.SetRoute(b, Route(*map, {"c13", "c12", "c11", "c10", "c9", "c8"})).ok());
+  ASSERT_EQ(ctl.Request(b, 0.0), TrafficDecision::kGo);  // B drives west in the row-1 corridor
+  ASSERT_TRUE(ctl.SetRoute(a, Route(*map, {"c9", "c10", "c11", "c12", "c13", "c14", "c15"})).ok());
+  EXPECT_EQ(ctl.Request(a, 0.0), TrafficDecision::kWait);
+  EXPECT_NE(ctl.why(a).find("head-on"), std::string::npos) << ctl.why(a);
+  EXPECT_EQ(ctl.Request(a, 9.9), TrafficDecision::kWait);
+  EXPECT_EQ(ctl.Request(a, 10.0), TrafficDecision::kReplanned);
+  const std::vector<PointId> around = ctl.RemainingRoute(a);
+  EXPECT_EQ(around.back(), P(*map, "c15"));
+  EXPECT_EQ(std::count(around.begin(), around.end(), P(*map, "c11")), 0);  // by row 3
+  ASSERT_FALSE(ctl.stats().head_on.empty());
+  EXPECT_FALSE(ctl.stats().head_on.front().replanned);  // the head-on itself was waited
 }
 
 TEST(TrafficControllerTest, RejectsBadConfig) {
