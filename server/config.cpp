@@ -43,6 +43,8 @@ std::vector<Key> Keys() {
       MakeKey("zeta", &ServerConfig::zeta),
       MakeKey("planner", &ServerConfig::planner),
       MakeKey("turn_time", &ServerConfig::turn_time),
+      MakeKey("routing", &ServerConfig::routing),
+      MakeKey("heat_period", &ServerConfig::heat_period),
       MakeKey("alpha", &ServerConfig::alpha),
       MakeKey("beta", &ServerConfig::beta),
       MakeKey("time_scale", &ServerConfig::time_scale),
@@ -116,6 +118,10 @@ engine::Status ValidateServerConfig(const ServerConfig& c) {
     for (const std::string& n : engine::PlannerNames()) names += (names.empty() ? "" : ", ") + n;
     return InvalidArgument("planner must be one of " + names + ", got '" + c.planner + "'");
   }
+  if (!engine::ParseRouting(c.routing)) {
+    return InvalidArgument("routing must be floyd or heat, got '" + c.routing + "'");
+  }
+  if (!std::isfinite(c.heat_period) || c.heat_period <= 0) return InvalidArgument("heat_period must be > 0 seconds");
   for (auto [name, v] : {std::pair{"zeta", c.zeta}, {"alpha", c.alpha}, {"beta", c.beta}, {"turn_time", c.turn_time}}) {
     if (!std::isfinite(v) || v < 0) return InvalidArgument(std::string(name) + " must be finite and >= 0");
   }
@@ -159,6 +165,9 @@ engine::Result<ParsedCommandLine> ParseCommandLine(int argc, char** argv) {
   app.add_option("--zeta", flags.zeta, "Traffic weight (Chu2024 eq. 5)")->capture_default_str();
   app.add_option("--planner", flags.planner, "rules | time-windows (Wang2019 time windows)")->capture_default_str();
   app.add_option("--turn-time", flags.turn_time, "Time-window planner: turning time per 90 degrees, s")
+      ->capture_default_str();
+  app.add_option("--routing", flags.routing, "floyd | heat (Wang2019 path heat, rules planner)")->capture_default_str();
+  app.add_option("--heat-period", flags.heat_period, "Path heat: the period δ the lanes' use is counted over, s")
       ->capture_default_str();
   app.add_option("--alpha", flags.alpha, "Weight of T_t (Chu2024 eq. 1)")->capture_default_str();
   app.add_option("--beta", flags.beta, "Weight of T_d (Chu2024 eq. 1)")->capture_default_str();

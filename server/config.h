@@ -27,6 +27,10 @@ struct ServerConfig {
   // time windows for single-robot orders; turn_time: seconds per 90 degrees of turning).
   std::string planner = "rules";
   double turn_time = 0.0;
+  // The rules planner's routes (AllocationConfig::routing): floyd | heat (Wang2019 path heat,
+  // lanes' use counted over heat_period seconds).
+  std::string routing = "floyd";
+  double heat_period = 60.0;
   double alpha = 0.5;             // Chu2024 eq. (1) weight of T_t
   double beta = 0.5;              // Chu2024 eq. (1) weight of T_d
   double time_scale = 1.0;        // dispatcher seconds per wall-clock second

@@ -140,7 +140,9 @@ Result<std::string> EncodeRunSetup(const RunSetup& s) {
                        {"planner", engine::PlannerName(a.planner)},
                        {"windows_body_length", a.windows.body_length},
                        {"windows_headway_s", a.windows.headway_s},
-                       {"windows_turn_s_per_90", a.windows.turn_s_per_90}};
+                       {"windows_turn_s_per_90", a.windows.turn_s_per_90},
+                       {"routing", engine::RoutingName(a.routing)},
+                       {"heat_period", a.heat_period}};
     j["core"] = {{"robot_snap_tolerance", s.core.robot_snap_tolerance},
                  {"traffic_control", s.core.traffic_control},
                  {"one_formation_per_pick", s.core.one_formation_per_pick},
@@ -193,6 +195,11 @@ Result<RunSetup> DecodeRunSetup(const std::string& text) {
     c.windows.body_length = a.value("windows_body_length", c.windows.body_length);
     c.windows.headway_s = a.value("windows_headway_s", c.windows.headway_s);
     c.windows.turn_s_per_90 = a.value("windows_turn_s_per_90", c.windows.turn_s_per_90);
+    const std::string routing = a.value("routing", std::string("floyd"));
+    const auto route_kind = engine::ParseRouting(routing);
+    if (!route_kind) return Corrupt("run setup", "unknown routing " + routing);
+    c.routing = *route_kind;
+    c.heat_period = a.value("heat_period", c.heat_period);
     const json& k = j.at("core");
     s.core.robot_snap_tolerance = k.at("robot_snap_tolerance").get<double>();
     s.core.traffic_control = k.at("traffic_control").get<bool>();

@@ -24,7 +24,8 @@ Status ValidateAllocationConfig(const AllocationConfig& config) {
                    non_negative("zeta", config.zeta), positive("sample_step h", config.sample_step),
                    positive("speed v", config.speed), non_negative("hold_seconds", config.hold_seconds),
                    positive("traffic bucket_seconds", config.traffic.bucket_seconds),
-                   positive("traffic zone_cell_size", config.traffic.zone_cell_size)}) {
+                   positive("traffic zone_cell_size", config.traffic.zone_cell_size),
+                   positive("heat_period", config.heat_period)}) {
     if (!s.ok()) return s;
   }
   for (Status s : {positive("windows body_length", config.windows.body_length),
@@ -54,6 +55,23 @@ std::optional<PlannerKind> ParsePlanner(std::string_view name) {
   }
   return std::nullopt;
 }
+
+const char* RoutingName(RoutingKind routing) {
+  switch (routing) {
+    case RoutingKind::kFloyd: return "floyd";
+    case RoutingKind::kHeat: return "heat";
+  }
+  return "?";
+}
+
+std::optional<RoutingKind> ParseRouting(std::string_view name) {
+  for (RoutingKind r : {RoutingKind::kFloyd, RoutingKind::kHeat}) {
+    if (name == RoutingName(r)) return r;
+  }
+  return std::nullopt;
+}
+
+std::vector<std::string> RoutingNames() { return {RoutingName(RoutingKind::kFloyd), RoutingName(RoutingKind::kHeat)}; }
 
 std::vector<std::string> PlannerNames() { return {PlannerName(PlannerKind::kRules), PlannerName(PlannerKind::kTimeWindows)}; }
 

@@ -33,6 +33,11 @@
 //    re-planned through the free time windows of every other robot's plan (Wang2019 §2-3,
 //    engine/planning/window_planner.h) with `windows` (its speed is `speed`); formations keep
 //    the route table's routes and are reserved as they are.
+//  - routing = floyd: the rules planner's routes are the route table's. heat: each single-robot
+//    award's legs are routed again by Wang2019's heat-weighted Dijkstra over the lanes the
+//    round's plans use in the next heat_period = 60 s (the seed leaves δ open; a minute spans a
+//    few tasks on the Chu2024 floor). Bids keep the table's costs; the time-window planner
+//    keeps its own routes.
 //  - work_time_override: unset = every order's own t_w (Order::work_time, 5 s by default,
 //    see kDefaultWorkTime); set = one t_w for every order, as in the paper.
 // Plain value; validate with ValidateAllocationConfig. Thread-safe to share.
@@ -53,6 +58,9 @@ namespace dispatch::engine {
 
 // How an award's robots get their routes (issue 16 §3).
 enum class PlannerKind { kRules, kTimeWindows };
+// Which routes the rules planner gives them: the route table's shortest (Floyd, or its lazy
+// equivalent on large floors) or Wang2019's heat-weighted ones (engine/planning/path_heat.h).
+enum class RoutingKind { kFloyd, kHeat };
 
 struct AllocationConfig {
   double alpha = 0.5;        // weight of T_t, total time (Chu2024 eq. (1))
@@ -70,12 +78,18 @@ struct AllocationConfig {
   FormationOptions formation;
   PlannerKind planner = PlannerKind::kRules;
   TimeWindowRules windows;  // planner kTimeWindows; windows.speed is replaced by `speed`
+  RoutingKind routing = RoutingKind::kFloyd;
+  double heat_period = 60.0;  // δ of Wang2019's path heat, seconds (> 0)
 };
 
 // "rules", "time-windows" (PlannerNames: in the order help texts list them).
 const char* PlannerName(PlannerKind planner);
 std::optional<PlannerKind> ParsePlanner(std::string_view name);
 std::vector<std::string> PlannerNames();
+// "floyd", "heat".
+const char* RoutingName(RoutingKind routing);
+std::optional<RoutingKind> ParseRouting(std::string_view name);
+std::vector<std::string> RoutingNames();
 
 // kInvalidArgument naming the field: weights must be finite and >= 0, h and v finite and > 0,
 // a work-time override finite and >= 0.

@@ -6,12 +6,12 @@
 //       [--formations 0.2]) [--strategy auction|greedy] [--zeta 100] [--csv series.csv]
 //       [--orders-csv out.csv] [--check-safety] [--journal run.db] [--max-queue N]
 //       [--one-formation-per-pick] [--trace R1,R2 [--trace-from T] [--trace-to T]]
-//       [--planner rules|time-windows [--turn-time S]]
+//       [--planner rules|time-windows [--turn-time S]] [--routing floyd|heat [--heat-period S]]
 //       an order stream with release times (formation orders too) under the online traffic
 //       controller; with --planner time-windows single-robot awards are planned through the
 //       others' time windows (Wang2019, window_awards.h).
 //   dispatch-sim compare [--random 200 --seed 1 --robots 18 --map chu2024]
-//       [--planners rules,time-windows [--strategy S] [--zeta Z]]
+//       [--planners rules,time-windows] [--routings floyd,heat] [--strategy S] [--zeta Z]
 //       auction zeta=100, auction zeta=0 and greedy on one random stream (issue 4 §4), or the
 //       planners side by side.
 //   dispatch-sim headon
@@ -175,8 +175,11 @@ struct StreamArgs {
   // "stream": the order-stream model (order_stream.h).
   std::string model = "core";
   std::string planner = "rules";           // AllocationConfig::planner (core model)
-  std::vector<std::string> planners;       // compare: one column per planner
+  std::vector<std::string> planners;       // compare: one column per planner (x routing)
+  std::string routing = "floyd";           // AllocationConfig::routing (core model)
+  std::vector<std::string> routings;       // compare: one column per routing (x planner)
   double turn_s = 0.0;                     // time windows: turning time per 90 degrees
+  double heat_period = 60.0;               // path heat: δ, s
 };
 
 struct Setup {
@@ -238,6 +241,8 @@ StreamConfig ConfigOf(const StreamArgs& a, const std::string& strategy, double z
   c.allocation.max_queue = a.max_queue;
   c.allocation.planner = ParsePlanner(a.planner).value_or(PlannerKind::kRules);
   c.allocation.windows.turn_s_per_90 = a.turn_s;
+  c.allocation.routing = ParseRouting(a.routing).value_or(RoutingKind::kFloyd);
+  c.allocation.heat_period = a.heat_period;
   c.one_formation_per_pick = a.one_formation_per_pick;
   c.blocked_recovery = a.blocked_recovery;
   c.check_safety = a.check_safety;
@@ -257,6 +262,10 @@ std::string TablesLabel(const StreamArgs& a) {
 
 Result<StreamResult> Simulate(const StreamArgs& a, const Setup& s, const StreamConfig& c) {
   if (!ParsePlanner(a.planner)) return InvalidArgument("--planner must be one of " + PlannerList());
+  if (!ParseRouting(a.routing)) return InvalidArgument("--routing must be floyd or heat");
+  if (a.model != "core" && c.allocation.routing != RoutingKind::kFloyd) {
+    return InvalidArgument("--routing " + a.routing + " routes in the dispatch core's rounds: --model core");
+  }
   if (a.model != "core" && c.allocation.planner != PlannerKind::kRules) {
     return InvalidArgument("--planner " + a.planner + " plans in the dispatch core's rounds: --model core");
   }
@@ -352,21 +361,29 @@ int RunCompare(StreamArgs a) {
               a.orders.empty() ? ("random, seed " + std::to_string(a.seed)).c_str()
                                : TablesLabel(a).c_str(),
               setup->robots.size(), a.map.c_str(), a.dt);
-  std::printf("%-18s %9s %10s %12s %10s %10s %9s %8s %9s %8s\n", a.planners.empty() ? "strategy" : "planner",
+  std::printf("%-18s %9s %10s %12s %10s %10s %9s %8s %9s %8s\n", a.planners.empty() && a.routings.empty() ? "strategy" : "planner",
               "completed", "makespan", "throughput/h", "mean compl", "waiting s", "distance", "replans",
               "deadlocks", "min dist");
   int rc = 0;
-  std::vector<std::tuple<std::string, std::string, double, std::string>> columns;  // name, strategy, zeta, planner
-  if (a.planners.empty()) {
-    columns = {{"auction zeta=100", "auction", 100.0, a.planner},
-               {"auction zeta=0", "auction", 0.0, a.planner},
-               {"greedy", "greedy", 0.0, a.planner}};
+  // name, strategy, zeta, planner, routing
+  std::vector<std::tuple<std::string, std::string, double, std::string, std::string>> columns;
+  if (a.planners.empty() && a.routings.empty()) {
+    columns = {{"auction zeta=100", "auction", 100.0, a.planner, a.routing},
+               {"auction zeta=0", "auction", 0.0, a.planner, a.routing},
+               {"greedy", "greedy", 0.0, a.planner, a.routing}};
   } else {
-    for (const std::string& p : a.planners) columns.emplace_back(p, a.strategy, a.zeta, p);
+    const std::vector<std::string> planners = a.planners.empty() ? std::vector<std::string>{a.planner} : a.planners;
+    const std::vector<std::string> routings = a.routings.empty() ? std::vector<std::string>{a.routing} : a.routings;
+    for (const std::string& p : planners) {
+      for (const std::string& r : routings) {
+        columns.emplace_back(routings.size() > 1 ? p + "/" + r : p, a.strategy, a.zeta, p, r);
+      }
+    }
   }
-  for (const auto& [name, strategy, zeta, planner] : columns) {
+  for (const auto& [name, strategy, zeta, planner, routing] : columns) {
     StreamArgs with = a;
     with.planner = planner;
+    with.routing = routing;
     StreamConfig c = ConfigOf(with, strategy, zeta);
     c.record_series = false;
     auto r = Simulate(with, *setup, c);
@@ -429,6 +446,10 @@ int Main(int argc, char** argv) {
         ->capture_default_str();
     c->add_option("--turn-time", a.turn_s, "Time-window planner: turning time per 90 degrees, s")
         ->capture_default_str()->check(CLI::NonNegativeNumber);
+    c->add_option("--routing", a.routing, "Routes of the rules planner: floyd (shortest) or heat (Wang2019)")
+        ->capture_default_str();
+    c->add_option("--heat-period", a.heat_period, "Path heat: the period δ the lanes' use is counted over, s")
+        ->capture_default_str()->check(CLI::PositiveNumber);
     c->add_option("--max-queue", a.max_queue, "Orders a robot may hold and still bid (0: no limit)")
         ->capture_default_str();
     c->add_flag("--one-formation-per-pick", a.one_formation_per_pick,
@@ -461,6 +482,9 @@ int Main(int argc, char** argv) {
                                                     ") with --strategy and --zeta, instead of the strategies")
       ->delimiter(',')
       ->check(CLI::IsMember(PlannerNames()));
+  c->add_option("--routings", compare.routings, "Compare these routings too (comma-separated: floyd, heat)")
+      ->delimiter(',')
+      ->check(CLI::IsMember(RoutingNames()));
   c->add_option("--strategy", compare.strategy, "Strategy of a --planners comparison")->capture_default_str()
       ->check(CLI::IsMember(AllocatorNames()));
   c->add_option("--zeta", compare.zeta, "Traffic weight of a --planners comparison")->capture_default_str();

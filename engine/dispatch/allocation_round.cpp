@@ -1,5 +1,6 @@
 #include "engine/dispatch/allocation_round.h"
 
+#include "engine/dispatch/heat_awards.h"
 #include "engine/dispatch/window_awards.h"
 
 #include <algorithm>
@@ -105,6 +106,8 @@ RoundResult RoundRunner::Run(const RoundInput& input) {
   }
   if (config_.planner == PlannerKind::kTimeWindows && !out.awards.empty()) {
     PlanAwardsInWindows(map_, *routes_, config_, state, segments, input.now, out.awards, out.notes);
+  } else if (config_.routing == RoutingKind::kHeat && !out.awards.empty()) {
+    RouteAwardsByHeat(*map_, config_, state, segments, input.now, out.awards, out.notes);
   }
   return out;
 }

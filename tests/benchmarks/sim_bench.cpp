@@ -12,6 +12,8 @@
 //   BM_SimulateOnCore/R, BM_SimulateFormationsOnCore/R   the same streams on SimulateOnCore:
 //                   the service's DispatchCore, its TrafficGate and robots following its
 //                   messages (a round whenever one is due, at most every 10 s).
+//   BM_SimulatePlannerTimeWindows/R, BM_SimulatePlannerHeat/R   BM_SimulateOnCore's stream with
+//                   AllocationConfig::planner = time-windows / routing = heat (issue 16).
 // Counter `speedup` = simulated seconds per wall second (target: R = 500 at >= 100x).
 // The map, the route table (warmed on every pick and drop) and the orders are built once,
 // outside the timing. Run from a Release build:
@@ -59,7 +61,8 @@ const Floor& LargeFloor() {
   return floor;
 }
 
-void Simulate(benchmark::State& state, double formation_share, bool on_core = false) {
+void Simulate(benchmark::State& state, double formation_share, bool on_core = false,
+              PlannerKind planner = PlannerKind::kRules, RoutingKind routing = RoutingKind::kFloyd) {
   const Floor& f = LargeFloor();
   const auto robots_count = static_cast<std::size_t>(state.range(0));
   auto robots = PlaceRobots(*f.map, robots_count);
@@ -75,6 +78,8 @@ void Simulate(benchmark::State& state, double formation_share, bool on_core = fa
   config.max_time = kHorizon;
   config.allocation_period = 10.0;
   config.record_series = false;
+  config.allocation.planner = planner;
+  config.allocation.routing = routing;
   double simulated = 0;
   std::size_t completed = 0, total = 0, deadlocks = 0, replans = 0, blocked = 0;
   double waiting = 0.0, completion = 0.0, recovered = 0.0, head_on = 0.0;
@@ -110,6 +115,10 @@ void BM_Simulate(benchmark::State& state) { Simulate(state, 0.0); }
 void BM_SimulateFormations(benchmark::State& state) { Simulate(state, 0.1); }
 void BM_SimulateOnCore(benchmark::State& state) { Simulate(state, 0.0, true); }
 void BM_SimulateFormationsOnCore(benchmark::State& state) { Simulate(state, 0.1, true); }
+void BM_SimulatePlannerTimeWindows(benchmark::State& state) {
+  Simulate(state, 0.0, true, PlannerKind::kTimeWindows);
+}
+void BM_SimulatePlannerHeat(benchmark::State& state) { Simulate(state, 0.0, true, PlannerKind::kRules, RoutingKind::kHeat); }
 BENCHMARK(BM_Simulate)->Arg(18)->Arg(100)->Arg(500)->Unit(benchmark::kMillisecond)
     ->UseRealTime()->Iterations(2);
 BENCHMARK(BM_SimulateFormations)->Arg(100)->Arg(500)->Unit(benchmark::kMillisecond)
@@ -117,6 +126,10 @@ BENCHMARK(BM_SimulateFormations)->Arg(100)->Arg(500)->Unit(benchmark::kMilliseco
 BENCHMARK(BM_SimulateOnCore)->Arg(18)->Arg(100)->Arg(500)->Unit(benchmark::kMillisecond)
     ->UseRealTime()->Iterations(2);
 BENCHMARK(BM_SimulateFormationsOnCore)->Arg(100)->Arg(500)->Unit(benchmark::kMillisecond)
+    ->UseRealTime()->Iterations(2);
+BENCHMARK(BM_SimulatePlannerTimeWindows)->Arg(100)->Arg(500)->Unit(benchmark::kMillisecond)
+    ->UseRealTime()->Iterations(2);
+BENCHMARK(BM_SimulatePlannerHeat)->Arg(100)->Arg(500)->Unit(benchmark::kMillisecond)
     ->UseRealTime()->Iterations(2);
 
 }  // namespace

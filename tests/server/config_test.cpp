@@ -20,7 +20,8 @@ TEST(ServerConfigTest, FlagsSetTheConfig) {
   auto parsed = Parse({"--grpc-port", "0", "--http-port", "8081", "--db", "x.db", "--map", "chu2024",
                        "--strategy", "greedy", "--zeta", "0", "--alpha", "0.3", "--beta", "0.7",
                        "--time-scale", "10", "--bind", "127.0.0.1", "--ports-file", "p.json",
-                       "--planner", "time-windows", "--turn-time", "1.5"});
+                       "--planner", "time-windows", "--turn-time", "1.5", "--routing", "heat",
+                       "--heat-period", "30"});
   ASSERT_TRUE(parsed.ok()) << parsed.error().message;
   const ServerConfig& c = parsed->config;
   EXPECT_EQ(c.grpc_port, 0);
@@ -35,6 +36,8 @@ TEST(ServerConfigTest, FlagsSetTheConfig) {
   EXPECT_EQ(c.ports_file, "p.json");
   EXPECT_EQ(c.planner, "time-windows");
   EXPECT_DOUBLE_EQ(c.turn_time, 1.5);
+  EXPECT_EQ(c.routing, "heat");
+  EXPECT_DOUBLE_EQ(c.heat_period, 30.0);
 }
 
 TEST(ServerConfigTest, FileKeysApplyAndFlagsWin) {
@@ -65,6 +68,10 @@ TEST(ServerConfigTest, BadValuesAreNamed) {
   ASSERT_FALSE(planner.ok());
   EXPECT_NE(planner.error().message.find("planner must be one of rules, time-windows, got 'cbs'"), std::string::npos);
   EXPECT_FALSE(Parse({"--turn-time", "-1"}).ok());
+  auto routing = Parse({"--routing", "astar"});
+  ASSERT_FALSE(routing.ok());
+  EXPECT_NE(routing.error().message.find("routing must be floyd or heat, got 'astar'"), std::string::npos);
+  EXPECT_FALSE(Parse({"--heat-period", "0"}).ok());
   auto port = Parse({"--grpc-port", "70000"});
   ASSERT_FALSE(port.ok());
   EXPECT_NE(port.error().message.find("grpc_port"), std::string::npos);

@@ -276,6 +276,8 @@ TEST(JournalStoreTest, ARunSetupRoundTrips) {
   s.allocation.work_time_override = 7.5;
   s.allocation.planner = engine::PlannerKind::kTimeWindows;
   s.allocation.windows.turn_s_per_90 = 1.5;
+  s.allocation.routing = engine::RoutingKind::kHeat;
+  s.allocation.heat_period = 30.0;
   s.core.traffic.t_w1 = 3.25;
   s.core.traffic.head_on = engine::HeadOnPolicy::kAlwaysWait;
   s.core.traffic_control = false;
@@ -290,6 +292,8 @@ TEST(JournalStoreTest, ARunSetupRoundTrips) {
   EXPECT_EQ(back->allocation.work_time_override, 7.5);
   EXPECT_EQ(back->allocation.planner, engine::PlannerKind::kTimeWindows);
   EXPECT_EQ(back->allocation.windows.turn_s_per_90, 1.5);
+  EXPECT_EQ(back->allocation.routing, engine::RoutingKind::kHeat);
+  EXPECT_EQ(back->allocation.heat_period, 30.0);
   EXPECT_EQ(back->core.traffic.t_w1, 3.25);
   EXPECT_EQ(back->core.traffic.head_on, engine::HeadOnPolicy::kAlwaysWait);
   EXPECT_FALSE(back->core.traffic_control);
@@ -301,9 +305,11 @@ TEST(JournalStoreTest, ARunSetupRoundTrips) {
   // A journal written before the planners were selectable ran the rules.
   auto old = nlohmann::json::parse(*text);
   old["allocation"].erase("planner");
+  old["allocation"].erase("routing");
   auto before = DecodeRunSetup(old.dump());
   ASSERT_TRUE(before.ok()) << before.error().message;
   EXPECT_EQ(before->allocation.planner, engine::PlannerKind::kRules);
+  EXPECT_EQ(before->allocation.routing, engine::RoutingKind::kFloyd);
   old["allocation"]["planner"] = "magic";
   EXPECT_FALSE(DecodeRunSetup(old.dump()).ok());
 }

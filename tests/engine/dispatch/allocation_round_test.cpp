@@ -12,19 +12,8 @@ namespace {
 
 using testing_util::Chu2024;
 using testing_util::Chu2024Routes;
+using testing_util::MakeOrder;
 using testing_util::PointsOfKind;
-
-std::shared_ptr<const Order> MakeOrder(const std::string& id, PointId pick, PointId drop, double created,
-                                       int priority = 0) {
-  auto o = std::make_shared<Order>();
-  o->id = id;
-  o->client_id = id;
-  o->picks = {pick};
-  o->drop = drop;
-  o->created_time = created;
-  o->priority = priority;
-  return o;
-}
 
 RoundRunner Runner(const std::string& strategy = "auction") {
   return RoundRunner(Chu2024(), Chu2024Routes(), AllocationConfig{}, std::move(MakeAllocator(strategy)).value());

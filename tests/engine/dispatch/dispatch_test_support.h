@@ -1,11 +1,15 @@
-// Shared set-up of the dispatch core's tests: the built-in Chu2024 floor and its route table.
+// Shared set-up of the dispatch core's tests: the built-in Chu2024 floor, its route table, and
+// single-pick orders on it.
 #pragma once
 
 #include <gtest/gtest.h>
 
 #include <memory>
 #include <stdexcept>
+#include <string>
 #include <vector>
+
+#include "engine/fleet/order.h"
 
 #include "engine/map/chu2024_floor.h"
 #include "engine/routing/route_table.h"
@@ -38,6 +42,19 @@ inline std::vector<PointId> PointsOfKind(const WarehouseMap& map, PointKind kind
     if (map.points()[i].kind == kind) out.push_back(static_cast<PointId>(i));
   }
   return out;
+}
+
+// A single-pick order as the core holds it.
+inline std::shared_ptr<const Order> MakeOrder(const std::string& id, PointId pick, PointId drop, double created,
+                                              int priority = 0) {
+  auto o = std::make_shared<Order>();
+  o->id = id;
+  o->client_id = id;
+  o->picks = {pick};
+  o->drop = drop;
+  o->created_time = created;
+  o->priority = priority;
+  return o;
 }
 
 }  // namespace dispatch::engine::testing_util

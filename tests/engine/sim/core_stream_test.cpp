@@ -109,14 +109,17 @@ TEST(CoreStreamTest, RandomStreamAuctionBeatsGreedyOnTheCore) {
   EXPECT_LT(makespan[1], makespan[2]);
 }
 
-// Issue 16 §3: the time-window planner is selectable in the simulator; on the random stream
-// every order completes with eps1 kept, the same orders by the same strategy, and the tables
-// complete with the safety check clean.
-TEST(CoreStreamTest, TheTimeWindowPlannerCompletesTheStreamAndTheTables) {
+// Issue 16 §3: the time-window planner and the heat routing are selectable in the simulator;
+// on the random stream every order completes with eps1 kept, and the tables complete with the
+// safety check clean.
+class CorePlannerTest : public ::testing::TestWithParam<std::pair<PlannerKind, RoutingKind>> {};
+
+TEST_P(CorePlannerTest, CompletesTheStreamAndTheTables) {
   const World w = Chu();
   const Stream s = ChuStream(w, 200, 1);
   StreamConfig c = Config();
-  c.allocation.planner = PlannerKind::kTimeWindows;
+  c.allocation.planner = GetParam().first;
+  c.allocation.routing = GetParam().second;
   auto r = SimulateOnCore(w.map, w.routes, s.robots, s.orders, c);
   ASSERT_TRUE(r.ok()) << r.error().message;
   ExpectCompleteAndClear(w, s.orders, *r, c);
@@ -129,6 +132,13 @@ TEST(CoreStreamTest, TheTimeWindowPlannerCompletesTheStreamAndTheTables) {
     ExpectCompleteAndClear(w, orders, *t, c);
   }
 }
+
+INSTANTIATE_TEST_SUITE_P(Planners, CorePlannerTest,
+                         ::testing::Values(std::pair{PlannerKind::kTimeWindows, RoutingKind::kFloyd},
+                                           std::pair{PlannerKind::kRules, RoutingKind::kHeat}),
+                         [](const auto& info) {
+                           return std::string(info.param.first == PlannerKind::kTimeWindows ? "TimeWindows" : "HeatRouting");
+                         });
 
 TEST(CoreStreamTest, RunsAreDeterministic) {
   const World w = Chu();

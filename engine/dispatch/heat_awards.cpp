@@ -1,0 +1,94 @@
+#include "engine/dispatch/heat_awards.h"
+
+#include <algorithm>
+
+#include "engine/planning/path_heat.h"
+
+namespace dispatch::engine {
+namespace {
+
+constexpr std::size_t kNone = static_cast<std::size_t>(-1);
+
+// Every arc driven by every plan, with the time it is entered.
+std::vector<LaneUse> UsesOf(const WarehouseMap& map, const FleetState& fleet) {
+  std::vector<LaneUse> uses;
+  for (std::size_t i = 0; i < fleet.robot_count(); ++i) {
+    const auto& w = fleet.plan(i).waypoints;
+    for (std::size_t k = 1; k < w.size(); ++k) {
+      if (w[k].point == w[k - 1].point) continue;
+      if (const auto a = map.FindArc(w[k - 1].point, w[k].point)) {
+        uses.push_back({*a, static_cast<int>(i), w[k - 1].departure()});
+      }
+    }
+  }
+  return uses;
+}
+
+}  // namespace
+
+void RouteAwardsByHeat(const WarehouseMap& map, const AllocationConfig& config, const FleetState& fleet,
+                       const RoundSegments& segments, double now, std::vector<RoundAward>& awards,
+                       std::vector<std::string>& notes) {
+  const PathHeat heat = PathHeat::FromUses(map, UsesOf(map, fleet), now, config.heat_period);
+  // Per robot: where and when its next new segment starts (its queue's end, then the end of
+  // the segment before it in this round).
+  std::vector<PointId> at(fleet.robot_count(), kNoPoint);
+  std::vector<double> free_at(fleet.robot_count(), now);
+  for (std::size_t i = 0; i < fleet.robot_count(); ++i) {
+    const std::size_t first = i < segments.first_new.size() ? segments.first_new[i] : kNone;
+    const auto& w = fleet.plan(i).waypoints;
+    if (first == kNone || segments.in_formation[i] || w.empty()) continue;
+    const Waypoint& before = w[first > 0 ? first - 1 : 0];
+    at[i] = before.point;
+    free_at[i] = first > 0 ? before.departure() : before.eta;
+  }
+  for (RoundAward& a : awards) {
+    if (a.award.winners.size() != 1 || a.segments.size() != 1 || a.segments[0].empty()) continue;
+    const auto found = fleet.FindRobot(a.award.winners[0]);
+    if (!found || at[*found] == kNoPoint) continue;
+    const std::size_t i = *found;
+    const std::vector<Waypoint>& old = a.segments[0];
+    const bool fresh = a.after_departure[0] == 0.0 && old.front().point == at[i] && old.front().action == WaypointAction::kMove;
+    std::vector<Waypoint> out;
+    double clock = fresh ? old.front().eta : free_at[i];
+    if (fresh) out.push_back(old.front());
+    PointId from = at[i];
+    bool ok = true;
+    for (std::size_t k = fresh ? 1 : 0; k < old.size() && ok; ++k) {
+      const Waypoint& stop = old[k];
+      if (stop.action != WaypointAction::kPick && stop.action != WaypointAction::kDrop) continue;
+      auto route = HeatRoute(map, heat, from, stop.point, config.speed);
+      if (!route.ok()) {
+        ok = false;
+        notes.push_back("order " + a.order_id + ": heat routing: " + route.error().message + "; the table's route kept");
+        break;
+      }
+      for (std::size_t p = 1; p < route->points.size(); ++p) {
+        const Arc& arc = map.arc(route->arcs[p - 1]);
+        clock += arc.length / (arc.max_speed > 0.0 ? std::min(config.speed, arc.max_speed) : config.speed);
+        Waypoint wp;
+        wp.point = route->points[p];
+        wp.xy = map.point(wp.point).position;
+        wp.eta = clock;
+        wp.action = WaypointAction::kMove;
+        out.push_back(wp);
+      }
+      if (out.empty() || out.back().point != stop.point) {  // a stop where it already stands
+        Waypoint wp = stop;
+        wp.eta = clock;
+        out.push_back(wp);
+      } else {
+        out.back().action = stop.action;
+        out.back().dwell = stop.dwell;
+      }
+      clock += stop.dwell;
+      from = stop.point;
+    }
+    if (!ok) continue;
+    a.segments[0] = std::move(out);
+    at[i] = from;
+    free_at[i] = clock;
+  }
+}
+
+}  // namespace dispatch::engine

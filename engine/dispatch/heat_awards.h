@@ -1,0 +1,24 @@
+// Wang2019's path heat in an allocation round (issue 16 §1, AllocationConfig::routing = heat):
+// after the strategy's awards, the lanes every robot's plan uses in the next heat_period give
+// the heat (steps 1-4 of seed 004 §3.1; the new segments are the plain routes of step 1), and
+// each single-robot award's legs between its stops are routed again over the heat-weighted
+// lengths (step 5), timed at the allocation's speed with the stops' work times. Formation
+// awards keep their routes. Pure; the awards are rewritten.
+#pragma once
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "engine/allocation/allocation_config.h"
+#include "engine/allocation/fleet_state.h"
+#include "engine/dispatch/allocation_round.h"
+#include "engine/dispatch/window_awards.h"
+
+namespace dispatch::engine {
+
+void RouteAwardsByHeat(const WarehouseMap& map, const AllocationConfig& config, const FleetState& fleet,
+                       const RoundSegments& segments, double now, std::vector<RoundAward>& awards,
+                       std::vector<std::string>& notes);
+
+}  // namespace dispatch::engine

@@ -1,0 +1,54 @@
+// Wang2019's path heat (seed 004 §3.1, eqs. (13)-(14)): lanes that many planned routes use in
+// the coming period weigh more, so the next routes spread over the floor instead of queueing on
+// the shortest lanes. The seed's five steps: (1) every robot's route by plain Dijkstra;
+// (2) the use h_k of each lane in the period δ; (3) the robots b_g on each lane; (4)
+//   F_k = (b_k + 1) · h_k / Σ_j b_j · h_j,      (13)
+//   w_k = 1 + F_k;                              (14)
+// (5) the routes again by Dijkstra over length · w.
+//
+// Read here (the seed's symbols are partly lost in its text): a lane is a map path (both
+// directions of a bidirectional lane are one lane), h_k counts the traversals of lane k that
+// start within [from, from + period], and b_k the distinct robots making them. With no use at
+// all (Σ = 0) every weight is 1 and routes are the plain shortest ones.
+// Immutable once built; safe to share.
+#pragma once
+
+#include <cstddef>
+#include <vector>
+
+#include "engine/common/result.h"
+#include "engine/map/warehouse_map.h"
+#include "engine/routing/route_table.h"
+
+namespace dispatch::engine {
+
+// One planned traversal of an arc by a robot, starting at `time`.
+struct LaneUse {
+  ArcId arc = -1;
+  int robot = -1;
+  double time = 0.0;
+};
+
+class PathHeat {
+ public:
+  // Uses outside [from, from + period] or on unknown arcs are ignored.
+  static PathHeat FromUses(const WarehouseMap& map, const std::vector<LaneUse>& uses, double from, double period);
+
+  std::size_t lanes() const { return heat_.size(); }
+  int Heat(std::size_t lane) const { return heat_[lane]; }      // h_k
+  int Robots(std::size_t lane) const { return robots_[lane]; }  // b_k
+  double Weight(std::size_t lane) const { return weight_[lane]; }  // w_k = 1 + F_k
+  // The weight of the lane arc `a` belongs to.
+  double ArcWeight(const WarehouseMap& map, ArcId a) const;
+
+ private:
+  std::vector<int> heat_, robots_;
+  std::vector<double> weight_;
+};
+
+// The route from -> to minimising the weighted length Σ length · w (step 5), by Dijkstra;
+// Route::cost is the drive time at `speed` (arcs' own limits apply), Route::length the metres.
+// Errors: kNotFound (unknown point), kUnreachable.
+Result<Route> HeatRoute(const WarehouseMap& map, const PathHeat& heat, PointId from, PointId to, double speed);
+
+}  // namespace dispatch::engine
