@@ -164,7 +164,7 @@ engine::Result<ParsedCommandLine> ParseCommandLine(int argc, char** argv) {
   app.add_option("--strategy", flags.strategy, "auction | greedy")->capture_default_str();
   app.add_option("--zeta", flags.zeta, "Traffic weight (Chu2024 eq. 5)")->capture_default_str();
   app.add_option("--planner", flags.planner, "rules | time-windows (Wang2019 time windows)")->capture_default_str();
-  app.add_option("--turn-time", flags.turn_time, "Time-window planner: turning time per 90 degrees, s")
+  app.add_option("--turn-time", flags.turn_time, "Turning time per 90 degrees, s (plans, route costs)")
       ->capture_default_str();
   app.add_option("--routing", flags.routing, "floyd | heat (Wang2019 path heat, rules planner)")->capture_default_str();
   app.add_option("--heat-period", flags.heat_period, "Path heat: the period δ the lanes' use is counted over, s")

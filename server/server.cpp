@@ -115,11 +115,12 @@ engine::Result<std::unique_ptr<DispatchServer>> DispatchServer::Start(const Serv
   allocation.zeta = config.zeta;
   allocation.max_queue = static_cast<std::size_t>(config.max_queue);
   allocation.planner = engine::ParsePlanner(config.planner).value_or(engine::PlannerKind::kRules);
-  allocation.windows.turn_s_per_90 = config.turn_time;
+  allocation.turn_time = config.turn_time;
   allocation.routing = engine::ParseRouting(config.routing).value_or(engine::RoutingKind::kFloyd);
   allocation.heat_period = config.heat_period;
   engine::RouteTableOptions route_options;
   route_options.speed = allocation.speed;
+  route_options.turn_penalty_s = allocation.turn_time;
   route_options.lazy_cache_bytes = static_cast<std::size_t>(config.route_cache_mb) << 20;
   auto routes = engine::MakeRouteTable(map, route_options);
   if (!routes.ok()) return routes.error();

@@ -140,7 +140,7 @@ Result<std::string> EncodeRunSetup(const RunSetup& s) {
                        {"planner", engine::PlannerName(a.planner)},
                        {"windows_body_length", a.windows.body_length},
                        {"windows_headway_s", a.windows.headway_s},
-                       {"windows_turn_s_per_90", a.windows.turn_s_per_90},
+                       {"turn_time", a.turn_time},
                        {"routing", engine::RoutingName(a.routing)},
                        {"heat_period", a.heat_period}};
     j["core"] = {{"robot_snap_tolerance", s.core.robot_snap_tolerance},
@@ -194,7 +194,7 @@ Result<RunSetup> DecodeRunSetup(const std::string& text) {
     c.planner = *kind;
     c.windows.body_length = a.value("windows_body_length", c.windows.body_length);
     c.windows.headway_s = a.value("windows_headway_s", c.windows.headway_s);
-    c.windows.turn_s_per_90 = a.value("windows_turn_s_per_90", c.windows.turn_s_per_90);
+    c.turn_time = a.value("turn_time", 0.0);
     const std::string routing = a.value("routing", std::string("floyd"));
     const auto route_kind = engine::ParseRouting(routing);
     if (!route_kind) return Corrupt("run setup", "unknown routing " + routing);

@@ -30,7 +30,7 @@ Status ValidateAllocationConfig(const AllocationConfig& config) {
   }
   for (Status s : {positive("windows body_length", config.windows.body_length),
                    non_negative("windows headway_s", config.windows.headway_s),
-                   non_negative("windows turn_s_per_90", config.windows.turn_s_per_90)}) {
+                   non_negative("turn_time", config.turn_time)}) {
     if (!s.ok()) return s;
   }
   if (config.work_time_override) {

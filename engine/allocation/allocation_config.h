@@ -76,8 +76,14 @@ struct AllocationConfig {
   std::size_t max_queue = 0;
   TrafficPredictionConfig traffic;
   FormationOptions formation;
+  // Turning time t_c (Wang2019 §2.2), seconds per 90 degrees of heading change; >= 0. It
+  // enters plan ETAs (BuildPlan), the route table's costs and so T_d when the table is built
+  // with it (RouteTableOptions::turn_penalty_s, the callers' part), the time-window planner,
+  // and the simulator's robots. 0 (default): Chu2024 has no turning time.
+  double turn_time = 0.0;
   PlannerKind planner = PlannerKind::kRules;
-  TimeWindowRules windows;  // planner kTimeWindows; windows.speed is replaced by `speed`
+  // Planner kTimeWindows; its speed and turning time are replaced by `speed` and `turn_time`.
+  TimeWindowRules windows;
   RoutingKind routing = RoutingKind::kFloyd;
   double heat_period = 60.0;  // δ of Wang2019's path heat, seconds (> 0)
 };

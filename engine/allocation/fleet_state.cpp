@@ -111,7 +111,7 @@ Status FleetState::AssignSingle(std::size_t robot, const std::string& order_id,
   }
   RobotEntry& e = robots_[robot];
   const QueueSummary& s = e.summary;
-  Result<Plan> segment = BuildPlan(*map_, *routes_, s.end_point, s.end_time, config_.speed, {task});
+  Result<Plan> segment = BuildPlan(*map_, *routes_, s.end_point, s.end_time, config_.speed, {task}, config_.turn_time);
   if (!segment.ok()) {
     return Error{segment.error().code,
                  "order " + order_id + " for robot " + e.info.id + ": " + segment.error().message};

@@ -6,7 +6,7 @@
 //       [--formations 0.2]) [--strategy auction|greedy] [--zeta 100] [--csv series.csv]
 //       [--orders-csv out.csv] [--check-safety] [--journal run.db] [--max-queue N]
 //       [--one-formation-per-pick] [--trace R1,R2 [--trace-from T] [--trace-to T]]
-//       [--planner rules|time-windows [--turn-time S]] [--routing floyd|heat [--heat-period S]]
+//       [--planner rules|time-windows] [--routing floyd|heat [--heat-period S]] [--turn-time S]
 //       an order stream with release times (formation orders too) under the online traffic
 //       controller; with --planner time-windows single-robot awards are planned through the
 //       others' time windows (Wang2019, window_awards.h).
@@ -178,7 +178,7 @@ struct StreamArgs {
   std::vector<std::string> planners;       // compare: one column per planner (x routing)
   std::string routing = "floyd";           // AllocationConfig::routing (core model)
   std::vector<std::string> routings;       // compare: one column per routing (x planner)
-  double turn_s = 0.0;                     // time windows: turning time per 90 degrees
+  double turn_s = 0.0;                     // turning time per 90 degrees (AllocationConfig::turn_time)
   double heat_period = 60.0;               // path heat: δ, s
 };
 
@@ -194,7 +194,9 @@ Result<Setup> Prepare(const StreamArgs& a) {
   auto loaded = LoadMapSource(a.map);
   if (!loaded.ok()) return loaded.error();
   s.map = std::make_shared<const WarehouseMap>(std::move(loaded).value());
-  auto routes = MakeRouteTable(s.map, {});
+  RouteTableOptions route_options;
+  route_options.turn_penalty_s = a.turn_s;  // T_d counts turning as the plans do
+  auto routes = MakeRouteTable(s.map, route_options);
   if (!routes.ok()) return routes.error();
   s.routes = std::move(routes).value();
   auto robots = PlaceRobots(*s.map, a.robots);
@@ -240,7 +242,7 @@ StreamConfig ConfigOf(const StreamArgs& a, const std::string& strategy, double z
   c.allocation.zeta = zeta;
   c.allocation.max_queue = a.max_queue;
   c.allocation.planner = ParsePlanner(a.planner).value_or(PlannerKind::kRules);
-  c.allocation.windows.turn_s_per_90 = a.turn_s;
+  c.allocation.turn_time = a.turn_s;
   c.allocation.routing = ParseRouting(a.routing).value_or(RoutingKind::kFloyd);
   c.allocation.heat_period = a.heat_period;
   c.one_formation_per_pick = a.one_formation_per_pick;
@@ -444,7 +446,7 @@ int Main(int argc, char** argv) {
         ->capture_default_str()->check(CLI::IsMember({"core", "stream"}));
     c->add_option("--planner", a.planner, "How awards get their routes: " + PlannerList())
         ->capture_default_str();
-    c->add_option("--turn-time", a.turn_s, "Time-window planner: turning time per 90 degrees, s")
+    c->add_option("--turn-time", a.turn_s, "Turning time per 90 degrees, s (plans, route costs, robots)")
         ->capture_default_str()->check(CLI::NonNegativeNumber);
     c->add_option("--routing", a.routing, "Routes of the rules planner: floyd (shortest) or heat (Wang2019)")
         ->capture_default_str();

@@ -107,6 +107,7 @@ Result<Loaded> Load(storage::JournalStore& journal, std::int64_t wanted) {
   out.replay.map = std::make_shared<const WarehouseMap>(std::move(map).value());
   RouteTableOptions route_options;
   route_options.speed = setup->allocation.speed;
+  route_options.turn_penalty_s = setup->allocation.turn_time;
   route_options.lazy_cache_bytes = setup->route_cache_bytes;
   auto routes = MakeRouteTable(out.replay.map, route_options);
   if (!routes.ok()) return routes.error();

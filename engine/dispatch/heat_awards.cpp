@@ -1,8 +1,10 @@
 #include "engine/dispatch/heat_awards.h"
 
 #include <algorithm>
+#include <numbers>
 
 #include "engine/planning/path_heat.h"
+#include "engine/routing/cost_graph.h"
 
 namespace dispatch::engine {
 namespace {
@@ -53,6 +55,7 @@ void RouteAwardsByHeat(const WarehouseMap& map, const AllocationConfig& config, 
     double clock = fresh ? old.front().eta : free_at[i];
     if (fresh) out.push_back(old.front());
     PointId from = at[i];
+    ArcId last_arc = -1;
     bool ok = true;
     for (std::size_t k = fresh ? 1 : 0; k < old.size() && ok; ++k) {
       const Waypoint& stop = old[k];
@@ -64,7 +67,12 @@ void RouteAwardsByHeat(const WarehouseMap& map, const AllocationConfig& config, 
         break;
       }
       for (std::size_t p = 1; p < route->points.size(); ++p) {
-        const Arc& arc = map.arc(route->arcs[p - 1]);
+        const ArcId a_id = route->arcs[p - 1];
+        const Arc& arc = map.arc(a_id);
+        if (config.turn_time > 0.0 && last_arc >= 0) {
+          clock += config.turn_time * TurnAngle(map, last_arc, a_id) / (std::numbers::pi / 2.0);  // as BuildPlan
+        }
+        last_arc = a_id;
         clock += arc.length / (arc.max_speed > 0.0 ? std::min(config.speed, arc.max_speed) : config.speed);
         Waypoint wp;
         wp.point = route->points[p];

@@ -73,6 +73,7 @@ void PlanAwardsInWindows(const std::shared_ptr<const WarehouseMap>& map, const R
                          double now, std::vector<RoundAward>& awards, std::vector<std::string>& notes) {
   TimeWindowRules rules = config.windows;
   rules.speed = config.speed;
+  rules.turn_s_per_90 = config.turn_time;
   ReservationTable table(map, rules);
   const std::size_t n = fleet.robot_count();
   std::vector<bool> replan(n, false);

@@ -2,8 +2,11 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numbers>
 #include <limits>
 #include <stdexcept>
+
+#include "engine/routing/cost_graph.h"
 
 namespace dispatch::engine {
 namespace {
@@ -91,7 +94,8 @@ int TaskPointCount(const PlanTask& task) { return static_cast<int>(task.picks.si
 double TaskWorkTime(const PlanTask& task) { return TaskPointCount(task) * task.work_time; }
 
 Result<Plan> BuildPlan(const WarehouseMap& map, const RouteTable& routes, PointId start,
-                       double start_time, double speed, const std::vector<PlanTask>& tasks) {
+                       double start_time, double speed, const std::vector<PlanTask>& tasks,
+                       double turn_time) {
   if (!std::isfinite(speed) || speed <= 0.0) {
     return InvalidArgument("speed must be > 0 m/s, got " + std::to_string(speed));
   }
@@ -115,8 +119,12 @@ Result<Plan> BuildPlan(const WarehouseMap& map, const RouteTable& routes, PointI
 
   Plan plan;
   Append(plan, start, map.point(start).position, start_time, WaypointAction::kMove, 0.0);
+  if (!std::isfinite(turn_time) || turn_time < 0.0) {
+    return InvalidArgument("turn time must be finite and >= 0 s, got " + std::to_string(turn_time));
+  }
   PointId at = start;
   double time = start_time;
+  ArcId last_arc = -1;  // the arc the robot came by (turning time from its heading)
   // Drives from `at` to `stop` along the table's route, then works `dwell` there.
   auto visit = [&](PointId stop, WaypointAction action, double dwell) -> Status {
     Result<Route> route = routes.Path(at, stop);
@@ -125,6 +133,10 @@ Result<Plan> BuildPlan(const WarehouseMap& map, const RouteTable& routes, PointI
     for (std::size_t i = 0; i < r.arcs.size(); ++i) {
       const Arc& arc = map.arc(r.arcs[i]);
       const double v = arc.max_speed > 0.0 ? std::min(speed, arc.max_speed) : speed;
+      if (turn_time > 0.0 && last_arc >= 0) {
+        time += turn_time * TurnAngle(map, last_arc, r.arcs[i]) / (std::numbers::pi / 2.0);
+      }
+      last_arc = r.arcs[i];
       time += arc.length / v;
       const PointId p = r.points[i + 1];
       if (i + 1 < r.arcs.size()) {

@@ -82,11 +82,14 @@ double TaskWorkTime(const PlanTask& task);
 // `speed` (m/s; an arc's own max_speed caps it where lower). Waypoint 0 is the start (move,
 // eta = start_time); every point of the RouteTable's route between consecutive stops becomes
 // a waypoint (move for passed points, pick/drop at the stops, with dwell = t_w), ETAs by
-// arc length / speed (the table's optional turn penalty chooses routes but adds no time
-// here). No tasks: just the start waypoint. robot_id is left empty.
+// arc length / speed plus `turn_time` seconds per 90 degrees of heading change between
+// consecutive arcs of the plan (Wang2019's turning time t_c, spent standing before the next
+// arc; the first arc's turn is not counted: a standing robot's heading is not known here).
+// No tasks: just the start waypoint. robot_id is left empty.
 // Errors: kInvalidArgument (speed <= 0, non-finite start time, a task without picks or with
 // negative t_w), kNotFound (unknown point id), kUnreachable (names both points).
 Result<Plan> BuildPlan(const WarehouseMap& map, const RouteTable& routes, PointId start,
-                       double start_time, double speed, const std::vector<PlanTask>& tasks);
+                       double start_time, double speed, const std::vector<PlanTask>& tasks,
+                       double turn_time = 0.0);
 
 }  // namespace dispatch::engine

@@ -2,7 +2,10 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numbers>
 #include <string>
+
+#include "engine/routing/cost_graph.h"
 
 namespace dispatch::engine {
 namespace {
@@ -58,13 +61,7 @@ double DriveTime(const WarehouseMap& map, const TimeWindowRules& rules, ArcId a)
 
 double TurnTime(const WarehouseMap& map, const TimeWindowRules& rules, ArcId before, ArcId a) {
   if (before < 0 || rules.turn_s_per_90 <= 0.0) return 0.0;
-  const Arc& x = map.arc(before);
-  const Arc& y = map.arc(a);
-  const Eigen::Vector2d u = map.point(x.to).position - map.point(x.from).position;
-  const Eigen::Vector2d w = map.point(y.to).position - map.point(y.from).position;
-  if (u.norm() < 1e-12 || w.norm() < 1e-12) return 0.0;
-  const double cos = std::clamp(u.dot(w) / (u.norm() * w.norm()), -1.0, 1.0);
-  return rules.turn_s_per_90 * std::acos(cos) / (M_PI / 2.0);
+  return rules.turn_s_per_90 * TurnAngle(map, before, a) / (std::numbers::pi / 2.0);
 }
 
 ReservationTable::ReservationTable(std::shared_ptr<const WarehouseMap> map, TimeWindowRules rules)

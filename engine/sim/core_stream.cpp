@@ -45,7 +45,7 @@ class CoreRun {
       r.pose.position = map_->point(fr.start).position;
       if (auto valid = ValidateRobot(r); !valid.ok()) return valid;
       index_.emplace(fr.id, bots_.size());
-      bots_.emplace_back(fr.id, r.pose.position, config_.allocation.speed);
+      bots_.emplace_back(fr.id, r.pose.position, config_.allocation.speed, config_.allocation.turn_time);
       was_waiting_.push_back(false);
       reported_.emplace_back();
       Deliver(core_->Connect(std::move(r), 0.0));

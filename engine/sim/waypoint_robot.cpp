@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numbers>
 
 namespace dispatch::engine {
 namespace {
@@ -12,8 +13,8 @@ bool IsTask(const Waypoint& w) { return w.action == WaypointAction::kPick || w.a
 
 }  // namespace
 
-WaypointRobot::WaypointRobot(std::string id, const Eigen::Vector2d& xy, double speed)
-    : id_(std::move(id)), xy_(xy), speed_(speed) {}
+WaypointRobot::WaypointRobot(std::string id, const Eigen::Vector2d& xy, double speed, double turn_time)
+    : id_(std::move(id)), xy_(xy), speed_(speed), turn_time_(turn_time) {}
 
 bool WaypointRobot::idle() const {
   return !dwelling_ && (stops_.empty() || (stops_.size() == 1 && stops_.front().arrived));
@@ -125,7 +126,18 @@ void WaypointRobot::Step(double now, std::vector<RobotEvent>& out) {
       continue;
     }
     if (speed_ <= 0.0 || t >= now_) break;
-    heading_ = std::atan2(d.y(), d.x());
+    const double want = std::atan2(d.y(), d.x());
+    if (turning_to_ != front.wp.seq) {  // a new leg: turn to it first (Wang2019's t_c)
+      turning_to_ = front.wp.seq;
+      const double angle = has_heading_ ? std::abs(std::remainder(want - heading_, 2.0 * std::numbers::pi)) : 0.0;
+      turn_end_ = t + turn_time_ * angle / (std::numbers::pi / 2.0);
+    }
+    if (turn_end_ > t) {
+      if (turn_end_ >= now_) break;  // still turning, standing
+      t = turn_end_;
+    }
+    heading_ = want;
+    has_heading_ = true;
     moving_ = true;
     const double reach = speed_ * (now_ - t);
     if (reach + kArriveEps >= dist) {

@@ -2,7 +2,9 @@
 // the core plus a motion model): it stands on or drives between the waypoints of its current
 // plan, straight towards the next one at up to `speed` m/s, never past the last released
 // waypoint, never leaving a waypoint before its planned departure (eta + dwell: ahead of plan
-// it waits, behind plan it goes at full speed). At a waypoint with a dwell it stands that long;
+// it waits, behind plan it goes at full speed), turning in place first where its heading
+// changes (`turn_time` seconds per 90 degrees, as BuildPlan times it; none before its first
+// move). At a waypoint with a dwell it stands that long;
 // at a pick or drop it then reports the pick or drop. Every waypoint reached is reported once,
 // in order.
 //
@@ -34,7 +36,7 @@ struct RobotEvent {
 
 class WaypointRobot {
  public:
-  WaypointRobot(std::string id, const Eigen::Vector2d& xy, double speed);
+  WaypointRobot(std::string id, const Eigen::Vector2d& xy, double speed, double turn_time = 0.0);
 
   const std::string& id() const { return id_; }
   const Eigen::Vector2d& xy() const { return xy_; }
@@ -64,7 +66,11 @@ class WaypointRobot {
   std::string id_;
   Eigen::Vector2d xy_;
   double heading_ = 0.0;
+  bool has_heading_ = false;  // it has moved (before, its heading is not known)
   double speed_;
+  double turn_time_;            // s per 90 degrees
+  int turning_to_ = -1;         // the waypoint (seq) it turned, or turns, towards
+  double turn_end_ = 0.0;       // when that turn is done
   double now_ = 0.0;
   bool started_ = false;
   bool moving_ = false;

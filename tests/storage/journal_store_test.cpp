@@ -275,7 +275,7 @@ TEST(JournalStoreTest, ARunSetupRoundTrips) {
   s.allocation.zeta = 0.0;
   s.allocation.work_time_override = 7.5;
   s.allocation.planner = engine::PlannerKind::kTimeWindows;
-  s.allocation.windows.turn_s_per_90 = 1.5;
+  s.allocation.turn_time = 1.5;
   s.allocation.routing = engine::RoutingKind::kHeat;
   s.allocation.heat_period = 30.0;
   s.core.traffic.t_w1 = 3.25;
@@ -291,7 +291,7 @@ TEST(JournalStoreTest, ARunSetupRoundTrips) {
   EXPECT_EQ(back->allocation.zeta, 0.0);
   EXPECT_EQ(back->allocation.work_time_override, 7.5);
   EXPECT_EQ(back->allocation.planner, engine::PlannerKind::kTimeWindows);
-  EXPECT_EQ(back->allocation.windows.turn_s_per_90, 1.5);
+  EXPECT_EQ(back->allocation.turn_time, 1.5);
   EXPECT_EQ(back->allocation.routing, engine::RoutingKind::kHeat);
   EXPECT_EQ(back->allocation.heat_period, 30.0);
   EXPECT_EQ(back->core.traffic.t_w1, 3.25);

@@ -181,6 +181,29 @@ TEST(WaypointActionTest, NamesRoundTrip) {
   EXPECT_FALSE(ParseWaypointAction("fly").has_value());
 }
 
+// Wang2019's turning time: every heading change between consecutive arcs adds its share of
+// turn_time (per 90 degrees) to the ETAs after it; without turns the plan is unchanged.
+TEST_F(PlanTest, TurningTimeAddsItsShareAtEveryHeadingChange) {
+  const PointId start = map_->FindPoint("park-P1").value();
+  const std::vector<PlanTask> tasks = {{{Pick(29, 13)}, Drop(32.25, 5), 5.0}};
+  const Plan plain = BuildPlan(*map_, *routes_, start, 0.0, 1.0, tasks).value();
+  const Plan turning = BuildPlan(*map_, *routes_, start, 0.0, 1.0, tasks, 2.0).value();
+  ASSERT_EQ(plain.waypoints.size(), turning.waypoints.size());
+  double turned = 0.0;  // expected extra seconds so far
+  for (std::size_t i = 2; i < plain.waypoints.size(); ++i) {
+    const Waypoint& a = plain.waypoints[i - 2];
+    const Waypoint& b = plain.waypoints[i - 1];
+    const Waypoint& c = plain.waypoints[i];
+    const Eigen::Vector2d u = b.xy - a.xy, v = c.xy - b.xy;
+    if (u.norm() > 1e-9 && v.norm() > 1e-9) {
+      turned += 2.0 * std::abs(std::atan2(u.x() * v.y() - u.y() * v.x(), u.dot(v))) / (M_PI / 2.0);
+    }
+    EXPECT_NEAR(turning.waypoints[i].eta - plain.waypoints[i].eta, turned, 1e-9) << i;
+  }
+  EXPECT_GT(turned, 2.0);  // the route turns at least once
+  EXPECT_FALSE(BuildPlan(*map_, *routes_, start, 0.0, 1.0, tasks, -1.0).ok());
+}
+
 TEST(FindSequenceTest, FindsAWaypointInAPlanWithOrWithoutGapsOrOutOfOrder) {
   auto plan = [](std::vector<int> seqs) {
     std::vector<Waypoint> w;

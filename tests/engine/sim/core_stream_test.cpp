@@ -140,6 +140,21 @@ INSTANTIATE_TEST_SUITE_P(Planners, CorePlannerTest,
                            return std::string(info.param.first == PlannerKind::kTimeWindows ? "TimeWindows" : "HeatRouting");
                          });
 
+// Issue 16 §1: turning time enters the plans (BuildPlan) and the robots' motion (WaypointRobot)
+// together: the stream still completes with eps1 kept, later than without turning.
+TEST(CoreStreamTest, TurningTimeSlowsTheStreamAndEveryOrderStillCompletes) {
+  const World w = Chu();
+  const Stream s = ChuStream(w, 200, 1);
+  StreamConfig c = Config();
+  auto straight = SimulateOnCore(w.map, w.routes, s.robots, s.orders, c);
+  c.allocation.turn_time = 1.0;
+  auto turning = SimulateOnCore(w.map, w.routes, s.robots, s.orders, c);
+  ASSERT_TRUE(straight.ok() && turning.ok());
+  ExpectCompleteAndClear(w, s.orders, *turning, c);
+  EXPECT_GT(turning->makespan, straight->makespan);
+  EXPECT_GT(turning->mean_completion, straight->mean_completion);
+}
+
 TEST(CoreStreamTest, RunsAreDeterministic) {
   const World w = Chu();
   const Stream s = ChuStream(w, 40, 3);
