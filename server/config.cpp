@@ -56,6 +56,7 @@ std::vector<Key> Keys() {
       MakeKey("t_w2", &ServerConfig::t_w2),
       MakeKey("blocked_after", &ServerConfig::blocked_after),
       MakeKey("blocked_recovery", &ServerConfig::blocked_recovery),
+      MakeKey("priority", &ServerConfig::priority),
       MakeKey("route_cache_mb", &ServerConfig::route_cache_mb),
       MakeKey("finished_retained", &ServerConfig::finished_retained),
       MakeKey("journal_runs", &ServerConfig::journal_runs),
@@ -118,6 +119,9 @@ engine::Status ValidateServerConfig(const ServerConfig& c) {
     for (const std::string& n : engine::PlannerNames()) names += (names.empty() ? "" : ", ") + n;
     return InvalidArgument("planner must be one of " + names + ", got '" + c.planner + "'");
   }
+  if (c.priority != "index" && c.priority != "release") {
+    return InvalidArgument("priority must be index or release, got '" + c.priority + "'");
+  }
   if (!engine::ParseRouting(c.routing)) {
     return InvalidArgument("routing must be floyd or heat, got '" + c.routing + "'");
   }
@@ -165,6 +169,8 @@ engine::Result<ParsedCommandLine> ParseCommandLine(int argc, char** argv) {
   app.add_option("--zeta", flags.zeta, "Traffic weight (Chu2024 eq. 5)")->capture_default_str();
   app.add_option("--planner", flags.planner, "rules | time-windows (Wang2019 time windows)")->capture_default_str();
   app.add_option("--turn-time", flags.turn_time, "Turning time per 90 degrees, s (plans, route costs)")
+      ->capture_default_str();
+  app.add_option("--priority", flags.priority, "Traffic priority within a class: index | release (Wang2019)")
       ->capture_default_str();
   app.add_option("--routing", flags.routing, "floyd | heat (Wang2019 path heat, rules planner)")->capture_default_str();
   app.add_option("--heat-period", flags.heat_period, "Path heat: the period δ the lanes' use is counted over, s")

@@ -45,6 +45,9 @@ struct ServerConfig {
   double t_w2 = 20.0;           // s: wait on a held point or grant before re-planning
   double blocked_after = 120.0; // s of waiting with no alternative -> robot blocked (fault)
   double blocked_recovery = 60.0;  // s a blocked robot stays in fault (0: until its next Hello)
+  // Traffic priority within a class (working, loaded, the rest): index (the lower robot index)
+  // or release (the earlier task release, Wang2019 §3.2).
+  std::string priority = "index";
   // Bound of the lazy route table's per-destination cache (large grid floors, where a dense
   // all-pairs table does not fit), MiB. It should hold the destinations in use at once (every
   // robot's next stop): on a 38k-cell floor one destination takes 0.46 MB.

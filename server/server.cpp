@@ -163,6 +163,7 @@ engine::Result<std::unique_ptr<DispatchServer>> DispatchServer::Start(const Serv
   options.traffic.t_w1 = config.t_w1;
   options.traffic.t_w2 = config.t_w2;
   options.traffic.blocked_after = config.blocked_after;
+  options.traffic.priority_by_release = config.priority == "release";
   options.map_version = recorded->content_hash;
   options.metrics = s->metrics_.get();
   if (!store && config.journal_runs > 0) {

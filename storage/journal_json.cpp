@@ -154,7 +154,8 @@ Result<std::string> EncodeRunSetup(const RunSetup& s) {
                  {"blocked_after", t.blocked_after},
                  {"max_envelope", t.max_envelope},
                  {"intersection_grants", t.intersection_grants},
-                 {"head_on", HeadOnName(t.head_on)}};
+                 {"head_on", HeadOnName(t.head_on)},
+                 {"priority_by_release", t.priority_by_release}};
     j["route_cache_bytes"] = s.route_cache_bytes;
     j["time_scale"] = s.time_scale;
     return j.dump();
@@ -213,6 +214,7 @@ Result<RunSetup> DecodeRunSetup(const std::string& text) {
     t.blocked_after = k.at("blocked_after").get<double>();
     t.max_envelope = k.at("max_envelope").get<double>();
     t.intersection_grants = k.at("intersection_grants").get<bool>();
+    t.priority_by_release = k.value("priority_by_release", false);  // journals before it: by index
     const std::string head_on = k.at("head_on").get<std::string>();
     bool known = false;
     for (auto p : {engine::HeadOnPolicy::kChooseFaster, engine::HeadOnPolicy::kAlwaysWait,

@@ -180,6 +180,7 @@ struct StreamArgs {
   std::vector<std::string> routings;       // compare: one column per routing (x planner)
   double turn_s = 0.0;                     // turning time per 90 degrees (AllocationConfig::turn_time)
   double heat_period = 60.0;               // path heat: δ, s
+  std::string priority = "index";          // TrafficControllerConfig::priority_by_release
 };
 
 struct Setup {
@@ -245,6 +246,7 @@ StreamConfig ConfigOf(const StreamArgs& a, const std::string& strategy, double z
   c.allocation.turn_time = a.turn_s;
   c.allocation.routing = ParseRouting(a.routing).value_or(RoutingKind::kFloyd);
   c.allocation.heat_period = a.heat_period;
+  c.traffic.priority_by_release = a.priority == "release";
   c.one_formation_per_pick = a.one_formation_per_pick;
   c.blocked_recovery = a.blocked_recovery;
   c.check_safety = a.check_safety;
@@ -450,6 +452,8 @@ int Main(int argc, char** argv) {
         ->capture_default_str()->check(CLI::NonNegativeNumber);
     c->add_option("--routing", a.routing, "Routes of the rules planner: floyd (shortest) or heat (Wang2019)")
         ->capture_default_str();
+    c->add_option("--priority", a.priority, "Traffic priority within a class: index or release (Wang2019)")
+        ->capture_default_str()->check(CLI::IsMember({"index", "release"}));
     c->add_option("--heat-period", a.heat_period, "Path heat: the period δ the lanes' use is counted over, s")
         ->capture_default_str()->check(CLI::PositiveNumber);
     c->add_option("--max-queue", a.max_queue, "Orders a robot may hold and still bid (0: no limit)")

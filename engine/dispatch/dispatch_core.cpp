@@ -3,6 +3,7 @@
 #include "engine/dispatch/dispatch_core.h"
 
 #include <algorithm>
+#include <limits>
 
 #include "engine/dispatch/order_release.h"
 
@@ -352,11 +353,16 @@ std::vector<RobotCommand> DispatchCore::Apply(const Change& change) {
 
 GatePlan DispatchCore::GatePlanOf(const BookRobot& r) const {
   std::map<std::string, std::vector<std::string>> teams;
+  double release = std::numeric_limits<double>::infinity();
   for (const auto& id : r.assignment.order_ids) {
     const BookOrder* o = order(id);
-    if (o && o->order->formation) teams[id] = o->robots;
+    if (!o) continue;
+    if (o->order->formation) teams[id] = o->robots;
+    release = std::min(release, o->order->created_time);
   }
-  return ToGatePlan(r.assignment, std::move(teams));
+  GatePlan plan = ToGatePlan(r.assignment, std::move(teams));
+  plan.release = release;
+  return plan;
 }
 
 void DispatchCore::SyncGate(const BookRobot& r) {

@@ -155,6 +155,7 @@ void TrafficController::SetWorking(std::size_t r, bool working, double work_end)
   impl_->robots.at(r).work_end = work_end;
 }
 void TrafficController::SetLoaded(std::size_t r, bool loaded) { impl_->robots.at(r).loaded = loaded; }
+void TrafficController::SetRank(std::size_t r, double release_time) { impl_->robots.at(r).rank = release_time; }
 void TrafficController::SetIdle(std::size_t r, bool idle) { impl_->robots.at(r).idle = idle; }
 void TrafficController::SetGroup(std::size_t r, int group, int second, int third) {
   impl_->robots.at(r).group = std::max(0, group);

@@ -24,7 +24,8 @@
 //    point / grant longer than T_w2, re-plans a detour if one exists; a robot that has waited
 //    `blocked_after` with no alternative is reported blocked (kBlocked, with the reason).
 //  - Priority: a robot that works (picks/drops: SetWorking) is never asked to yield; among
-//    the others loaded robots (SetLoaded) come before empty ones, then lower index.
+//    the others loaded robots (SetLoaded) come before empty ones, then (priority_by_release,
+//    Wang2019 §3.2) the earlier task release (SetRank), then lower index.
 //  - Deadlock (ResolveDeadlocks): the wait-for graph has an edge from every waiting robot to
 //    one robot it waits for (point holder, oncoming corridor holder, or grant holder); each
 //    node has out-degree <= 1, so cycles are found in O(robots). In each cycle the lowest-
@@ -72,6 +73,9 @@ struct TrafficControllerConfig {
   double max_envelope = 0.25;
   bool intersection_grants = true;
   HeadOnPolicy head_on = HeadOnPolicy::kChooseFaster;
+  // Wang2019 §3.2: between robots of one class (working, loaded, the rest) the one whose task
+  // was released earlier has priority (SetRank); false: the lower index, as before.
+  bool priority_by_release = false;
   Status Validate() const;
 };
 
@@ -124,6 +128,9 @@ class TrafficController {
   // remaining work counts in oncoming robots' wait estimates.
   void SetWorking(std::size_t r, bool working, double work_end = 0.0);
   void SetLoaded(std::size_t r, bool loaded);
+  // The release time of robot r's task (+infinity: none, the lowest); read when
+  // priority_by_release is set.
+  void SetRank(std::size_t r, double release_time);
   // Idle: no work assigned. Only idle robots are nudged aside for others.
   void SetIdle(std::size_t r, bool idle);
   // Robots sharing a group (> 0; 0 = none), e.g. the members of a formation assembling at

@@ -39,6 +39,7 @@ struct RobotState {
   int group = 0, group2 = 0, group3 = 0;  // > 0: robots sharing a group (a formation) may come closer
   double envelope = 0.0;  // extra clearance (a formation's D_f), <= config.max_envelope
   double work_end = 0.0;
+  double rank = std::numeric_limits<double>::infinity();  // its task's release time (SetRank)
   bool idle = true;
   std::vector<int> corridors;  // held corridor reservations
   int guard = -1;              // intersection requested or granted
@@ -147,7 +148,9 @@ struct TrafficController::Impl {
   // True when robot a yields to robot b (a has lower priority).
   bool Lower(std::size_t a, std::size_t b) const {
     const int pa = Priority(a), pb = Priority(b);
-    return pa != pb ? pa < pb : a > b;
+    if (pa != pb) return pa < pb;
+    if (config.priority_by_release && robots[a].rank != robots[b].rank) return robots[a].rank > robots[b].rank;
+    return a > b;
   }
   // Robots of one formation (a shared group) may come closer than eps1.
   static bool Mates(const RobotState& a, const RobotState& b) {

@@ -216,6 +216,7 @@ void TrafficGate::SetPlan(const std::string& robot, GatePlan plan) {
   plan.next_sequence = std::max(plan.next_sequence, b.plan.next_sequence);
   b.plan = std::move(plan);
   s.Reindex(b);
+  if (b.ctl >= 0) s.ctl.SetRank(static_cast<std::size_t>(b.ctl), b.plan.release);
   b.leg_stale = true;
   if (b.released < b.reached_seq) b.released = b.reached_seq;
   s.SyncTeams(b);

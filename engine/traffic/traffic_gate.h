@@ -80,6 +80,9 @@ struct GatePlan {
   // Formation orders among them: order id -> members, leader first.
   std::map<std::string, std::vector<std::string>> teams;
   std::uint64_t next_sequence = 1;  // the first waypoint sequence never issued
+  // The earliest release time of its orders (+infinity: none): its traffic priority under
+  // TrafficControllerConfig::priority_by_release.
+  double release = std::numeric_limits<double>::infinity();
 };
 
 struct MinDistance {

@@ -46,6 +46,7 @@ bool GateImpl::StepLeaving(GateTeam& team, double t, std::vector<GateEffect>& ou
       auto added = ctl.AddRobot(b.id, at, group);
       if (!added.ok()) return false;
       b.ctl = static_cast<int>(*added);
+      ctl.SetRank(*added, b.plan.release);
       return true;
     }
     if (!ctl.removed(static_cast<std::size_t>(b.ctl))) ctl.Remove(static_cast<std::size_t>(b.ctl));

@@ -25,6 +25,7 @@ bool GateImpl::PlaceBot(GateBot& b, PointId at) {
     auto added = ctl.AddRobot(b.id, at);
     if (!added.ok()) return false;
     b.ctl = static_cast<int>(*added);
+    ctl.SetRank(*added, b.plan.release);
   } else if (ctl.removed(static_cast<std::size_t>(b.ctl))) {
     if (!ctl.Place(static_cast<std::size_t>(b.ctl), at).ok()) return false;
   } else {

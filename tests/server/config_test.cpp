@@ -21,7 +21,7 @@ TEST(ServerConfigTest, FlagsSetTheConfig) {
                        "--strategy", "greedy", "--zeta", "0", "--alpha", "0.3", "--beta", "0.7",
                        "--time-scale", "10", "--bind", "127.0.0.1", "--ports-file", "p.json",
                        "--planner", "time-windows", "--turn-time", "1.5", "--routing", "heat",
-                       "--heat-period", "30"});
+                       "--heat-period", "30", "--priority", "release"});
   ASSERT_TRUE(parsed.ok()) << parsed.error().message;
   const ServerConfig& c = parsed->config;
   EXPECT_EQ(c.grpc_port, 0);
@@ -38,6 +38,7 @@ TEST(ServerConfigTest, FlagsSetTheConfig) {
   EXPECT_DOUBLE_EQ(c.turn_time, 1.5);
   EXPECT_EQ(c.routing, "heat");
   EXPECT_DOUBLE_EQ(c.heat_period, 30.0);
+  EXPECT_EQ(c.priority, "release");
 }
 
 TEST(ServerConfigTest, FileKeysApplyAndFlagsWin) {
@@ -72,6 +73,7 @@ TEST(ServerConfigTest, BadValuesAreNamed) {
   ASSERT_FALSE(routing.ok());
   EXPECT_NE(routing.error().message.find("routing must be floyd or heat, got 'astar'"), std::string::npos);
   EXPECT_FALSE(Parse({"--heat-period", "0"}).ok());
+  EXPECT_FALSE(Parse({"--priority", "fifo"}).ok());
   auto port = Parse({"--grpc-port", "70000"});
   ASSERT_FALSE(port.ok());
   EXPECT_NE(port.error().message.find("grpc_port"), std::string::npos);

@@ -280,6 +280,7 @@ TEST(JournalStoreTest, ARunSetupRoundTrips) {
   s.allocation.heat_period = 30.0;
   s.core.traffic.t_w1 = 3.25;
   s.core.traffic.head_on = engine::HeadOnPolicy::kAlwaysWait;
+  s.core.traffic.priority_by_release = true;
   s.core.traffic_control = false;
   s.route_cache_bytes = 1 << 20;
   s.time_scale = 10;
@@ -296,6 +297,7 @@ TEST(JournalStoreTest, ARunSetupRoundTrips) {
   EXPECT_EQ(back->allocation.heat_period, 30.0);
   EXPECT_EQ(back->core.traffic.t_w1, 3.25);
   EXPECT_EQ(back->core.traffic.head_on, engine::HeadOnPolicy::kAlwaysWait);
+  EXPECT_TRUE(back->core.traffic.priority_by_release);
   EXPECT_FALSE(back->core.traffic_control);
   EXPECT_EQ(back->route_cache_bytes, std::size_t{1} << 20);
   auto map = engine::ParseMapJson(back->map_json);
@@ -310,6 +312,8 @@ TEST(JournalStoreTest, ARunSetupRoundTrips) {
   ASSERT_TRUE(before.ok()) << before.error().message;
   EXPECT_EQ(before->allocation.planner, engine::PlannerKind::kRules);
   EXPECT_EQ(before->allocation.routing, engine::RoutingKind::kFloyd);
+  old["core"].erase("priority_by_release");
+  EXPECT_FALSE(DecodeRunSetup(old.dump()).value().core.traffic.priority_by_release);
   old["allocation"]["planner"] = "magic";
   EXPECT_FALSE(DecodeRunSetup(old.dump()).ok());
 }

@@ -122,6 +122,31 @@ TEST(TrafficControllerTest, SwapOnOpenGridIsADeadlockThatGetsBroken) {
   EXPECT_GE(ctl.stats().replans, 1u);
 }
 
+// Wang2019 §3.2: with priority_by_release the robot whose task was released later gives way
+// in a deadlock; by index (the default) the higher index does, whatever the release times.
+TEST(TrafficControllerTest, TheLaterReleasedRobotGivesWayInADeadlock) {
+  auto map = Grid({"...", "...", "..."});
+  for (bool by_release : {false, true}) {
+    SCOPED_TRACE(by_release ? "by release" : "by index");
+    TrafficControllerConfig c;
+    c.priority_by_release = by_release;
+    TrafficController ctl = Make(map, c);
+    const std::size_t a = *ctl.AddRobot("A", P(*map, "c3"));
+    const std::size_t b = *ctl.AddRobot("B", P(*map, "c4"));
+    ctl.SetRank(a, 20.0);  // A's task was released after B's
+    ctl.SetRank(b, 10.0);
+    const auto route_a = Route(*map, {"c3", "c4", "c5"}), route_b = Route(*map, {"c4", "c3"});
+    ASSERT_TRUE(ctl.SetRoute(a, route_a).ok());
+    ASSERT_TRUE(ctl.SetRoute(b, route_b).ok());
+    EXPECT_EQ(ctl.Request(a, 0.0), TrafficDecision::kWait);
+    EXPECT_EQ(ctl.Request(b, 0.0), TrafficDecision::kWait);
+    EXPECT_EQ(ctl.ResolveDeadlocks(0.0), 1u);
+    const bool a_moved = ctl.RemainingRoute(a) != route_a, b_moved = ctl.RemainingRoute(b) != route_b;
+    EXPECT_EQ(a_moved, by_release);
+    EXPECT_EQ(b_moved, !by_release);
+  }
+}
+
 TEST(TrafficControllerTest, IdleRobotInTheWayIsNudgedToASiding) {
   auto map = Grid({".....", "@@.@@"});
   TrafficController ctl = Make(map);
