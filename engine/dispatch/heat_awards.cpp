@@ -39,13 +39,22 @@ void RouteAwardsByHeat(const WarehouseMap& map, const AllocationConfig& config, 
   for (std::size_t i = 0; i < fleet.robot_count(); ++i) {
     const std::size_t first = i < segments.first_new.size() ? segments.first_new[i] : kNone;
     const auto& w = fleet.plan(i).waypoints;
-    if (first == kNone || segments.in_formation[i] || w.empty()) continue;
+    if (first == kNone || w.empty()) continue;
     const Waypoint& before = w[first > 0 ? first - 1 : 0];
     at[i] = before.point;
     free_at[i] = first > 0 ? before.departure() : before.eta;
   }
   for (RoundAward& a : awards) {
-    if (a.award.winners.size() != 1 || a.segments.size() != 1 || a.segments[0].empty()) continue;
+    if (a.award.winners.size() != 1) {  // a formation keeps its routes; its members go on from its end
+      for (std::size_t k = 0; k < a.award.winners.size() && k < a.segments.size(); ++k) {
+        const auto member = fleet.FindRobot(a.award.winners[k]);
+        if (!member || a.segments[k].empty()) continue;
+        at[*member] = a.segments[k].back().point;
+        free_at[*member] = a.segments[k].back().departure();
+      }
+      continue;
+    }
+    if (a.segments.size() != 1 || a.segments[0].empty()) continue;
     const auto found = fleet.FindRobot(a.award.winners[0]);
     if (!found || at[*found] == kNoPoint) continue;
     const std::size_t i = *found;

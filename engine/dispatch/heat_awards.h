@@ -3,7 +3,8 @@
 // the heat (steps 1-4 of seed 004 §3.1; the new segments are the plain routes of step 1), and
 // each single-robot award's legs between its stops are routed again over the heat-weighted
 // lengths (step 5), timed at the allocation's speed with the stops' work times. Formation
-// awards keep their routes. Pure; the awards are rewritten.
+// awards keep their routes (a member's next single-robot segment starts where its formation
+// segment ends). Pure; the awards are rewritten.
 #pragma once
 
 #include <memory>
