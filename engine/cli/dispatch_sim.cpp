@@ -14,6 +14,8 @@
 //       [--planners rules,time-windows] [--routings floyd,heat] [--strategy S] [--zeta Z]
 //       auction zeta=100, auction zeta=0 and greedy on one random stream (issue 4 §4), or the
 //       planners side by side.
+//   dispatch-sim mapf --map FILE.map --agents N [--planner conflict-elimination|cbs|both]
+//       the discrete-time planners on a floor (mapf_command.h).
 //   dispatch-sim headon
 //       seed 004 §4.3: a head-on conflict resolved by waiting vs. re-planning.
 //   dispatch-sim replay --db dispatch.db [--run N | --list] [--what-if [--strategy S] [--zeta Z]
@@ -42,6 +44,7 @@
 #include "engine/routing/route_table.h"
 #include "engine/sim/core_stream.h"
 #include "engine/sim/fleet_placement.h"
+#include "engine/cli/mapf_command.h"
 #include "engine/sim/head_on_scenario.h"
 #include "engine/sim/order_stream.h"
 #include "engine/sim/random_orders.h"
@@ -507,7 +510,10 @@ int Main(int argc, char** argv) {
   r->add_option("--robots", replay.robots, "What-if fleet: the first N robots of the run (default: all)");
   r->add_option("--dt", replay.dt, "What-if time step, s")->capture_default_str()->check(CLI::PositiveNumber);
   r->add_option("--max-time", replay.max_time, "What-if simulated seconds before giving up")->capture_default_str();
+  MapfArgs mapf;
+  auto* m = AddMapfCommand(app, mapf);
   CLI11_PARSE(app, argc, argv);
+  if (*m) return RunMapf(mapf);
   if (*r) return RunReplay(replay);
   if (*p) return RunPlan(plan);
   if (*s) return RunStream(stream);
