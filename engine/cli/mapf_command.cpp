@@ -5,7 +5,6 @@
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
-#include <random>
 #include <vector>
 
 #include "engine/io/map_source.h"
@@ -15,19 +14,14 @@
 namespace dispatch::engine {
 namespace {
 
-// The vertices of the largest strongly reachable part: those that reach, and are reached from,
-// the vertex most others reach (a cheap stand-in: the vertex 0's part if it is large, else the
-// best of a few probes).
+// The largest strongly connected part among those of a few probed vertices (on a grid
+// floor the first probe finds the whole floor).
 std::vector<PointId> LargestPart(const MapfGraph& g) {
   std::vector<PointId> best;
-  for (std::size_t probe = 0; probe < g.size(); probe += std::max<std::size_t>(1, g.size() / 8)) {
-    const std::vector<int> to = g.StepsTo(static_cast<PointId>(probe));
-    std::vector<PointId> part;
-    for (std::size_t v = 0; v < g.size(); ++v) {
-      if (to[v] != MapfGraph::kUnreachable) part.push_back(static_cast<PointId>(v));
-    }
+  for (std::size_t probe = 0; probe < g.size() && best.size() * 2 <= g.size();
+       probe += std::max<std::size_t>(1, g.size() / 8)) {
+    std::vector<PointId> part = g.PartOf(static_cast<PointId>(probe));
     if (part.size() > best.size()) best = std::move(part);
-    if (best.size() * 2 > g.size()) break;
   }
   return best;
 }
@@ -53,21 +47,15 @@ int RunMapf(const MapfArgs& a) {
     return 1;
   }
   const MapfGraph graph = MapfGraph::FromMap(loaded.value());
-  std::vector<PointId> cells = LargestPart(graph);
-  if (cells.size() < a.agents) {
-    std::fprintf(stderr, "dispatch-sim: %zu agents do not fit on %zu connected points\n", a.agents, cells.size());
+  const std::vector<PointId> cells = LargestPart(graph);
+  auto drawn = RandomAgents(cells, a.agents, a.seed);
+  if (!drawn.ok()) {
+    std::fprintf(stderr, "dispatch-sim: %s\n", drawn.error().message.c_str());
     return 1;
   }
-  std::mt19937_64 random(a.seed);
-  std::vector<PointId> starts = cells, goals = cells;
-  std::shuffle(starts.begin(), starts.end(), random);
-  std::shuffle(goals.begin(), goals.end(), random);
-  std::vector<MapfAgent> agents;
+  const std::vector<MapfAgent>& agents = drawn.value();
   int lower_bound = 0;
-  for (std::size_t i = 0; i < a.agents; ++i) {
-    agents.push_back({starts[i], goals[i]});
-    lower_bound += graph.StepsTo(goals[i])[static_cast<std::size_t>(starts[i])];
-  }
+  for (const MapfAgent& agent : agents) lower_bound += graph.StepsTo(agent.goal)[static_cast<std::size_t>(agent.start)];
   std::printf("%zu agents on %s (%zu points, %zu connected), seed %llu; independent shortest paths: SOC %d\n",
               a.agents, a.map.c_str(), graph.size(), cells.size(), static_cast<unsigned long long>(a.seed),
               lower_bound);

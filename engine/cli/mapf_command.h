@@ -1,6 +1,6 @@
 // dispatch-sim mapf: the discrete-time planners of engine/planning on a floor, for the record
 // and for comparing them (issue 16 §2). N agents get distinct random starts and goals (seeded)
-// on the floor's largest connected part; the chosen planner runs under a time budget and its
+// on the floor's largest strongly connected part; the chosen planner runs under a time budget and its
 // paths go through the one checker (CheckPaths). Each arc is one step: exact on grid floors
 // (MovingAI maps, the generated grid floors), an approximation on maps with arcs of other
 // lengths.

@@ -56,23 +56,36 @@ bool MapfGraph::Adjacent(PointId u, PointId v) const {
   return std::binary_search(Neighbours(u), NeighboursEnd(u), v);
 }
 
-std::vector<int> MapfGraph::StepsTo(PointId goal) const {
-  std::vector<int> steps(size(), kUnreachable);
-  if (!Contains(goal)) return steps;
-  std::vector<PointId> frontier{goal};
-  steps[static_cast<std::size_t>(goal)] = 0;
+std::vector<int> MapfGraph::Levels(PointId from, const std::vector<std::uint32_t>& begin,
+                                  const std::vector<PointId>& next, std::size_t size) {
+  std::vector<int> steps(size, kUnreachable);
+  if (from < 0 || static_cast<std::size_t>(from) >= size) return steps;
+  std::vector<PointId> frontier{from};
+  steps[static_cast<std::size_t>(from)] = 0;
   for (std::size_t head = 0; head < frontier.size(); ++head) {
-    const PointId v = frontier[head];
-    const int d = steps[static_cast<std::size_t>(v)] + 1;
-    const auto vi = static_cast<std::size_t>(v);
-    for (std::uint32_t k = rbegin_[vi]; k < rbegin_[vi + 1]; ++k) {
-      const auto u = static_cast<std::size_t>(prev_[k]);
+    const auto vi = static_cast<std::size_t>(frontier[head]);
+    const int d = steps[vi] + 1;
+    for (std::uint32_t k = begin[vi]; k < begin[vi + 1]; ++k) {
+      const auto u = static_cast<std::size_t>(next[k]);
       if (steps[u] != kUnreachable) continue;
       steps[u] = d;
-      frontier.push_back(prev_[k]);
+      frontier.push_back(next[k]);
     }
   }
   return steps;
+}
+
+std::vector<int> MapfGraph::StepsTo(PointId goal) const { return Levels(goal, rbegin_, prev_, size()); }
+
+std::vector<int> MapfGraph::StepsFrom(PointId source) const { return Levels(source, begin_, next_, size()); }
+
+std::vector<PointId> MapfGraph::PartOf(PointId v) const {
+  const std::vector<int> to = StepsTo(v), from = StepsFrom(v);
+  std::vector<PointId> part;
+  for (std::size_t u = 0; u < size(); ++u) {
+    if (to[u] != kUnreachable && from[u] != kUnreachable) part.push_back(static_cast<PointId>(u));
+  }
+  return part;
 }
 
 }  // namespace dispatch::engine

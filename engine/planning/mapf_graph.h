@@ -37,9 +37,15 @@ class MapfGraph {
   // Steps from every vertex to `goal` (kUnreachable where there is no way): the planners'
   // heuristic, exact for a free floor. Breadth-first search backwards, O(V + E).
   std::vector<int> StepsTo(PointId goal) const;
+  // Steps from `source` to every vertex (kUnreachable where there is no way), forwards.
+  std::vector<int> StepsFrom(PointId source) const;
+  // The vertices that `v` reaches and that reach `v` (its strongly connected part), sorted.
+  std::vector<PointId> PartOf(PointId v) const;
 
  private:
   explicit MapfGraph(const std::vector<std::vector<PointId>>& adjacency);
+  static std::vector<int> Levels(PointId from, const std::vector<std::uint32_t>& begin,
+                                 const std::vector<PointId>& next, std::size_t size);
 
   std::vector<std::uint32_t> begin_;  // CSR offsets, size() + 1
   std::vector<PointId> next_;

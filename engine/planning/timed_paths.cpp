@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <functional>
+#include <random>
 
 namespace dispatch::engine {
 namespace {
@@ -139,6 +140,20 @@ std::string Describe(const PathConflict& c) {
   }
   return pair + " swap " + std::to_string(c.from) + " <-> " + std::to_string(c.at) + " arriving at step " +
          std::to_string(c.time);
+}
+
+Result<std::vector<MapfAgent>> RandomAgents(const std::vector<PointId>& cells, std::size_t n, std::uint64_t seed) {
+  if (cells.size() < n) {
+    return InvalidArgument(std::to_string(n) + " agents do not fit on " + std::to_string(cells.size()) +
+                           " connected points");
+  }
+  std::mt19937_64 random(seed);
+  std::vector<PointId> starts = cells, goals = cells;
+  std::shuffle(starts.begin(), starts.end(), random);
+  std::shuffle(goals.begin(), goals.end(), random);
+  std::vector<MapfAgent> agents;
+  for (std::size_t i = 0; i < n; ++i) agents.push_back({starts[i], goals[i]});
+  return agents;
 }
 
 }  // namespace dispatch::engine

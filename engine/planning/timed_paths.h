@@ -9,6 +9,7 @@
 // Pure functions; thread-safe.
 #pragma once
 
+#include <cstdint>
 #include <optional>
 #include <string>
 #include <vector>
@@ -60,5 +61,10 @@ Status CheckPaths(const MapfGraph& graph, const std::vector<MapfAgent>& agents,
 Status CheckAgents(const MapfGraph& graph, const std::vector<MapfAgent>& agents);
 
 std::string Describe(const PathConflict& c);
+
+// n agents with distinct starts and distinct goals drawn (seeded) from `cells`, which must be
+// one strongly connected part (MapfGraph::PartOf) so every goal is reachable from every start.
+// Errors: fewer cells than agents.
+Result<std::vector<MapfAgent>> RandomAgents(const std::vector<PointId>& cells, std::size_t n, std::uint64_t seed);
 
 }  // namespace dispatch::engine

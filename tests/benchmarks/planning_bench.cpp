@@ -52,22 +52,11 @@ const MapfGraph& Floor() {
   return graph;
 }
 
-// n agents on distinct starts and distinct goals, all on the floor's largest component
-// (a cell that reaches vertex 0; the grid floor is connected).
+// n agents on distinct starts and distinct goals (seed 7), on the floor's connected part.
 std::vector<MapfAgent> Agents(std::size_t n) {
-  const MapfGraph& g = Floor();
-  const std::vector<int> reach = g.StepsTo(0);
-  std::vector<PointId> cells;
-  for (std::size_t v = 0; v < g.size(); ++v) {
-    if (reach[v] != MapfGraph::kUnreachable) cells.push_back(static_cast<PointId>(v));
-  }
-  std::mt19937_64 random(7);
-  std::vector<PointId> starts = cells, goals = cells;
-  std::shuffle(starts.begin(), starts.end(), random);
-  std::shuffle(goals.begin(), goals.end(), random);
-  std::vector<MapfAgent> agents;
-  for (std::size_t i = 0; i < n; ++i) agents.push_back({starts[i], goals[i]});
-  return agents;
+  auto agents = RandomAgents(Floor().PartOf(0), n, 7);
+  if (!agents.ok()) throw std::runtime_error(agents.error().message);
+  return std::move(agents).value();
 }
 
 int LowerBound(const std::vector<MapfAgent>& agents) {

@@ -91,5 +91,20 @@ TEST(MapfGraphTest, StepsToAGoalFollowTheEdgesBackwards) {
   EXPECT_FALSE(MapfGraph::FromAdjacency({{2}, {}}).ok());
 }
 
+// On a one-way loop with a spur the strongly connected part leaves out what cannot come back.
+TEST(MapfGraphTest, APartHoldsWhatReachesAndIsReachedBack) {
+  // 0 -> 1 -> 2 -> 0, 2 -> 3 (a dead end), 4 -> 0 (no way in).
+  const MapfGraph g = MapfGraph::FromAdjacency({{1}, {2}, {0, 3}, {}, {0}}).value();
+  EXPECT_EQ(g.StepsFrom(0), (std::vector<int>{0, 1, 2, 3, MapfGraph::kUnreachable}));
+  EXPECT_EQ(g.PartOf(1), (std::vector<PointId>{0, 1, 2}));
+  EXPECT_EQ(g.PartOf(3), (std::vector<PointId>{3}));
+  const auto agents = RandomAgents(g.PartOf(0), 3, 5);
+  ASSERT_TRUE(agents.ok());
+  EXPECT_TRUE(CheckAgents(g, agents.value()).ok());
+  for (const MapfAgent& a : agents.value()) EXPECT_NE(g.StepsTo(a.goal)[static_cast<std::size_t>(a.start)], MapfGraph::kUnreachable);
+  EXPECT_EQ(RandomAgents(g.PartOf(0), 3, 5).value().front().start, agents.value().front().start);  // seeded
+  EXPECT_FALSE(RandomAgents(g.PartOf(0), 4, 5).ok());
+}
+
 }  // namespace
 }  // namespace dispatch::engine
