@@ -39,6 +39,7 @@ std::vector<Key> Keys() {
       MakeKey("map", &ServerConfig::map),
       MakeKey("strategy", &ServerConfig::strategy),
       MakeKey("max_queue", &ServerConfig::max_queue),
+      MakeKey("formation_max_queue", &ServerConfig::formation_max_queue),
       MakeKey("one_formation_per_pick", &ServerConfig::one_formation_per_pick),
       MakeKey("zeta", &ServerConfig::zeta),
       MakeKey("planner", &ServerConfig::planner),
@@ -147,6 +148,7 @@ engine::Status ValidateServerConfig(const ServerConfig& c) {
   if (c.route_cache_mb < 1) return InvalidArgument("route_cache_mb must be >= 1");
   if (c.finished_retained < 0) return InvalidArgument("finished_retained must be >= 0");
   if (c.max_queue < 0) return InvalidArgument("max_queue must be >= 0 (0: no limit)");
+  if (c.formation_max_queue < 0) return InvalidArgument("formation_max_queue must be >= 0 (0: no limit)");
   if (c.journal_runs < 0) return InvalidArgument("journal_runs must be >= 0 (0: no journal)");
   if (c.journal_max_mb < 0) return InvalidArgument("journal_max_mb must be >= 0 (0: no limit)");
   if (!c.web_root.empty() && !std::filesystem::is_directory(c.web_root)) {
@@ -204,6 +206,9 @@ engine::Result<ParsedCommandLine> ParseCommandLine(int argc, char** argv) {
                  "Finished orders kept in memory (the newest); older ones are read from the database")
       ->capture_default_str();
   app.add_option("--max-queue", flags.max_queue, "Orders a robot may hold and still bid for another (0: no limit)")
+      ->capture_default_str();
+  app.add_option("--formation-max-queue", flags.formation_max_queue,
+                 "Orders a robot may hold and still join a formation (0: no limit)")
       ->capture_default_str();
   app.add_option("--one-formation-per-pick", flags.one_formation_per_pick,
                  "Allocate a formation only while no other is heading for its first pick")->capture_default_str();

@@ -18,10 +18,12 @@ struct ServerConfig {
   std::string map = "chu2024";    // chu2024 | <file>.json | <file>.map
   std::string strategy = "auction";  // auction | greedy
   // Orders a robot may hold and still bid for another (0: no limit, the paper's auction), and
-  // one formation at a time heading for a first pick: see AllocationConfig::max_queue and
+  // for a formation order (0: no limit), and one formation at a time heading for a first
+  // pick: see AllocationConfig::max_queue, formation_max_queue and
   // CoreOptions::one_formation_per_pick (README "Formations on the dispatch core").
   int max_queue = 0;
-  bool one_formation_per_pick = false;
+  int formation_max_queue = 1;
+  bool one_formation_per_pick = true;
   double zeta = 100.0;            // Chu2024 eq. (5) traffic weight
   // How awards get their routes (AllocationConfig::planner): rules | time-windows (Wang2019's
   // time windows for single-robot orders). turn_time: seconds per 90 degrees of turning in plan

@@ -114,6 +114,7 @@ engine::Result<std::unique_ptr<DispatchServer>> DispatchServer::Start(const Serv
   allocation.beta = config.beta;
   allocation.zeta = config.zeta;
   allocation.max_queue = static_cast<std::size_t>(config.max_queue);
+  allocation.formation_max_queue = static_cast<std::size_t>(config.formation_max_queue);
   allocation.planner = engine::ParsePlanner(config.planner).value_or(engine::PlannerKind::kRules);
   allocation.turn_time = config.turn_time;
   allocation.routing = engine::ParseRouting(config.routing).value_or(engine::RoutingKind::kFloyd);

@@ -130,6 +130,7 @@ Result<std::string> EncodeRunSetup(const RunSetup& s) {
                        {"hold_seconds", a.hold_seconds},
                        {"price_every_bid_up_to", a.price_every_bid_up_to},
                        {"max_queue", a.max_queue},
+                       {"formation_max_queue", a.formation_max_queue},
                        {"work_time_override", a.work_time_override ? json(*a.work_time_override) : json(nullptr)},
                        {"bucket_seconds", a.traffic.bucket_seconds},
                        {"origin_time", a.traffic.origin_time},
@@ -181,6 +182,7 @@ Result<RunSetup> DecodeRunSetup(const std::string& text) {
     c.hold_seconds = a.at("hold_seconds").get<double>();
     c.price_every_bid_up_to = a.at("price_every_bid_up_to").get<std::size_t>();
     c.max_queue = a.value("max_queue", std::size_t{0});
+    c.formation_max_queue = a.value("formation_max_queue", std::size_t{0});  // older runs had no limit
     if (!a.at("work_time_override").is_null()) c.work_time_override = a.at("work_time_override").get<double>();
     c.traffic.bucket_seconds = a.at("bucket_seconds").get<double>();
     c.traffic.origin_time = a.at("origin_time").get<double>();

@@ -74,6 +74,14 @@ struct AllocationConfig {
   // Orders a robot may hold (its current one included) and still bid for another; 0 = no
   // limit (the paper's auction: every order is awarded at once, queues grow without bound).
   std::size_t max_queue = 0;
+  // A robot joins a formation order (as its leader or a companion) only while its queue holds
+  // fewer than this many orders; 0 = no limit (Chu2024 §2.2 as printed: the cheapest three,
+  // whatever they still have to do). 1: only robots with nothing queued, so a team gathers at
+  // once instead of holding its rendezvous while members finish queues of other work; the
+  // product's default (dispatchd, dispatch-sim stream|compare; README "Formations on the
+  // dispatch core"), 0 here so that the engine reproduces the paper. Single-robot orders are
+  // not limited by it.
+  std::size_t formation_max_queue = 0;
   TrafficPredictionConfig traffic;
   FormationOptions formation;
   // Turning time t_c (Wang2019 §2.2), seconds per 90 degrees of heading change; >= 0. It

@@ -229,7 +229,7 @@ double AuctionAllocator::AddLegSamples(RouteSampler& sampler, const TrafficPredi
 }
 
 std::vector<Bid> AuctionAllocator::ComputeBids(const FleetState& state, const PlanTask& task,
-                                               std::size_t keep) {
+                                               std::size_t keep, bool formation) {
   const AllocationConfig& c = state.config();
   const RouteTable& routes = state.routes();
   RouteSampler& sampler = Sampler(state);
@@ -261,7 +261,7 @@ std::vector<Bid> AuctionAllocator::ComputeBids(const FleetState& state, const Pl
   legs_.assign(state.robot_count(), -1.0);
   for (std::size_t i = 0; i < state.robot_count(); ++i) {
     const QueueSummary& s = state.summary(i);
-    if (!state.HasRoom(i)) {
+    if (!state.HasRoom(i, formation)) {
       bids.push_back(FullQueueBid(state.robot_id(i), s.end_time));
       continue;
     }
@@ -315,7 +315,7 @@ std::vector<Bid> AuctionAllocator::ComputeReachBids(const FleetState& state, Poi
   bids.reserve(state.robot_count());
   for (std::size_t i = 0; i < state.robot_count(); ++i) {
     const QueueSummary& s = state.summary(i);
-    if (!state.HasRoom(i)) {
+    if (!state.HasRoom(i, true)) {
       bids.push_back(FullQueueBid(state.robot_id(i), s.end_time));
       continue;
     }
@@ -359,7 +359,7 @@ Result<AwardExplanation> AuctionAllocator::Allocate(const Order& order, FleetSta
   AwardExplanation ex;
   ex.order_id = order.id;
   ex.strategy = std::string(name());
-  ex.bids = ComputeBids(state, *task, Keep(state, 2));
+  ex.bids = ComputeBids(state, *task, Keep(state, 2), order.formation);
   const std::vector<std::size_t> leader = Lowest(ex.bids, 1);
   if (leader.empty()) {
     return Unreachable("order " + order.id + ": no robot can reach the first pick " + first_name);

@@ -46,9 +46,10 @@ class AuctionAllocator final : public Allocator {
 
   // Every robot's bid for `task` appended to its queue, in robot order; commits nothing.
   // keep = 0 prices every bid; keep = k > 0 only those that can be among the k lowest (the
-  // others get priced = false and their lower bound).
+  // others get priced = false and their lower bound). formation: the task is a formation's
+  // (a robot's room in its queue is FleetState::HasRoom's for formations).
   std::vector<Bid> ComputeBids(const FleetState& state, const PlanTask& task,
-                               std::size_t keep = 0);
+                               std::size_t keep = 0, bool formation = false);
   // Every robot's cost to reach `first_pick` after its queue, in robot order; commits nothing.
   // keep as for ComputeBids.
   std::vector<Bid> ComputeReachBids(const FleetState& state, PointId first_pick,

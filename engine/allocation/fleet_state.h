@@ -86,9 +86,12 @@ class FleetState {
   const FleetRobot& robot(std::size_t robot) const { return robots_.at(robot).info; }
   const QueueSummary& summary(std::size_t robot) const { return robots_.at(robot).summary; }
   const std::vector<QueuedTask>& queue(std::size_t robot) const { return robots_.at(robot).queue; }
-  // False when the robot's queue holds AllocationConfig::max_queue orders: it does not bid.
-  bool HasRoom(std::size_t robot) const {
-    return config().max_queue == 0 || queue(robot).size() < config().max_queue;
+  // False when the robot's queue holds AllocationConfig::max_queue orders, or for a formation
+  // order formation_max_queue: it does not bid.
+  bool HasRoom(std::size_t robot, bool formation = false) const {
+    const std::size_t held = queue(robot).size();
+    if (config().max_queue != 0 && held >= config().max_queue) return false;
+    return !formation || config().formation_max_queue == 0 || held < config().formation_max_queue;
   }
   const Plan& plan(std::size_t robot) const { return robots_.at(robot).plan; }
 

@@ -22,7 +22,7 @@ Result<AwardExplanation> GreedyAllocator::Allocate(const Order& order, FleetStat
     b.robot = state.robot_id(i);
     b.ready_time = s.end_time;
     b.t_d = state.routes().Cost(s.end_point, first);
-    b.queue_full = !state.HasRoom(i);
+    b.queue_full = !state.HasRoom(i, order.formation);
     b.reachable = std::isfinite(b.t_d) && !b.queue_full;
     b.bid = b.t_d;
     if (b.reachable) ranked.push_back(i);

@@ -99,6 +99,7 @@ StreamConfig ConfigOf(const StreamArgs& a, const std::string& strategy, double z
   c.strategy = strategy == "greedy" ? AllocationStrategy::kGreedy : AllocationStrategy::kAuction;
   c.allocation.zeta = zeta;
   c.allocation.max_queue = a.max_queue;
+  c.allocation.formation_max_queue = a.formation_max_queue;
   c.allocation.planner = ParsePlanner(a.planner).value_or(PlannerKind::kRules);
   c.allocation.turn_time = a.turn_s;
   c.allocation.routing = ParseRouting(a.routing).value_or(RoutingKind::kFloyd);
@@ -289,8 +290,12 @@ StreamCommands AddStreamCommands(CLI::App& app, StreamArgs& stream_args, StreamA
         ->capture_default_str()->check(CLI::PositiveNumber);
     c->add_option("--max-queue", a.max_queue, "Orders a robot may hold and still bid (0: no limit)")
         ->capture_default_str();
-    c->add_flag("--one-formation-per-pick", a.one_formation_per_pick,
-                "Allocate a formation only while no other is heading for its first pick (core model)");
+    c->add_option("--formation-max-queue", a.formation_max_queue,
+                  "Orders a robot may hold and still join a formation (0: no limit)")
+        ->capture_default_str();
+    c->add_option("--one-formation-per-pick", a.one_formation_per_pick,
+                  "Allocate a formation only while no other is heading for its first pick (core model): true or false")
+        ->capture_default_str();
     c->add_option("--blocked-recovery", a.blocked_recovery,
                   "s a blocked robot stays in fault before it is back in service (core model; 0: never)")
         ->capture_default_str()

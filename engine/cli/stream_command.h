@@ -19,10 +19,10 @@ namespace dispatch::engine {
 struct StreamArgs {
   std::string map = "chu2024", csv, orders_csv, strategy = "auction", journal;
   std::vector<std::string> orders;  // task tables, submitted together
-  std::size_t robots = 18, random = 0, repeat = 1, max_queue = 0;
+  std::size_t robots = 18, random = 0, repeat = 1, max_queue = 0, formation_max_queue = 1;
   std::uint64_t seed = 1;
   double interval = 2.0, zeta = 100.0, dt = 0.1, max_time = 36000.0, formations = 0.0;
-  bool check_safety = false, one_formation_per_pick = false;
+  bool check_safety = false, one_formation_per_pick = true;
   double blocked_recovery = 60.0;  // core model: CoreOptions::blocked_recovery
   std::vector<std::string> trace;  // robots to trace (core model)
   double trace_from = 0.0, trace_to = std::numeric_limits<double>::infinity();

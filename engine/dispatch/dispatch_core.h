@@ -55,7 +55,8 @@ struct CoreOptions {
   bool traffic_control = true;
   TrafficControllerConfig traffic;
   // A formation order is allocated only while no other formation is still heading for its
-  // first pick (MakeRound).
+  // first pick (MakeRound). Off (the engine's default): Chu2024 as printed, every order
+  // awarded at once; dispatchd and dispatch-sim turn it on by default.
   bool one_formation_per_pick = false;
   // Seconds a robot the traffic controller found blocked stays in fault (an obstacle where it
   // stands, out of every auction) before it is back in service (idle, allocatable again; the

@@ -21,7 +21,8 @@ TEST(ServerConfigTest, FlagsSetTheConfig) {
                        "--strategy", "greedy", "--zeta", "0", "--alpha", "0.3", "--beta", "0.7",
                        "--time-scale", "10", "--bind", "127.0.0.1", "--ports-file", "p.json",
                        "--planner", "time-windows", "--turn-time", "1.5", "--routing", "heat",
-                       "--heat-period", "30", "--priority", "release"});
+                       "--heat-period", "30", "--priority", "release", "--formation-max-queue", "0",
+                       "--one-formation-per-pick", "false"});
   ASSERT_TRUE(parsed.ok()) << parsed.error().message;
   const ServerConfig& c = parsed->config;
   EXPECT_EQ(c.grpc_port, 0);
@@ -39,6 +40,8 @@ TEST(ServerConfigTest, FlagsSetTheConfig) {
   EXPECT_EQ(c.routing, "heat");
   EXPECT_DOUBLE_EQ(c.heat_period, 30.0);
   EXPECT_EQ(c.priority, "release");
+  EXPECT_EQ(c.formation_max_queue, 0);
+  EXPECT_FALSE(c.one_formation_per_pick);
 }
 
 TEST(ServerConfigTest, FileKeysApplyAndFlagsWin) {
@@ -53,6 +56,9 @@ TEST(ServerConfigTest, FileKeysApplyAndFlagsWin) {
   EXPECT_DOUBLE_EQ(parsed->config.zeta, 50.0);
   EXPECT_EQ(parsed->config.strategy, "auction");
   EXPECT_EQ(parsed->config.planner, "rules");
+  // Formations by default: members with nothing queued, one team at a time per first pick.
+  EXPECT_EQ(parsed->config.formation_max_queue, 1);
+  EXPECT_TRUE(parsed->config.one_formation_per_pick);
 }
 
 TEST(ServerConfigTest, BadValuesAreNamed) {
@@ -74,6 +80,9 @@ TEST(ServerConfigTest, BadValuesAreNamed) {
   EXPECT_NE(routing.error().message.find("routing must be floyd or heat, got 'astar'"), std::string::npos);
   EXPECT_FALSE(Parse({"--heat-period", "0"}).ok());
   EXPECT_FALSE(Parse({"--priority", "fifo"}).ok());
+  auto queue = Parse({"--formation-max-queue", "-1"});
+  ASSERT_FALSE(queue.ok());
+  EXPECT_NE(queue.error().message.find("formation_max_queue must be >= 0"), std::string::npos);
   auto port = Parse({"--grpc-port", "70000"});
   ASSERT_FALSE(port.ok());
   EXPECT_NE(port.error().message.find("grpc_port"), std::string::npos);

@@ -278,6 +278,8 @@ TEST(JournalStoreTest, ARunSetupRoundTrips) {
   s.allocation.turn_time = 1.5;
   s.allocation.routing = engine::RoutingKind::kHeat;
   s.allocation.heat_period = 30.0;
+  s.allocation.formation_max_queue = 2;
+  s.core.one_formation_per_pick = true;
   s.core.traffic.t_w1 = 3.25;
   s.core.traffic.head_on = engine::HeadOnPolicy::kAlwaysWait;
   s.core.traffic.priority_by_release = true;
@@ -295,6 +297,8 @@ TEST(JournalStoreTest, ARunSetupRoundTrips) {
   EXPECT_EQ(back->allocation.turn_time, 1.5);
   EXPECT_EQ(back->allocation.routing, engine::RoutingKind::kHeat);
   EXPECT_EQ(back->allocation.heat_period, 30.0);
+  EXPECT_EQ(back->allocation.formation_max_queue, 2u);
+  EXPECT_TRUE(back->core.one_formation_per_pick);
   EXPECT_EQ(back->core.traffic.t_w1, 3.25);
   EXPECT_EQ(back->core.traffic.head_on, engine::HeadOnPolicy::kAlwaysWait);
   EXPECT_TRUE(back->core.traffic.priority_by_release);
@@ -312,6 +316,9 @@ TEST(JournalStoreTest, ARunSetupRoundTrips) {
   ASSERT_TRUE(before.ok()) << before.error().message;
   EXPECT_EQ(before->allocation.planner, engine::PlannerKind::kRules);
   EXPECT_EQ(before->allocation.routing, engine::RoutingKind::kFloyd);
+  // ... and had no limit on a formation member's queue.
+  old["allocation"].erase("formation_max_queue");
+  EXPECT_EQ(DecodeRunSetup(old.dump()).value().allocation.formation_max_queue, 0u);
   old["core"].erase("priority_by_release");
   EXPECT_FALSE(DecodeRunSetup(old.dump()).value().core.traffic.priority_by_release);
   old["allocation"]["planner"] = "magic";

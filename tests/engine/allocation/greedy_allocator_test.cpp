@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <set>
 
@@ -106,6 +107,43 @@ TEST_F(GreedyTest, ARobotWithAFullQueueDoesNotBid) {
     ASSERT_TRUE(strategy->Allocate(MakeOrder("c", {p3}, d0), s).ok());
     ASSERT_TRUE(strategy->Allocate(MakeOrder("d", {p3}, d0), s).ok());
     EXPECT_FALSE(strategy->Allocate(MakeOrder("e", {p3}, d0), s).ok());
+  }
+}
+
+// AllocationConfig::formation_max_queue: a robot holding that many orders still takes
+// single-robot orders but joins no formation, as leader or companion, for either strategy;
+// with too few robots left free the formation waits.
+TEST_F(GreedyTest, ARobotWithQueuedWorkJoinsNoFormation) {
+  AllocationConfig config;
+  config.formation_max_queue = 1;
+  const PointId p2 = Pt(*map_, "2,0"), p3 = Pt(*map_, "3,0"), d0 = Pt(*map_, "0,0");
+  GreedyAllocator greedy;
+  AuctionAllocator auction;
+  for (Allocator* strategy : {static_cast<Allocator*>(&greedy), static_cast<Allocator*>(&auction)}) {
+    SCOPED_TRACE(std::string(strategy->name()));
+    FleetState s = MakeFleet(map_, routes_, {{"R1", Pt(*map_, "1,0"), 0.0}, {"R2", Pt(*map_, "6,0"), 0.0},
+                                             {"R3", Pt(*map_, "9,0"), 0.0}, {"R4", Pt(*map_, "8,0"), 0.0},
+                                             {"R5", Pt(*map_, "7,0"), 0.0}},
+                             config);
+    ASSERT_TRUE(strategy->Allocate(MakeOrder("a", {p2}, d0), s).ok());
+    EXPECT_EQ(s.queue(0).size(), 1u);  // R1, the nearest
+    // R1 still takes single orders (the limit is for formations only) ...
+    auto b = strategy->Allocate(MakeOrder("b", {p2}, d0), s);
+    ASSERT_TRUE(b.ok()) << b.error().message;
+    EXPECT_FALSE(b->bids[0].queue_full);
+    // ... but the nearest robot to the pick joins no formation: its bid says its queue is full.
+    auto f = strategy->Allocate(MakeOrder("f", {p3}, d0, true), s);
+    ASSERT_TRUE(f.ok()) << f.error().message;
+    EXPECT_EQ(f->winners.size(), 3u);
+    EXPECT_EQ(std::count(f->winners.begin(), f->winners.end(), "R1"), 0);
+    EXPECT_TRUE(f->bids[0].queue_full);
+    // Four robots hold work now, one is free: the next formation is not formed, nothing changes.
+    std::size_t queued = 0;
+    for (std::size_t r = 0; r < s.robot_count(); ++r) queued += s.queue(r).size();
+    EXPECT_FALSE(strategy->Allocate(MakeOrder("g", {p3}, d0, true), s).ok());
+    std::size_t after = 0;
+    for (std::size_t r = 0; r < s.robot_count(); ++r) after += s.queue(r).size();
+    EXPECT_EQ(after, queued);
   }
 }
 
