@@ -119,8 +119,12 @@ void GateImpl::BreakTeam(GateTeam& team) {
       // (its controller group, TeamKeys) and may stand closer to one than eps1 now. It stays
       // exempt from them until it has driven off, as a member that had joined. Found by the
       // core's safety check: two members waiting 0.4 m apart for their rendezvous lost the
-      // exemption at once.
-      if (m.approach == team.order) BecomeFormer(m, team.order, at);
+      // exemption at once. Only one that stands by a teammate, though: one still far from
+      // them (stuck on its way) is a stranger to them from now on, or a member leaving its slot
+      // was let drive up to it as to a teammate (found by the core's safety check: Tables 1+2
+      // x10 with free members only, a member blocked 1.7 m from the rendezvous and a member
+      // leaving its slot 0.400 m apart).
+      if (m.approach == team.order && TeammateBeside(m, team.order)) BecomeFormer(m, team.order, at);
       continue;
     }
     if (m.team != team.order) continue;

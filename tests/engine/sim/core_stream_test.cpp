@@ -265,6 +265,29 @@ TEST(CoreStreamTest, MembersOnTheirWayStayExemptFromEachOtherWhenTheirTeamBreaks
   ExpectSafeToTheEnd(w, Repeated(w, {"chu2024-table1.csv", "chu2024-table2.csv"}, 10));
 }
 
+// The same burst with the product's formation settings (formations take robots with nothing
+// queued, one at a time per first pick) completes nine in ten orders (2 of 140 with the
+// paper's), and stays safe. Only a member that stands by a teammate stays exempt from its
+// team once it breaks up: checked on true positions, a member blocked 1.7 m short of its
+// rendezvous stayed its teammates' mate after the break-up, and one leaving its slot drove up
+// to it at 0.400 m (t = 1770 s). The last orders still wait at the time limit (a stray member
+// off the floor in a cycle of waits; README "Formations on the dispatch core"), so the run is
+// not checked for waiting for ever.
+TEST(CoreStreamTest, AMemberStuckFarFromItsRendezvousIsNoTeammateOnceTheTeamBreaksUp) {
+  const World w = Chu();
+  const std::vector<Order> orders = Repeated(w, {"chu2024-table1.csv", "chu2024-table2.csv"}, 10);
+  StreamConfig c = Config();
+  c.max_time = 3000;
+  c.check_safety = true;
+  c.allocation.formation_max_queue = 1;
+  c.one_formation_per_pick = true;
+  auto r = SimulateOnCore(w.map, w.routes, Fleet(w, 18), orders, c);
+  ASSERT_TRUE(r.ok()) << r.error().message;
+  ASSERT_TRUE(r->safety.has_value());
+  EXPECT_TRUE(r->safety->ok()) << r->safety->violations.front().Describe();
+  EXPECT_GE(r->completed * 10, orders.size() * 9) << r->completed << " of " << orders.size();
+}
+
 // Before it reaches the first waypoint of a new plan, a robot counts as one with the team of
 // that waypoint's order (not with none, as the plan's anchor serves no order). Seed Table 1
 // four times at once, checked on true positions: a formation member whose new plan began with
