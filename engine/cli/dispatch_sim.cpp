@@ -5,7 +5,7 @@
 //   dispatch-sim stream --map chu2024 --robots 18 (--orders FILE... [--repeat N] | --random 200 --seed 1
 //       [--formations 0.2]) [--strategy auction|greedy] [--zeta 100] [--csv series.csv]
 //       [--orders-csv out.csv] [--check-safety] [--journal run.db] [--max-queue N]
-//       [--one-formation-per-pick] [--trace R1,R2 [--trace-from T] [--trace-to T]]
+//       [--formation-max-queue N] [--one-formation-per-pick true|false] [--trace R1,R2 [--trace-from T] [--trace-to T]]
 //       [--planner rules|time-windows] [--routing floyd|heat [--heat-period S]] [--turn-time S]
 //       an order stream with release times (formation orders too) under the online traffic
 //       controller; with --planner time-windows single-robot awards are planned through the
