@@ -217,6 +217,30 @@ int RunStream(const StreamArgs& a) {
   return r->all_completed() && (!r->safety || r->safety->ok()) ? 0 : 2;
 }
 
+namespace {
+
+// An order that did not complete, by why: blocked (the controller or a team's rendezvous gave
+// up on it), still waiting at the time limit, or anything else (unreachable, cancelled).
+struct FailureCounts {
+  std::size_t blocked = 0, waiting = 0, other = 0;
+};
+FailureCounts CountFailures(const StreamResult& r) {
+  FailureCounts n;
+  for (const StreamOrderOutcome& o : r.orders) {
+    if (o.completed) continue;
+    if (o.failure.rfind("not finished by", 0) == 0) {
+      ++n.waiting;
+    } else if (o.failure.find("blocked") != std::string::npos) {
+      ++n.blocked;
+    } else {
+      ++n.other;
+    }
+  }
+  return n;
+}
+
+}  // namespace
+
 int RunCompare(StreamArgs a) {
   if (a.orders.empty() && a.random == 0) a.random = 200;
   auto setup = Prepare(a);
@@ -225,9 +249,11 @@ int RunCompare(StreamArgs a) {
               a.orders.empty() ? ("random, seed " + std::to_string(a.seed)).c_str()
                                : TablesLabel(a).c_str(),
               setup->robots.size(), a.map.c_str(), a.dt);
-  std::printf("%-18s %9s %10s %12s %10s %10s %9s %8s %9s %8s\n", a.planners.empty() && a.routings.empty() ? "strategy" : "planner",
-              "completed", "makespan", "throughput/h", "mean compl", "waiting s", "distance", "replans",
-              "deadlocks", "min dist");
+  // failed: blocked / still waiting at --max-time / other; violations: with --check-safety.
+  std::printf("%-18s %9s %11s %10s %12s %10s %10s %6s %9s %8s %9s %8s %10s\n",
+              a.planners.empty() && a.routings.empty() ? "strategy" : "planner", "completed", "failed b/w/o",
+              "makespan", "throughput/h", "mean compl", "waiting s", "stops", "distance", "replans", "deadlocks",
+              "min dist", "violations");
   int rc = 0;
   // name, strategy, zeta, planner, routing
   std::vector<std::tuple<std::string, std::string, double, std::string, std::string>> columns;
@@ -252,11 +278,15 @@ int RunCompare(StreamArgs a) {
     c.record_series = false;
     auto r = Simulate(with, *setup, c);
     if (!r.ok()) return Fail(r.error().message);
-    std::printf("%-18s %5zu/%-3zu %10.1f %12.1f %10.1f %10.1f %9.1f %8zu %9zu %8.3f\n", name.c_str(),
-                r->completed, r->orders.size(), r->makespan, r->throughput_per_hour,
-                r->mean_completion, r->total_waiting_time, r->total_distance,
-                r->traffic.replans, r->traffic.deadlocks_resolved, r->overall_min_distance);
-    if (!r->all_completed()) rc = 2;
+    const FailureCounts failed = CountFailures(*r);
+    char failures[48];
+    std::snprintf(failures, sizeof failures, "%zu/%zu/%zu", failed.blocked, failed.waiting, failed.other);
+    const std::string violations = r->safety ? std::to_string(r->safety->violations.size()) : "-";
+    std::printf("%-18s %5zu/%-3zu %11s %10.1f %12.1f %10.1f %10.1f %6zu %9.1f %8zu %9zu %8.3f %10s\n", name.c_str(),
+                r->completed, r->orders.size(), failures, r->makespan, r->throughput_per_hour,
+                r->mean_completion, r->total_waiting_time, r->stops, r->total_distance, r->traffic.replans,
+                r->traffic.deadlocks_resolved, r->overall_min_distance, violations.c_str());
+    if (!r->all_completed() || (r->safety && !r->safety->ok())) rc = 2;
   }
   return rc;
 }

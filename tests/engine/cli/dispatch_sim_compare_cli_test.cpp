@@ -1,0 +1,57 @@
+// dispatch-sim compare --planners: one table of the planners on the same stream (issue 16 §3),
+// with why orders failed, the stops, and the safety check's violations.
+#include <gtest/gtest.h>
+
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "run_command.h"
+
+namespace {
+
+dispatch::testing::CommandRun Compare(const std::string& args) {
+  return dispatch::testing::RunCommand(std::string(DISPATCH_SIM_BIN) + " compare " + args);
+}
+
+// The whitespace-separated fields of the table row that starts with `name`.
+std::vector<std::string> Row(const std::string& output, const std::string& name) {
+  std::istringstream lines(output);
+  for (std::string line; std::getline(lines, line);) {
+    std::istringstream fields(line);
+    std::vector<std::string> out;
+    for (std::string f; fields >> f;) out.push_back(f);
+    if (!out.empty() && out.front() == name) return out;
+  }
+  return {};
+}
+
+TEST(DispatchSimCompareCliTest, PlannersSideBySideWithFailuresStopsAndViolations) {
+  const auto run = Compare("--random 30 --seed 1 --planners rules,time-windows --check-safety");
+  ASSERT_EQ(run.status, 0) << run.output;
+  for (const char* column : {"completed", "failed b/w/o", "stops", "replans", "deadlocks", "min dist", "violations"}) {
+    EXPECT_NE(run.output.find(column), std::string::npos) << column << "\n" << run.output;
+  }
+  for (const char* planner : {"rules", "time-windows"}) {
+    const std::vector<std::string> row = Row(run.output, planner);
+    ASSERT_EQ(row.size(), 13u) << planner << "\n" << run.output;
+    EXPECT_EQ(row[1], "30/30") << run.output;
+    EXPECT_EQ(row[2], "0/0/0") << run.output;
+    EXPECT_EQ(row[12], "0") << run.output;  // violations
+  }
+}
+
+TEST(DispatchSimCompareCliTest, OrdersLeftAtTheTimeLimitAreCountedAsWaiting) {
+  // 60 s cannot serve 30 orders: the rest are still waiting; no safety check, no violations column.
+  const auto run = Compare("--random 30 --seed 1 --planners rules --max-time 60");
+  EXPECT_EQ(run.status, 2) << run.output;
+  const std::vector<std::string> row = Row(run.output, "rules");
+  ASSERT_EQ(row.size(), 13u) << run.output;
+  const std::string failed = row[2];
+  const std::size_t a = failed.find('/'), b = failed.rfind('/');
+  ASSERT_NE(a, b) << failed;
+  EXPECT_GT(std::stoul(failed.substr(a + 1, b - a - 1)), 0u) << run.output;
+  EXPECT_EQ(row[12], "-") << run.output;
+}
+
+}  // namespace
