@@ -199,6 +199,7 @@ Status TrafficController::Place(std::size_t r, PointId at) {
   x.working = x.loaded = false;
   x.idle = true;
   s.ClearWait(x);
+  ClearStanding(r);
   s.holder[static_cast<std::size_t>(at)] = static_cast<int>(r);
   s.OccupyGuard(r);
   return Ok{};
@@ -207,6 +208,16 @@ void TrafficController::HoldGrantAt(std::size_t r, PointId at) {
   Impl& s = *impl_;
   if (r >= s.robots.size() || at < 0 || static_cast<std::size_t>(at) >= s.M().point_count()) return;
   s.OccupyGuard(r, s.M().IntersectionOf(at));
+}
+void TrafficController::SetStanding(std::size_t r, const Eigen::Vector2d& xy) {
+  Impl& s = *impl_;
+  if (r >= s.robots.size() || !s.robots[r].removed) return;
+  ClearStanding(r);
+  s.standing.emplace_back(r, xy);
+}
+void TrafficController::ClearStanding(std::size_t r) {
+  auto& v = impl_->standing;
+  v.erase(std::remove_if(v.begin(), v.end(), [&](const auto& e) { return e.first == r; }), v.end());
 }
 bool TrafficController::removed(std::size_t r) const { return impl_->robots.at(r).removed; }
 int TrafficController::HolderOf(PointId p) const { return impl_->holder.at(static_cast<std::size_t>(p)); }

@@ -165,6 +165,12 @@ class TrafficController {
   // intersection: its members take the grant over before the team's agent lets it go, so no
   // crossing movement is granted in between. No-op when `at` is in no intersection.
   void HoldGrantAt(std::size_t r, PointId at);
+  // A robot off the floor (removed) that still stands at `xy` (a formation member left in its
+  // slot when its team broke up): no point closer to xy than the pair's clearance is given to
+  // a robot that is not its mate, nor is anyone placed there, until it is placed (Place) or
+  // cleared (ClearStanding). No-op for a robot on the floor.
+  void SetStanding(std::size_t r, const Eigen::Vector2d& xy);
+  void ClearStanding(std::size_t r);
   bool removed(std::size_t r) const;
   // The robot holding point p (standing there, driving to it, or not yet clear of it), or -1.
   int HolderOf(PointId p) const;

@@ -108,6 +108,8 @@ struct TrafficController::Impl {
   // Points closer than point_clearance + 2 * max_envelope, with their distance.
   std::vector<std::vector<std::pair<PointId, double>>> near;
   std::vector<int> holder;                 // per point
+  // Robots off the floor that still stand somewhere (SetStanding): index and position.
+  std::vector<std::pair<std::size_t, Eigen::Vector2d>> standing;
   std::vector<CorridorState> cstate;
   std::vector<RobotState> robots;
   std::unordered_map<std::string, std::size_t> index;

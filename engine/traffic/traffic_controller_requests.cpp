@@ -29,6 +29,12 @@ int TrafficController::Impl::PointBlocker(PointId q, std::size_t r, double envel
     if (mates(other)) continue;
     if (d < own + other.envelope) return hn;
   }
+  for (const auto& [s, xy] : standing) {  // off the floor, still standing there
+    if (s == r) continue;
+    const RobotState& other = robots[s];
+    if (mates(other)) continue;
+    if ((M().point(q).position - xy).norm() < own + other.envelope) return static_cast<int>(s);
+  }
   return -1;
 }
 

@@ -90,6 +90,10 @@ struct GateTeam {
   bool left = false;
   bool blocked = false;
   PointId drop = kNoPoint;  // where the team leaves from
+  // Its order went before the drop and it leaves the point it stood on (DissolveTeam): `drop`
+  // is that point, and the order may come back to a new team once this one is gone.
+  bool broken = false;
+  double broken_since = -1.0;  // when it began to leave (StepTeams; -1: not yet stepped)
   std::map<std::string, std::uint64_t> drop_seq;  // member -> sequence of its drop waypoint
 };
 
@@ -220,6 +224,7 @@ struct GateImpl {
   void StepTeams(double t, std::vector<GateEffect>& out);
   void StepTeamsAfterDeadlocks(double t, std::vector<GateEffect>& out);
   void BreakTeam(GateTeam& team);
+  bool DissolveTeam(GateTeam& team);  // true: gone (BreakTeam); false: it leaves (kLeaving)
   // b leaves (or never joins) `order`'s team at `at` (kNoPoint: until its next point): exempt
   // from its members until it has driven off; a former team it still had moves to older_former,
   // which makes way, unless one of its members still stands beside b and none of the newer

@@ -85,22 +85,52 @@ bool GateImpl::StepLeaving(GateTeam& team, double t, std::vector<GateEffect>& ou
       return true;
     }
     const long j = onward(b);
-    PointId target = j >= 0 ? b.plan.waypoints[static_cast<std::size_t>(j)].point : kNoPoint;
-    if (target == kNoPoint) {
+    // Where it goes: its onward route's first point, or (idle) any free neighbour of D that is
+    // no service point and outside intersections.
+    std::vector<PointId> targets;
+    if (j >= 0) {
+      targets.push_back(b.plan.waypoints[static_cast<std::size_t>(j)].point);
+    } else {
       for (ArcId a : map->out_arcs(d)) {
         const PointId q = map->arc(a).to;
-        if (!IsServicePoint(map->point(q).kind) && map->IntersectionOf(q) < 0) {
-          target = q;
-          break;
-        }
+        if (!IsServicePoint(map->point(q).kind) && map->IntersectionOf(q) < 0) targets.push_back(q);
       }
     }
-    if (target == kNoPoint || !place(b, target)) return false;  // retried next step
+    // An idle member of a broken-up team drives on home (its parking point) from there: left
+    // on the neighbour it would close the way off for the next member (a team broken up inside
+    // an intersection has few ways off that are no intersection points).
+    auto home_route = [&](PointId q) {
+      std::vector<PointId> route{d, q};
+      if (!team.broken || j >= 0 || b.home == kNoPoint || b.home == q) return route;
+      auto path = routes->Path(q, b.home);
+      if (path.ok()) route.insert(route.end(), path->points.begin() + 1, path->points.end());
+      return route;
+    };
+    PointId target = kNoPoint;
+    for (PointId q : targets) {
+      if (place(b, q)) {
+        target = q;
+        break;
+      }
+    }
+    if (target == kNoPoint) {  // retried next step; the team agent waits on whoever is in the way
+      if (agent_on_floor && !targets.empty()) {
+        const auto tr = static_cast<std::size_t>(team.ctl);
+        const int blocker = ctl.BlockerOf(targets.front(), tr, 0.0);
+        ctl.WaitOn(tr, blocker, t,
+                   blocker >= 0 ? "formation " + team.order + ": " + b.id + " leaves for '" +
+                                      map->point(targets.front()).name + "', held by " +
+                                      ctl.robot_id(static_cast<std::size_t>(blocker))
+                                : std::string());
+      }
+      return false;
+    }
+    if (agent_on_floor) ctl.WaitOn(static_cast<std::size_t>(team.ctl), -1, t, {});
     notes.push_back("formation " + team.order + ": " + b.id + " leaves '" + map->point(d).name + "' for '" +
                     map->point(target).name + "' (onward waypoint " + std::to_string(j) + ")");
     long first_new = j;
-    if (j < 0) {  // idle: a move to the neighbour
-      RewriteLeg(b, static_cast<long>(b.plan.waypoints.size()) - 1, {d, target}, -1, t, out);
+    if (j < 0) {  // idle: a move to the neighbour (and home, see home_route)
+      RewriteLeg(b, static_cast<long>(b.plan.waypoints.size()) - 1, home_route(target), -1, t, out);
       first_new = static_cast<long>(b.plan.waypoints.size()) - 1;
     }
     b.leave_seq = static_cast<std::uint64_t>(b.plan.waypoints[static_cast<std::size_t>(first_new)].seq);

@@ -71,7 +71,9 @@ void GateImpl::PlaceStrays() {
     if (stray && !PlaceNear(bot->second)) {
       ++it;
     } else {
-      it = strays.erase(it);  // placed, or no longer a stray (placed elsewhere, in a team again)
+      // Placed, or no longer a stray (placed elsewhere, in a team again).
+      if (bot != bots.end() && bot->second.ctl >= 0) ctl.ClearStanding(static_cast<std::size_t>(bot->second.ctl));
+      it = strays.erase(it);
     }
   }
 }

@@ -44,8 +44,7 @@ void GateImpl::SyncTeams(GateBot& b) {
       if (drop != it->second.drop_seq.end() && b.reached_seq >= drop->second) {
         it->second.phase = GateTeam::Phase::kLeaving;
       } else if (it->second.phase != GateTeam::Phase::kLeaving) {
-        BreakTeam(it->second);
-        teams.erase(it);
+        if (DissolveTeam(it->second)) teams.erase(it);
       }
     }
   }
@@ -54,8 +53,11 @@ void GateImpl::SyncTeams(GateBot& b) {
     GateTeam& team = it->second;
     const bool mine = std::find(team.members.begin(), team.members.end(), b.id) != team.members.end();
     if (mine && team.phase == GateTeam::Phase::kForming && !in_plan.count(team.order)) {
-      BreakTeam(team);
-      it = teams.erase(it);
+      if (DissolveTeam(team)) {
+        it = teams.erase(it);
+      } else {
+        ++it;
+      }
     } else {
       ++it;
     }
@@ -83,6 +85,45 @@ bool GateImpl::TeammateBeside(const GateBot& b, const std::string& order) const 
     if (&o == &b || !o.has_xy || (o.xy - b.xy).norm() >= envelope - 1e-9) continue;
     if (o.team == order || o.former_team == order || o.older_former == order || o.approach == order) return true;
   }
+  return false;
+}
+
+bool GateImpl::DissolveTeam(GateTeam& team) {
+  // A team whose order went before its drop (cancelled, failed, put back after a block). If
+  // its agent stands on a point with members in their slots, those leave that point one at a
+  // time as after a drop (StepLeaving), under the agent's envelope until each has driven off:
+  // broken up at once they would stay in their slots off the floor wherever the point was a
+  // teammate's, unseen by the controller (strays: robots then waited in cycles no deadlock
+  // breaking saw, and strangers drove up to them, Tables 1+2 x10 and 30% formation streams).
+  const bool standing = TeamAgentOnFloor(team) && ctl.Next(static_cast<std::size_t>(team.ctl)) == kNoPoint;
+  bool in_slots = false;
+  for (const std::string& id : team.members) {
+    const GateBot* m = Find(id);
+    in_slots = in_slots || (m && m->team == team.order);
+  }
+  if (!standing || !in_slots) {
+    BreakTeam(team);
+    return true;
+  }
+  const PointId at = ctl.At(static_cast<std::size_t>(team.ctl));
+  notes.push_back("formation " + team.order + " broken up: its members leave '" + map->point(at).name +
+                  "' one at a time");
+  for (const std::string& id : team.members) {  // not in the team yet: as in BreakTeam
+    GateBot* m = Find(id);
+    if (m && m->team.empty() && m->approach == team.order && TeammateBeside(*m, team.order)) {
+      BecomeFormer(*m, team.order, at);
+    }
+  }
+  // It drives no more: no route, no request queued for a grant, no wait of its own (it waits
+  // on whoever holds the point a member leaves for: StepLeaving); never asked to yield, as when
+  // it assembled, and as long as anyone would wait (its members leave around it).
+  const auto tr = static_cast<std::size_t>(team.ctl);
+  (void)ctl.SetRoute(tr, {at});
+  ctl.WaitOn(tr, -1, 0.0, {});
+  ctl.SetWorking(tr, true, 1e9);
+  team.phase = GateTeam::Phase::kLeaving;
+  team.broken = true;
+  team.drop = at;
   return false;
 }
 
@@ -141,7 +182,11 @@ void GateImpl::BreakTeam(GateTeam& team) {
       ctl.SetGroup(r, 0, group);
       if (PlaceBot(b, map->NearestPoint(b.xy))) ctl.SetEnvelope(r, FormationRadius());
     }
-    if (!OnFloor(b)) strays.insert(id);
+    if (!OnFloor(b)) {
+      // A stray: the controller keeps strangers' points clear of where it stands.
+      strays.insert(id);
+      if (b.ctl >= 0 && b.has_xy) ctl.SetStanding(static_cast<std::size_t>(b.ctl), b.xy);
+    }
   }
 }
 
@@ -209,6 +254,7 @@ bool GateImpl::TeamAgentOnFloor(const GateTeam& team) const {
 }
 
 void GateImpl::StepTeams(double t, std::vector<GateEffect>& out) {
+  std::vector<std::string> resync;  // broken teams gone: their order may have a new team by now
   for (auto it = teams.begin(); it != teams.end();) {
     GateTeam& team = it->second;
     // Members as they stand now.
@@ -227,7 +273,7 @@ void GateImpl::StepTeams(double t, std::vector<GateEffect>& out) {
         v.first_pick = span->first_pick;
         v.length = span->drop - span->first_pick + 1;
         team.drop_seq[id] = span->seq_drop;
-        team.drop = b->second.plan.waypoints[static_cast<std::size_t>(span->drop)].point;
+        if (!team.broken) team.drop = b->second.plan.waypoints[static_cast<std::size_t>(span->drop)].point;
       }
       m.push_back(v);
     }
@@ -375,12 +421,34 @@ void GateImpl::StepTeams(double t, std::vector<GateEffect>& out) {
         }
       }
     }
+    if (team.broken && team.broken_since < 0) team.broken_since = t;
+    if (team.broken && t - team.broken_since > config.t_w2 && team.phase == GateTeam::Phase::kLeaving) {
+      // Its members found no way off within T_w2 (the points around held by robots that wait
+      // for the team, or blocked): it breaks up where it stands, as before (BreakTeam).
+      notes.push_back("formation " + team.order + ": no way off '" + map->point(team.drop).name + "' for " +
+                      std::to_string(static_cast<int>(config.t_w2)) + " s");
+      BreakTeam(team);
+      resync.push_back(team.order);
+      it = teams.erase(it);
+      continue;
+    }
     if (team.phase == GateTeam::Phase::kLeaving && StepLeaving(team, t, out)) {
-      finished_teams.insert(team.order);
+      const bool broken = team.broken;
+      const std::string order = team.order;
+      if (broken) {
+        resync.push_back(order);
+      } else {
+        finished_teams.insert(order);
+      }
       it = teams.erase(it);
       continue;
     }
     ++it;
+  }
+  for (const std::string& order : resync) {
+    for (GateBot* b : in_order) {
+      if (b->plan.teams.count(order)) SyncTeams(*b);
+    }
   }
 }
 

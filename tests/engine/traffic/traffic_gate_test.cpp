@@ -372,7 +372,9 @@ TEST_F(TrafficGateTest, RegressionABlockedFormationMemberIsNeverPlacedAtItsHome)
   // Issue 15 §3b: a moving formation is blocked; the dispatcher takes the order away, which cuts
   // each member's plan back to its anchor (its parking point). The members still stand in their
   // slots and must stay obstacles there: the gate used to put them back at home, and a robot
-  // then came D_f = 0.231 m (later 0 m) from one of them.
+  // then came D_f = 0.231 m (later 0 m) from one of them. Now the team's agent keeps the point
+  // while the members leave it one at a time for a free point next to it (DissolveTeam), each
+  // driving there, never home.
   AddFormation({"park-P1", "park-P2", "park-P3"}, "K3-2-3N", "D-B2", "f1");
   ASSERT_TRUE(Run(40000, {}, [&] {
     for (const auto& id : team_) {
@@ -398,17 +400,26 @@ TEST_F(TrafficGateTest, RegressionABlockedFormationMemberIsNeverPlacedAtItsHome)
     cut.order_of = {""};
     gate_->SetPlan(id, cut);
   }
-  Run(1);
+  Eigen::Vector2d centre = Eigen::Vector2d::Zero();
+  for (const auto& [id, xy] : stands) centre += xy / static_cast<double>(stands.size());
+  const PointId team_point = map_->NearestPoint(centre);
+  auto all_left = [&] {
+    for (const auto& id : team_) {
+      if (gate_->RobotState(id).formation != "") return false;
+    }
+    return true;
+  };
+  for (int step = 0; step < 2000 && !all_left(); ++step) Run(1);
+  ASSERT_TRUE(all_left()) << DescribeAll();
   int on_floor = 0;
   for (const auto& id : team_) {
-    EXPECT_EQ(gate_->RobotState(id).formation, "") << id;
     const PointId at = gate_->StartPoint(id);
-    if (at == kNoPoint) continue;  // the point at its slot is a teammate's
+    if (at == kNoPoint) continue;  // still in its slot (no way off in time): a stray, seen standing
     ++on_floor;
     EXPECT_NE(at, home[id]) << gate_->Describe(id);
-    EXPECT_LE((map_->point(at).position - stands[id]).norm(), 0.6 + FormationRadius()) << gate_->Describe(id);
+    EXPECT_TRUE(at == team_point || map_->FindArc(team_point, at).has_value()) << gate_->Describe(id);
   }
-  EXPECT_GE(on_floor, 1) << DescribeAll();
+  EXPECT_GE(on_floor, 2) << DescribeAll();
   // A robot sent the formation's way keeps eps1 from the members standing in their slots.
   AddRobot("R4", "park-P4", {"K3-2-3N"}, "D-B2", "o4");
   Run(600, {}, [&] { return sims_["R4"].at + 1 >= sims_["R4"].plan.size(); });
