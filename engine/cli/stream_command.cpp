@@ -250,10 +250,11 @@ int RunCompare(StreamArgs a) {
                                : TablesLabel(a).c_str(),
               setup->robots.size(), a.map.c_str(), a.dt);
   // failed: blocked / still waiting at --max-time / other; violations: with --check-safety.
-  std::printf("%-18s %9s %11s %10s %12s %10s %10s %6s %9s %8s %9s %8s %10s\n",
+  // ms/order: wall time of the allocation rounds (auction and planner) per award.
+  std::printf("%-18s %9s %11s %10s %12s %10s %10s %6s %9s %8s %9s %8s %10s %9s\n",
               a.planners.empty() && a.routings.empty() ? "strategy" : "planner", "completed", "failed b/w/o",
               "makespan", "throughput/h", "mean compl", "waiting s", "stops", "distance", "replans", "deadlocks",
-              "min dist", "violations");
+              "min dist", "violations", "ms/order");
   int rc = 0;
   // name, strategy, zeta, planner, routing
   std::vector<std::tuple<std::string, std::string, double, std::string, std::string>> columns;
@@ -282,10 +283,12 @@ int RunCompare(StreamArgs a) {
     char failures[48];
     std::snprintf(failures, sizeof failures, "%zu/%zu/%zu", failed.blocked, failed.waiting, failed.other);
     const std::string violations = r->safety ? std::to_string(r->safety->violations.size()) : "-";
-    std::printf("%-18s %5zu/%-3zu %11s %10.1f %12.1f %10.1f %10.1f %6zu %9.1f %8zu %9zu %8.3f %10s\n", name.c_str(),
-                r->completed, r->orders.size(), failures, r->makespan, r->throughput_per_hour,
+    const double per_order =
+        r->planned_awards > 0 ? 1000.0 * r->planning_seconds / static_cast<double>(r->planned_awards) : 0.0;
+    std::printf("%-18s %5zu/%-3zu %11s %10.1f %12.1f %10.1f %10.1f %6zu %9.1f %8zu %9zu %8.3f %10s %9.3f\n",
+                name.c_str(), r->completed, r->orders.size(), failures, r->makespan, r->throughput_per_hour,
                 r->mean_completion, r->total_waiting_time, r->stops, r->total_distance, r->traffic.replans,
-                r->traffic.deadlocks_resolved, r->overall_min_distance, violations.c_str());
+                r->traffic.deadlocks_resolved, r->overall_min_distance, violations.c_str(), per_order);
     if (!r->all_completed() || (r->safety && !r->safety->ok())) rc = 2;
   }
   return rc;

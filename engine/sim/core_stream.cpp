@@ -1,6 +1,7 @@
 #include "engine/sim/core_stream.h"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <limits>
@@ -117,7 +118,10 @@ class CoreRun {
     RoundCommit commit;
     std::optional<RoundInput> input = core_->MakeRound(t, commit);
     if (!input) return;
+    const auto started = std::chrono::steady_clock::now();
     RoundResult round = rounds_->Run(*input);
+    out_.planning_seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+    out_.planned_awards += round.awards.size();
     commit.awards = std::move(round.awards);
     core_->RoundResult(commit, false);
     const Change change = core_->PlanAwards(commit, commit.awards.size(), t);

@@ -117,6 +117,10 @@ struct StreamResult {
   double total_distance = 0.0;        // m
   double total_waiting_time = 0.0;    // robot-seconds stopped by the controller
   std::size_t stops = 0;              // moving -> traffic wait transitions
+  // SimulateOnCore: wall seconds spent in allocation rounds (the auction and the planner,
+  // RoundRunner::Run) and the awards they made; a measurement only, no decision reads it.
+  double planning_seconds = 0.0;
+  std::size_t planned_awards = 0;
   TrafficStats traffic;               // re-plans, grants, deadlocks resolved, head-on log
   std::vector<std::string> blocked;   // "R3: blocked after ..." for robots taken off
   // SimulateOnCore: "R3 at 245.0 s" for each blocked robot back in service

@@ -29,15 +29,16 @@ std::vector<std::string> Row(const std::string& output, const std::string& name)
 TEST(DispatchSimCompareCliTest, PlannersSideBySideWithFailuresStopsAndViolations) {
   const auto run = Compare("--random 30 --seed 1 --planners rules,time-windows --check-safety");
   ASSERT_EQ(run.status, 0) << run.output;
-  for (const char* column : {"completed", "failed b/w/o", "stops", "replans", "deadlocks", "min dist", "violations"}) {
+  for (const char* column : {"completed", "failed b/w/o", "stops", "replans", "deadlocks", "min dist", "violations", "ms/order"}) {
     EXPECT_NE(run.output.find(column), std::string::npos) << column << "\n" << run.output;
   }
   for (const char* planner : {"rules", "time-windows"}) {
     const std::vector<std::string> row = Row(run.output, planner);
-    ASSERT_EQ(row.size(), 13u) << planner << "\n" << run.output;
+    ASSERT_EQ(row.size(), 14u) << planner << "\n" << run.output;
     EXPECT_EQ(row[1], "30/30") << run.output;
     EXPECT_EQ(row[2], "0/0/0") << run.output;
     EXPECT_EQ(row[12], "0") << run.output;  // violations
+    EXPECT_GT(std::stod(row[13]), 0.0) << run.output;  // the rounds' time per award
   }
 }
 
@@ -46,7 +47,7 @@ TEST(DispatchSimCompareCliTest, OrdersLeftAtTheTimeLimitAreCountedAsWaiting) {
   const auto run = Compare("--random 30 --seed 1 --planners rules --max-time 60");
   EXPECT_EQ(run.status, 2) << run.output;
   const std::vector<std::string> row = Row(run.output, "rules");
-  ASSERT_EQ(row.size(), 13u) << run.output;
+  ASSERT_EQ(row.size(), 14u) << run.output;
   const std::string failed = row[2];
   const std::size_t a = failed.find('/'), b = failed.rfind('/');
   ASSERT_NE(a, b) << failed;
