@@ -228,7 +228,7 @@ FailureCounts CountFailures(const StreamResult& r) {
   FailureCounts n;
   for (const StreamOrderOutcome& o : r.orders) {
     if (o.completed) continue;
-    if (o.failure.rfind("not finished by", 0) == 0) {
+    if (o.open_at_limit) {
       ++n.waiting;
     } else if (o.failure.find("blocked") != std::string::npos) {
       ++n.blocked;

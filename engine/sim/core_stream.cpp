@@ -84,7 +84,9 @@ class CoreRun {
     out_.steps = step;
     out_.end_time = std::min(t, config_.max_time);
     for (const auto& [id, k] : outcome_of_) {
-      if (!terminal_of_.count(k)) Fail(k, "not finished by " + std::to_string(config_.max_time) + " s");
+      if (terminal_of_.count(k)) continue;
+      Fail(k, "not finished by " + std::to_string(config_.max_time) + " s");
+      out_.orders[k].open_at_limit = true;
     }
     Summarise();
     if (config_.check_safety) {

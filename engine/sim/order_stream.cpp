@@ -506,6 +506,7 @@ StreamResult StreamSim::Run() {
       sum += o.completion_time - o.release_time;
     } else if (o.failure.empty()) {
       o.failure = "simulation time limit reached";
+      o.open_at_limit = true;
     }
   }
   if (out_.completed > 0) {

@@ -105,6 +105,7 @@ struct StreamOrderOutcome {
   double completion_time = 0.0;  // end of the drop's work
   bool completed = false;
   std::string failure;
+  bool open_at_limit = false;  // failed only because the run stopped at max_time, still open
 };
 
 struct StreamResult {

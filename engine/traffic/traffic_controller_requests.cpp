@@ -33,7 +33,7 @@ int TrafficController::Impl::PointBlocker(PointId q, std::size_t r, double envel
     if (s == r) continue;
     const RobotState& other = robots[s];
     if (mates(other)) continue;
-    if ((M().point(q).position - xy).norm() < own + other.envelope) return static_cast<int>(s);
+    if ((point_xy[static_cast<std::size_t>(q)] - xy).norm() < own + other.envelope) return static_cast<int>(s);
   }
   return -1;
 }

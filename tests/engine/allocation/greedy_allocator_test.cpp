@@ -74,6 +74,13 @@ TEST_F(GreedyTest, FormationTakesTheThreeFirstByTheSameRule) {
   for (std::size_t r = 1; r < 4; ++r) EXPECT_EQ(s.queue(r).size(), 1u);
 }
 
+// Orders queued over the whole fleet.
+std::size_t Queued(const FleetState& s) {
+  std::size_t n = 0;
+  for (std::size_t r = 0; r < s.robot_count(); ++r) n += s.queue(r).size();
+  return n;
+}
+
 // AllocationConfig::max_queue: a robot whose queue is full does not bid, for either strategy,
 // single or formation orders; with nobody left with room the order is not allocated.
 TEST_F(GreedyTest, ARobotWithAFullQueueDoesNotBid) {
@@ -100,9 +107,7 @@ TEST_F(GreedyTest, ARobotWithAFullQueueDoesNotBid) {
     // Two robots left with room: a formation cannot be formed, and nothing changes.
     auto f = strategy->Allocate(MakeOrder("f", {p3}, d0, true), s);
     EXPECT_FALSE(f.ok());
-    std::size_t queued = 0;
-    for (std::size_t r = 0; r < s.robot_count(); ++r) queued += s.queue(r).size();
-    EXPECT_EQ(queued, 2u);
+    EXPECT_EQ(Queued(s), 2u);
     // One more single order, then every robot is full.
     ASSERT_TRUE(strategy->Allocate(MakeOrder("c", {p3}, d0), s).ok());
     ASSERT_TRUE(strategy->Allocate(MakeOrder("d", {p3}, d0), s).ok());
@@ -138,12 +143,9 @@ TEST_F(GreedyTest, ARobotWithQueuedWorkJoinsNoFormation) {
     EXPECT_EQ(std::count(f->winners.begin(), f->winners.end(), "R1"), 0);
     EXPECT_TRUE(f->bids[0].queue_full);
     // Four robots hold work now, one is free: the next formation is not formed, nothing changes.
-    std::size_t queued = 0;
-    for (std::size_t r = 0; r < s.robot_count(); ++r) queued += s.queue(r).size();
+    const std::size_t queued = Queued(s);
     EXPECT_FALSE(strategy->Allocate(MakeOrder("g", {p3}, d0, true), s).ok());
-    std::size_t after = 0;
-    for (std::size_t r = 0; r < s.robot_count(); ++r) after += s.queue(r).size();
-    EXPECT_EQ(after, queued);
+    EXPECT_EQ(Queued(s), queued);
   }
 }
 

@@ -215,6 +215,17 @@ TEST(CoreStreamTest, TableOneThreeTimesCompletesWithShortQueuesAndOneFormationPe
   EXPECT_TRUE(r->safety->ok()) << r->safety->violations.front().Describe();
 }
 
+// dispatchd's and dispatch-sim's formation settings (formation_max_queue 1, one formation per
+// pick), up to 3000 s, checked on the robots' true positions.
+StreamConfig ProductFormationConfig() {
+  StreamConfig c = Config();
+  c.max_time = 3000;
+  c.check_safety = true;
+  c.allocation.formation_max_queue = 1;
+  c.one_formation_per_pick = true;
+  return c;
+}
+
 // The product's formation settings (dispatchd's and dispatch-sim's defaults): a formation takes
 // only robots with nothing queued (formation_max_queue 1; single orders queue as before) and
 // one formation at a time heads for a first pick. Seed Table 1 four times at once (24 orders,
@@ -223,11 +234,7 @@ TEST(CoreStreamTest, TableOneThreeTimesCompletesWithShortQueuesAndOneFormationPe
 TEST(CoreStreamTest, TableOneFourTimesCompletesWhenFormationsTakeFreeRobots) {
   const World w = Chu();
   const std::vector<Order> orders = Repeated(w, {"chu2024-table1.csv"}, 4);
-  StreamConfig c = Config();
-  c.max_time = 3000;
-  c.check_safety = true;
-  c.allocation.formation_max_queue = 1;
-  c.one_formation_per_pick = true;
+  const StreamConfig c = ProductFormationConfig();
   auto r = SimulateOnCore(w.map, w.routes, Fleet(w, 18), orders, c);
   ASSERT_TRUE(r.ok()) << r.error().message;
   ExpectSane(w, orders, *r, c);
@@ -276,11 +283,7 @@ TEST(CoreStreamTest, MembersOnTheirWayStayExemptFromEachOtherWhenTheirTeamBreaks
 TEST(CoreStreamTest, AMemberStuckFarFromItsRendezvousIsNoTeammateOnceTheTeamBreaksUp) {
   const World w = Chu();
   const std::vector<Order> orders = Repeated(w, {"chu2024-table1.csv", "chu2024-table2.csv"}, 10);
-  StreamConfig c = Config();
-  c.max_time = 3000;
-  c.check_safety = true;
-  c.allocation.formation_max_queue = 1;
-  c.one_formation_per_pick = true;
+  const StreamConfig c = ProductFormationConfig();
   auto r = SimulateOnCore(w.map, w.routes, Fleet(w, 18), orders, c);
   ASSERT_TRUE(r.ok()) << r.error().message;
   ExpectSane(w, orders, *r, c);
@@ -304,11 +307,7 @@ TEST(CoreStreamTest, AMemberStuckFarFromItsRendezvousIsNoTeammateOnceTheTeamBrea
 TEST(CoreStreamTest, ABrokenUpTeamLeavesItsPointOneMemberAtATime) {
   const World w = Chu();
   const Stream s = ChuStream(w, 200, 6, 0.3);
-  StreamConfig c = Config();
-  c.max_time = 3000;
-  c.check_safety = true;
-  c.allocation.formation_max_queue = 1;
-  c.one_formation_per_pick = true;
+  const StreamConfig c = ProductFormationConfig();
   auto r = SimulateOnCore(w.map, w.routes, s.robots, s.orders, c);
   ASSERT_TRUE(r.ok()) << r.error().message;
   ASSERT_TRUE(r->safety.has_value());
