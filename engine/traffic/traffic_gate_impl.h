@@ -1,5 +1,6 @@
 // TrafficGate's state, shared by traffic_gate.cpp (plans, effects, interface),
 // traffic_gate_solo.cpp (solo agents), traffic_gate_teams.cpp (formations),
+// traffic_gate_breakup.cpp (a formation breaking up before its drop),
 // traffic_gate_leaving.cpp (a formation leaving its drop) and traffic_gate_rejoin.cpp
 // (formations formed again after a restart). Internal to the gate; see
 // traffic_gate.h for the model.
