@@ -94,14 +94,15 @@ void FleetState::Publish(RobotEntry& e) {
     e.prediction = predictor_->SetPlan(e.info.id, e.plan);
     return;
   }
-  Plan held = e.plan;
-  Waypoint w = held.waypoints.back();
-  w.seq = static_cast<int>(held.waypoints.size());
+  // The plan with the hold appended for the predictor, then as it was (no copy of the plan).
+  Waypoint w = e.plan.waypoints.back();
+  w.seq = static_cast<int>(e.plan.waypoints.size());
   w.eta = w.departure();
   w.action = WaypointAction::kWait;
   w.dwell = config_.hold_seconds;
-  held.waypoints.push_back(w);
-  e.prediction = predictor_->SetPlan(e.info.id, held);
+  e.plan.waypoints.push_back(w);
+  e.prediction = predictor_->SetPlan(e.info.id, e.plan);
+  e.plan.waypoints.pop_back();
 }
 
 Status FleetState::AssignSingle(std::size_t robot, const std::string& order_id,

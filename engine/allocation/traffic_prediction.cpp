@@ -46,9 +46,15 @@ TrafficPredictor::TrafficPredictor(std::shared_ptr<const ZoneIndex> index,
 // --- Buckets and counts ---------------------------------------------------------------------
 
 void TrafficPredictor::Apply(const Contribution& c, int sign) {
-  for (std::size_t k = 0; k < c.zones.size(); ++k) {
+  const std::size_t tail = std::min(c.tail, c.zones.size());
+  for (std::size_t k = 0; k < tail; ++k) {
     if (c.zones[k] < 0) continue;
     counts_[static_cast<std::size_t>(c.zones[k]) * bucket_stride_ + c.first_bucket + k] += sign;
+  }
+  // The final run in one zone (a plan's last stop and hold): adjacent counts of one row.
+  if (tail < c.zones.size() && c.zones.back() >= 0) {
+    std::int32_t* row = counts_.data() + static_cast<std::size_t>(c.zones.back()) * bucket_stride_ + c.first_bucket;
+    for (std::size_t k = tail; k < c.zones.size(); ++k) row[k] += sign;
   }
 }
 
@@ -96,8 +102,15 @@ TrafficPredictor::PlanHandle TrafficPredictor::SetPlan(const std::string& robot,
           xy = w.front().xy;
         } else {
           while (upper < w.size() && !(t < w[upper].eta)) ++upper;
+          if (upper == w.size()) {
+            // At the last waypoint from here on (its dwell, then the plan's end): one zone
+            // for every bucket left (a plan's final hold is hundreds of buckets).
+            if (!(w.back().xy == last_xy)) last_zone = index_->ZoneAt(w.back().xy);
+            next.zones.resize(last_plus_one - first, last_zone);
+            break;
+          }
           const Waypoint& from = w[upper - 1];
-          if (upper == w.size() || t <= from.departure()) {
+          if (t <= from.departure()) {
             xy = from.xy;
           } else {
             const Waypoint& to = w[upper];

@@ -139,6 +139,16 @@ std::vector<PointId> TrafficController::RemainingRoute(std::size_t r) const {
   if (x.route.empty()) return {};
   return {x.route.begin() + static_cast<std::ptrdiff_t>(x.pos), x.route.end()};
 }
+void TrafficController::SetRouteBound(std::shared_ptr<const RouteTable> routes) {
+  impl_->bound_routes.reset();
+  if (!routes || routes->point_count() != impl_->M().point_count()) return;
+  const RouteTableBuildInfo info = routes->build_info();
+  if (info.turn_expanded || !(info.speed > 0.0)) return;
+  // Per arc, the table costs length / min(its speed, max_speed) and ArcTime length /
+  // min(config.speed, max_speed): times min(1, table speed / config.speed), never more.
+  impl_->bound_scale = std::min(1.0, info.speed / impl_->config.speed);
+  impl_->bound_routes = std::move(routes);
+}
 bool TrafficController::RemainingRouteIs(std::size_t r, const std::vector<PointId>& route) const {
   const RobotState& x = impl_->robots.at(r);
   if (x.route.empty()) return route.empty();

@@ -48,6 +48,7 @@
 
 #include "engine/common/result.h"
 #include "engine/map/warehouse_map.h"
+#include "engine/routing/route_table.h"
 #include "engine/traffic/intersection_grants.h"
 #include "engine/traffic/lane_corridors.h"
 
@@ -113,6 +114,14 @@ class TrafficController {
   Result<std::size_t> AddRobot(const std::string& id, PointId at, int group = 0);
   std::size_t robot_count() const;
   const std::string& robot_id(std::size_t r) const;
+
+  // A table of this map's shortest travel times, to bound detour searches: a bounded search
+  // skips points from which even the unobstructed route cannot arrive within its bound. The
+  // searches' answers are unchanged (only points that cannot be on such a route are skipped);
+  // a failing search no longer sweeps everything within its bound. Ignored (searches as
+  // without) for a table of another map or with turn penalties (its costs are then no lower
+  // bound of the controller's arc times); null: none.
+  void SetRouteBound(std::shared_ptr<const RouteTable> routes);
 
   // The robot's route from where it stands: points[0] must be its point, consecutive points
   // joined by arcs. Withdraws pending grant requests. Errors: bad route.

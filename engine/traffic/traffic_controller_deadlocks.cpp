@@ -3,6 +3,7 @@
 // Requests are in traffic_controller_requests.cpp, the public interface in
 // traffic_controller.cpp, the shared state in traffic_controller_impl.h.
 #include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <functional>
 #include <optional>
@@ -51,6 +52,54 @@ Detour TrafficController::Impl::Route(PointId from, PointId to, PointId ban_poin
   return a.detour;
 }
 
+// The cost of Search(q)'s route (+infinity when there is none within q.bound), by A* with
+// the route bound's exact unobstructed times as heuristic (consistent: bans only remove
+// arcs), which goes straight for the goal where Search's straight-line heuristic sweeps.
+// Only the cost: which of several cheapest routes Search returns is its own order's choice.
+double TrafficController::Impl::CheapestCost(const traffic_detail::RouteQuery& q) {
+  const auto [from, to, ban_point, ban_corridor, ban_guard, bound] = q;
+  const double inf = std::numeric_limits<double>::infinity();
+  const double limit = bound + 1e-6 * (1.0 + std::abs(bound));  // float tables' rounding
+  if (++stamp == 0) {
+    std::fill(seen.begin(), seen.end(), 0);
+    stamp = 1;
+  }
+  std::vector<OpenItem>& heap = open;  // here h holds the entry's cost so far
+  heap.clear();
+  // Ties to the entry furthest along (on a grid many routes cost the same: without this the
+  // search would sweep all of them).
+  auto later = [](const OpenItem& a, const OpenItem& b) { return a.key != b.key ? a.key > b.key : a.h < b.h; };
+  auto relax = [&](PointId v, double d) {
+    const auto i = static_cast<std::size_t>(v);
+    if (seen[i] == stamp && dist[i] <= d) return;
+    const double key = d + bound_scale * bound_routes->Cost(v, to);
+    if (!(key <= limit)) return;  // also unreachable (+infinity)
+    seen[i] = stamp;
+    dist[i] = d;
+    heap.push_back({key, v, d});
+    std::push_heap(heap.begin(), heap.end(), later);
+  };
+  relax(from, 0.0);
+  while (!heap.empty()) {
+    std::pop_heap(heap.begin(), heap.end(), later);
+    const OpenItem item = heap.back();
+    heap.pop_back();
+    const PointId u = item.point;
+    const auto ui = static_cast<std::size_t>(u);
+    if (item.h > dist[ui]) continue;  // stale entry
+    if (u == to) return dist[ui];
+    for (std::uint32_t k = search_begin[ui]; k < search_begin[ui + 1]; ++k) {
+      const SearchArc& a = search_arcs[k];
+      const PointId v = a.to;
+      if (v == ban_point) continue;
+      if (ban_corridor >= 0 && a.corridor == ban_corridor) continue;
+      if (ban_guard >= 0 && guard_of[static_cast<std::size_t>(v)] == ban_guard && v != to) continue;
+      relax(v, item.h + a.time);
+    }
+  }
+  return inf;
+}
+
 // Search: Route without the memo.
 Detour TrafficController::Impl::Search(const traffic_detail::RouteQuery& q) {
   const auto [from, to, ban_point, ban_corridor, ban_guard, bound] = q;
@@ -59,29 +108,52 @@ Detour TrafficController::Impl::Search(const traffic_detail::RouteQuery& q) {
     if (from == to) out = {{from}, 0.0};
     return out;
   }
+  // With a route bound (SetRouteBound): first the cheapest cost C (CheapestCost), then this
+  // search without the points from which even the unobstructed route cannot arrive by C. No
+  // cheapest route passes through one (with h* the table's bound, g + h* <= C on such a
+  // route), nor does any of them reach a point of one at its cheapest cost first, so the
+  // search finds the route it finds without the skip, having popped the same points before.
+  double prune = std::numeric_limits<double>::infinity();
+  if (bound_routes) {
+    const double cheapest = CheapestCost(q);
+    if (!std::isfinite(cheapest)) return out;  // nothing within the bound
+    prune = cheapest + 1e-6 * (1.0 + cheapest);  // the margin covers float tables' rounding
+  }
+  // A min-heap on (key, point), as std::priority_queue<std::pair<double, PointId>> would
+  // keep it, in a buffer kept between searches.
+  std::vector<OpenItem>& heap = open;
+  heap.clear();
+  auto later = [](const OpenItem& a, const OpenItem& b) {
+    return a.key != b.key ? a.key > b.key : a.point > b.point;
+  };
+  const Eigen::Vector2d goal = point_xy[static_cast<std::size_t>(to)];
+  auto h = [&](PointId v) { return (point_xy[static_cast<std::size_t>(v)] - goal).norm() / config.speed; };
+  const RouteTable* lower = bound_routes.get();
   if (++stamp == 0) {
     std::fill(seen.begin(), seen.end(), 0);
     stamp = 1;
   }
-  using Item = std::pair<double, PointId>;
-  std::priority_queue<Item, std::vector<Item>, std::greater<>> heap;
-  const Eigen::Vector2d goal = point_xy[static_cast<std::size_t>(to)];
-  auto h = [&](PointId v) { return (point_xy[static_cast<std::size_t>(v)] - goal).norm() / config.speed; };
   auto relax = [&](PointId v, double d, ArcId a) {
     const auto i = static_cast<std::size_t>(v);
     if (seen[i] == stamp && dist[i] <= d) return;
+    if (lower && d + bound_scale * lower->Cost(v, to) > prune) return;
     seen[i] = stamp;
     dist[i] = d;
     via[i] = a;
-    heap.push({d + h(v), v});
+    const double hv = h(v);
+    heap.push_back({d + hv, v, hv});
+    std::push_heap(heap.begin(), heap.end(), later);
   };
   relax(from, 0.0, -1);
   bool found = false;
   while (!heap.empty()) {
-    const auto [key, u] = heap.top();
-    heap.pop();
+    std::pop_heap(heap.begin(), heap.end(), later);
+    const OpenItem item = heap.back();
+    heap.pop_back();
+    const double key = item.key;
+    const PointId u = item.point;
     const double d = dist[static_cast<std::size_t>(u)];
-    if (key > d + h(u) + 1e-12) continue;  // stale entry
+    if (key > d + item.h + 1e-12) continue;  // stale entry
     if (key > bound) break;
     if (u == to) {
       found = true;
@@ -241,13 +313,15 @@ bool TrafficController::Impl::BreakCycle(const std::vector<std::size_t>& members
 
 std::size_t TrafficController::Impl::ResolveDeadlocks(double t) {
   const std::size_t n = robots.size();
-  std::vector<std::uint32_t> walk(n, 0);
+  std::vector<std::uint32_t>& walk = deadlock_walk;
+  walk.assign(n, 0);
   std::uint32_t walk_id = 0;
   std::size_t broken = 0;
   for (std::size_t s = 0; s < n; ++s) {
     if (walk[s] != 0 || robots[s].wait == WaitKind::kNone) continue;
     ++walk_id;
-    std::vector<std::size_t> path;
+    std::vector<std::size_t>& path = deadlock_path;
+    path.clear();
     int v = static_cast<int>(s);
     while (v >= 0 && walk[static_cast<std::size_t>(v)] == 0) {
       walk[static_cast<std::size_t>(v)] = walk_id;

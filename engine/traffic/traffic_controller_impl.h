@@ -132,6 +132,20 @@ struct TrafficController::Impl {
   std::vector<ArcId> via;
   std::vector<std::uint32_t> seen;
   std::uint32_t stamp = 0;
+  // SetRouteBound: the table (null: none) and the factor that turns its costs into lower
+  // bounds of ArcTime sums (its speed may exceed config.speed).
+  std::shared_ptr<const RouteTable> bound_routes;
+  double bound_scale = 1.0;
+  // A*'s open list (a binary heap on key, then point; h kept for the staleness test).
+  struct OpenItem {
+    double key;
+    PointId point;
+    double h;
+  };
+  std::vector<OpenItem> open;
+  // ResolveDeadlocks' scratch: the walk each robot was reached on, the current wait chain.
+  std::vector<std::uint32_t> deadlock_walk;
+  std::vector<std::size_t> deadlock_path;
   // Route's recent answers (cleared when full: kRouteMemo entries bound its memory).
   static constexpr std::size_t kRouteMemo = 4096;
   std::unordered_map<traffic_detail::RouteQuery, traffic_detail::RouteAnswer, traffic_detail::RouteQueryHash> route_memo;
@@ -210,6 +224,7 @@ struct TrafficController::Impl {
   Detour Route(PointId from, PointId to, PointId ban_point, int ban_corridor, int ban_guard,
                double bound = kInf);
   Detour Search(const traffic_detail::RouteQuery& q);  // Route without the memo
+  double CheapestCost(const traffic_detail::RouteQuery& q);  // Search's route cost, by bound_routes
   bool StartAllowed(std::size_t r, const std::vector<PointId>& points) const;
   bool TryDetour(std::size_t r, PointId ban_point, int ban_corridor, int ban_guard,
                  bool need_free_first_hop);

@@ -32,6 +32,7 @@ GateImpl::GateImpl(std::shared_ptr<const WarehouseMap> m,
                    std::shared_ptr<const RouteTable> r, TrafficControllerConfig c,
                    TrafficController controller)
     : map(std::move(m)), routes(std::move(r)), config(c), ctl(std::move(controller)) {
+  ctl.SetRouteBound(routes);  // bounded detour searches skip what cannot arrive in time
   // Service points by 1 m cell, then every point against the service points around it.
   const double reach = config.point_clearance + FormationRadius();
   auto cell = [&](const Eigen::Vector2d& p) {
