@@ -50,8 +50,12 @@ BookRobot* DispatchCore::FindRobot(const std::string& id) {
 
 BookRobot& DispatchCore::Book(const std::string& id) {
   if (BookRobot* r = FindRobot(id)) return *r;
-  BookRobot& r = robots_[id];
+  auto [it, inserted] = robots_.try_emplace(id);
+  BookRobot& r = it->second;
   robot_index_.emplace(id, &r);
+  const auto at = std::upper_bound(bidding_order_.begin(), bidding_order_.end(), id,
+                                   [](const std::string& a, const auto& b) { return NaturalLess(a, *b.first); });
+  bidding_order_.insert(at, {&it->first, &r});
   return r;
 }
 
@@ -190,12 +194,11 @@ std::optional<RoundInput> DispatchCore::MakeRound(double now, RoundCommit& commi
     if (o.order->state == OrderState::kAccepted) input.pending.push_back(o.order);
   }
   if (input.pending.empty()) return std::nullopt;
-  std::vector<std::string> ids;
-  for (const auto& [id, r] : robots_) {
-    if (Eligible(r)) ids.push_back(id);
+  std::vector<std::pair<const std::string*, const BookRobot*>> bidders;  // in bidding order
+  for (const auto& [id, r] : bidding_order_) {
+    if (Eligible(*r)) bidders.emplace_back(id, r);
   }
-  if (ids.empty()) return std::nullopt;
-  std::sort(ids.begin(), ids.end(), NaturalLess);
+  if (bidders.empty()) return std::nullopt;
   std::sort(input.pending.begin(), input.pending.end(),
             [](const auto& a, const auto& b) { return AllocationOrderLess(*a, *b); });
   if (options_.one_formation_per_pick) {
@@ -214,8 +217,9 @@ std::optional<RoundInput> DispatchCore::MakeRound(double now, RoundCommit& commi
     input.pending = std::move(kept);
     if (input.pending.empty()) return std::nullopt;
   }
-  for (const auto& id : ids) {
-    const BookRobot& r = robots_.at(id);
+  for (const auto& [id_of, robot] : bidders) {
+    const std::string& id = *id_of;
+    const BookRobot& r = *robot;
     RoundRobot rr;
     rr.id = id;
     rr.start = StartOf(r);

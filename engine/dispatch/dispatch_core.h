@@ -289,6 +289,9 @@ class DispatchCore {
   std::map<std::string, BookRobot> robots_;  // never erased: robot_index_ points into it
   // robots_ by id in one hash lookup (every report and arrival looks its robot up).
   std::unordered_map<std::string, BookRobot*> robot_index_;
+  // robots_ in bidding order (NaturalLess of their ids, the map's keys), kept as they are
+  // booked: every round bids them in this order.
+  std::vector<std::pair<const std::string*, BookRobot*>> bidding_order_;
   CoreCounts counts_;
   std::vector<BookRobot*> blocked_;  // in fault since the controller blocked them
   bool allocation_due_ = false;

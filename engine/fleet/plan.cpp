@@ -55,6 +55,9 @@ std::size_t FindSequence(const std::vector<Waypoint>& w, std::uint64_t seq) {
   const int s = static_cast<int>(seq);
   const std::size_t guess = static_cast<std::size_t>(static_cast<std::int64_t>(s) - w.front().seq);
   if (guess < w.size() && w[guess].seq == s) return guess;  // numbered without gaps
+  // Numbered without gaps from s to the end (a plan rewritten before s, e.g. a detour).
+  const std::size_t from_back = w.size() - 1 - static_cast<std::size_t>(static_cast<std::int64_t>(w.back().seq) - s);
+  if (from_back < w.size() && w[from_back].seq == s) return from_back;
   auto at = std::lower_bound(w.begin(), w.end(), s, [](const Waypoint& x, int v) { return x.seq < v; });
   if (at != w.end() && at->seq == s) return static_cast<std::size_t>(at - w.begin());
   // Not found by halving: absent, or a plan out of order (then only a scan finds it).

@@ -42,12 +42,12 @@ PointGrid::PointGrid(const std::vector<Point>& points) {
   xy_.reserve(ids_.size());
   for (PointId i : ids_) xy_.push_back(points[static_cast<std::size_t>(i)].position);
   by_id_.reserve(points.size());
-  for (const Point& p : points) by_id_.push_back(p.position);
-  half_gap_.assign(points.size(), 0.0);
+  for (const Point& p : points) by_id_.push_back({p.position.x(), p.position.y(), 0.0});
   for (std::size_t i = 0; i < points.size(); ++i) {
     PointId other = kNoPoint;
     double gap = 0.0;
-    if (Search(by_id_[i], static_cast<PointId>(i), &other, &gap) && other != kNoPoint) half_gap_[i] = 0.5 * gap;
+    const Eigen::Vector2d xy(by_id_[i].x, by_id_[i].y);
+    if (Search(xy, static_cast<PointId>(i), &other, &gap) && other != kNoPoint) by_id_[i].half_gap = 0.5 * gap;
   }
 }
 
@@ -60,10 +60,11 @@ bool PointGrid::NearestFrom(const Eigen::Vector2d& xy, PointId hint, PointId* id
 }
 
 bool PointGrid::Owns(const Eigen::Vector2d& xy, PointId p, double* distance) const {
-  if (p < 0 || static_cast<std::size_t>(p) >= half_gap_.size()) return false;
+  if (p < 0 || static_cast<std::size_t>(p) >= by_id_.size()) return false;
   // Any other point q: |xy - q| >= |p - q| - |xy - p| >= 2 half_gap - d > d.
-  const double d = (by_id_[static_cast<std::size_t>(p)] - xy).norm();
-  if (!(d < half_gap_[static_cast<std::size_t>(p)] * (1.0 - 1e-9))) return false;  // a margin for rounding
+  const OwnedPoint& o = by_id_[static_cast<std::size_t>(p)];
+  const double d = (Eigen::Vector2d(o.x, o.y) - xy).norm();
+  if (!(d < o.half_gap * (1.0 - 1e-9))) return false;  // a margin for rounding
   *distance = d;
   return true;
 }

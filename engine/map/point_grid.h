@@ -42,8 +42,13 @@ class PointGrid {
   std::vector<std::uint32_t> begin_;  // per cell (row-major), then one past the end
   std::vector<PointId> ids_;          // point ids by cell, ascending within a cell
   std::vector<Eigen::Vector2d> xy_;   // their positions, side by side (no Point read per query)
-  std::vector<Eigen::Vector2d> by_id_;  // positions by point id
-  std::vector<double> half_gap_;        // by point id: half the distance to its nearest other point
+  // By point id: its position and half the distance to its nearest other point, side by side
+  // (Owns reads both, once per robot report).
+  struct alignas(32) OwnedPoint {  // one cache line holds two
+    double x = 0.0, y = 0.0;
+    double half_gap = 0.0;
+  };
+  std::vector<OwnedPoint> by_id_;
   bool Search(const Eigen::Vector2d& xy, PointId exclude, PointId* id, double* distance) const;
 };
 
