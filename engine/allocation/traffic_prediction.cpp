@@ -212,12 +212,26 @@ void TrafficPredictor::DensityAccumulator::Reset(PlanHandle own) {
   peaks_.clear();
   last_ = 0;
   cursor_ = 0;
+  if (++slot_stamp_ == 0) {  // wrapped: no slot may look current
+    std::fill(slot_seen_.begin(), slot_seen_.end(), 0);
+    slot_stamp_ = 1;
+  }
 }
 
 void TrafficPredictor::DensityAccumulator::NewZone(ZoneId zone, int n) {
-  last_ = 0;
-  while (last_ < peaks_.size() && peaks_[last_].first != zone) ++last_;
-  if (last_ == peaks_.size()) peaks_.emplace_back(zone, n);
+  const auto z = static_cast<std::size_t>(zone);
+  if (z >= slot_seen_.size()) {
+    const std::size_t zones = std::max(predictor_->index_->zones().size(), z + 1);
+    slot_seen_.resize(zones, 0);
+    slot_.resize(zones, 0);
+  }
+  if (slot_seen_[z] == slot_stamp_) {
+    last_ = slot_[z];
+    return;
+  }
+  slot_seen_[z] = slot_stamp_;
+  slot_[z] = last_ = peaks_.size();
+  peaks_.emplace_back(zone, n);
 }
 
 void TrafficPredictor::DensityAccumulator::AddRun(ZoneId zone, const double* times,

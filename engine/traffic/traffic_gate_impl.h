@@ -145,6 +145,7 @@ struct GateImpl {
     Eigen::Vector2d xy;  // the robot's position (not clamped)
     long long cx, cy;    // its cell
     const GateBot* bot;
+    Eigen::Vector2d in_cell;  // xy relative to its cell's low corner (NaN: off the grid)
   };
   std::vector<DistanceItem> distance_items;
   // Per item, its team keys once a close pair needed them (valid while the stamp is the

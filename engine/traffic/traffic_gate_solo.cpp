@@ -170,7 +170,12 @@ void GateImpl::StepSolo(GateBot& b, double t, std::vector<GateEffect>& out) {
   const auto& w = b.plan.waypoints;
   const long n = static_cast<long>(w.size());
   // On its way to a rendezvous, or leaving one, a member may come closer to its teammates.
-  SetGroups(b, TeamKeys(b));
+  if (b.team.empty() && b.former_team.empty() && b.plan.teams.empty()) {
+    b.approach.clear();  // a robot alone: TeamKeys(b) would be empty (no strings built per step)
+    ctl.SetGroup(r, 0, 0, 0);
+  } else {
+    SetGroups(b, TeamKeys(b));
+  }
   const PointId next = ctl.Next(r);
   if (next != kNoPoint) {  // driving: the point behind is released once clear of it
     // Clear of it by eps2 (Chu2024 eq. (11)): a formation may be given the point behind.
@@ -439,9 +444,13 @@ void GateImpl::SampleDistances(double t) {
     // Off the grid (a pose the floor's margin does not cover): the nearest border cell.
     const Eigen::Vector2d xy = b.xy.cwiseMax(distance_origin).cwiseMin(
         distance_origin + Eigen::Vector2d(static_cast<double>(distance_cols) - 1e-6, static_cast<double>(distance_rows) - 1e-6));
-    const long long cx = std::clamp(static_cast<long long>(std::floor(xy.x() - distance_origin.x())), 0LL, cols - 1);
-    const long long cy = std::clamp(static_cast<long long>(std::floor(xy.y() - distance_origin.y())), 0LL, rows - 1);
-    items.push_back({b.xy, cx, cy, &b});
+    // xy - origin >= 0 here: truncation is the floor.
+    const Eigen::Vector2d rel = xy - distance_origin;
+    const long long cx = std::clamp(static_cast<long long>(rel.x()), 0LL, cols - 1);
+    const long long cy = std::clamp(static_cast<long long>(rel.y()), 0LL, rows - 1);
+    const Eigen::Vector2d in_cell = xy == b.xy ? Eigen::Vector2d(rel.x() - static_cast<double>(cx), rel.y() - static_cast<double>(cy))
+                                               : Eigen::Vector2d::Constant(std::numeric_limits<double>::quiet_NaN());
+    items.push_back({b.xy, cx, cy, &b, in_cell});
   }
   if (++distance_stamp == 0) {
     std::fill(distance_keys_stamp.begin(), distance_keys_stamp.end(), 0);
@@ -468,8 +477,18 @@ void GateImpl::SampleDistances(double t) {
   distance_next.assign(items.size(), -1);
   for (std::size_t k = 0; k < items.size(); ++k) {
     const Item& me = items[k];
-    for (long long x = std::max(me.cx - 1, 0LL); x <= std::min(me.cx + 1, cols - 1); ++x) {
-      for (long long y = std::max(me.cy - 1, 0LL); y <= std::min(me.cy + 1, rows - 1); ++y) {
+    // A neighbouring cell is skipped when me is further than the minimum so far from the
+    // side they share: every robot there is further than that too, and would be skipped
+    // below (a margin far above rounding; a robot off the grid scans all nine).
+    const double reach = min_distance.distance + 1e-9;
+    const Eigen::Vector2d& f = me.in_cell;
+    const bool all = !(f.x() == f.x());  // NaN: off the grid
+    const long long x0 = all || f.x() <= reach ? me.cx - 1 : me.cx;
+    const long long x1 = all || 1.0 - f.x() <= reach ? me.cx + 1 : me.cx;
+    const long long y0 = all || f.y() <= reach ? me.cy - 1 : me.cy;
+    const long long y1 = all || 1.0 - f.y() <= reach ? me.cy + 1 : me.cy;
+    for (long long x = std::max(x0, 0LL); x <= std::min(x1, cols - 1); ++x) {
+      for (long long y = std::max(y0, 0LL); y <= std::min(y1, rows - 1); ++y) {
         for (int j = distance_head[static_cast<std::size_t>(y * cols + x)]; j >= 0;
              j = distance_next[static_cast<std::size_t>(j)]) {
           const auto jo = static_cast<std::size_t>(j);
