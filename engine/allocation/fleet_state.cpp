@@ -82,6 +82,8 @@ double FleetState::TaskTravelTime(const PlanTask& task) const {
 }
 
 void FleetState::AppendSegment(Plan& plan, const std::vector<Waypoint>& segment) {
+  const std::size_t needed = plan.waypoints.size() + segment.size();
+  if (plan.waypoints.capacity() < needed) plan.waypoints.reserve(std::max(needed, 2 * plan.waypoints.capacity()));
   for (std::size_t k = 1; k < segment.size(); ++k) {
     Waypoint w = segment[k];
     w.seq = static_cast<int>(plan.waypoints.size());

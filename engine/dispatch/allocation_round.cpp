@@ -124,21 +124,22 @@ bool RoundRunner::ReplayQueue(FleetState& fleet, std::size_t index, const RoundR
       return false;
     }
     const Order& order = *r.queue[k];
-    std::vector<PointId> picks = order.picks;
+    std::vector<PointId> ahead;
     if (k == 0) {  // only the picks still ahead of the robot
-      picks.clear();
       for (std::size_t w = 1; w < starts[1] && w < stored.size(); ++w) {
         if (stored[w].action == WaypointAction::kPick && static_cast<std::uint64_t>(stored[w].seq) > r.last_reached) {
-          picks.push_back(stored[w].point);
+          ahead.push_back(stored[w].point);
         }
       }
-      if (picks.empty()) picks.push_back(order.drop);  // picked: only the drop is left
+      if (ahead.empty()) ahead.push_back(order.drop);  // picked: only the drop is left
     }
+    const std::vector<PointId>& picks = k == 0 ? ahead : order.picks;
     // The stored waypoints of this order (the first: those not reached yet), re-timed from
     // the queue's end: no routing (on a large floor every random pick is a new destination
     // of the lazy route table, and re-routing every queue each round thrashed its cache).
     const std::size_t begin = starts[k], end = starts[k + 1];
     std::vector<Waypoint> segment;
+    segment.reserve(std::min(end, stored.size()) - std::min(begin, std::min(end, stored.size())) + 1);
     const PointId from = fleet.summary(index).end_point;
     segment.push_back({0, from, map_->point(from).position, 0.0, WaypointAction::kMove, 0.0});
     for (std::size_t w = begin; w < end && w < stored.size(); ++w) {

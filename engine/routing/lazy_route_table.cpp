@@ -27,19 +27,31 @@ Result<std::unique_ptr<LazyRouteTable>> LazyRouteTable::Build(
   return t;
 }
 
-std::shared_ptr<const LazyRouteTable::Entry> LazyRouteTable::Lookup(PointId to) const {
-  // This thread's last lookup (of any table: the key is the table's id, never reused).
-  thread_local struct {
-    std::uint64_t table = 0;
-    PointId to = kNoPoint;
-    std::shared_ptr<const Entry> entry;
-  } last;
-  if (last.table == id_ && last.to == to) return last.entry;
+// This thread's last lookup (of any table: the key is the table's id, never reused).
+struct LazyRouteTable::LastLookup {
+  std::uint64_t table = 0;
+  PointId to = kNoPoint;
+  std::shared_ptr<const Entry> entry;
+};
+
+LazyRouteTable::LastLookup& LazyRouteTable::Last() {
+  thread_local LastLookup last;
+  return last;
+}
+
+const LazyRouteTable::Entry* LazyRouteTable::Lookup(PointId to) const {
+  LastLookup& last = Last();
+  if (last.table == id_ && last.to == to) return last.entry.get();  // no reference count touched
   std::shared_ptr<const Entry> entry = Find(to);
   last.table = id_;
   last.to = to;
-  last.entry = entry;
-  return entry;
+  last.entry = std::move(entry);
+  return last.entry.get();
+}
+
+std::shared_ptr<const LazyRouteTable::Entry> LazyRouteTable::LookupShared(PointId to) const {
+  Lookup(to);
+  return Last().entry;
 }
 
 void LazyRouteTable::Prepare(PointId to) const {
@@ -94,7 +106,7 @@ Result<Route> LazyRouteTable::Path(PointId from, PointId to) const {
     return NoRouteError(*map_, from, to);
   }
   if (from == to) return Route{{from}, {}, 0.0, 0.0};
-  const std::shared_ptr<const Entry> entry = Lookup(to);
+  const std::shared_ptr<const Entry> entry = LookupShared(to);
   if (entry->via[static_cast<std::size_t>(from)] < 0) {
     return NoRouteError(*map_, from, to);
   }

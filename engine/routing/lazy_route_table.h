@@ -49,7 +49,12 @@ class LazyRouteTable final : public RouteTable {
   };
   LazyRouteTable();
   bool Known(PointId p) const { return p >= 0 && static_cast<std::size_t>(p) < graph_.point_count; }
-  std::shared_ptr<const Entry> Lookup(PointId to) const;  // via this thread's last entry
+  // Via this thread's last entry: valid until this thread's next Lookup (Cost and NextHop read
+  // it at once; a shared_ptr copy per query cost two atomic reference count updates).
+  const Entry* Lookup(PointId to) const;
+  std::shared_ptr<const Entry> LookupShared(PointId to) const;  // kept alive by the caller
+  struct LastLookup;
+  static LastLookup& Last();
   std::shared_ptr<const Entry> Find(PointId to) const;    // the cache, or a new search
 
   std::shared_ptr<const WarehouseMap> map_;

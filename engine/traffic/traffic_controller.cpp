@@ -149,6 +149,14 @@ void TrafficController::SetRouteBound(std::shared_ptr<const RouteTable> routes) 
   impl_->bound_scale = std::min(1.0, info.speed / impl_->config.speed);
   impl_->bound_routes = std::move(routes);
 }
+void TrafficController::CopyRemainingRoute(std::size_t r, std::vector<PointId>& out) const {
+  const RobotState& x = impl_->robots.at(r);
+  if (x.route.empty()) {
+    out.clear();
+    return;
+  }
+  out.assign(x.route.begin() + static_cast<std::ptrdiff_t>(x.pos), x.route.end());
+}
 bool TrafficController::RemainingRouteIs(std::size_t r, const std::vector<PointId>& route) const {
   const RobotState& x = impl_->robots.at(r);
   if (x.route.empty()) return route.empty();

@@ -128,6 +128,8 @@ class TrafficController {
   Status SetRoute(std::size_t r, std::vector<PointId> points);
   // Remaining route: the point it stands at (or drives to) and the rest.
   std::vector<PointId> RemainingRoute(std::size_t r) const;
+  // out = RemainingRoute(r), in out's own storage (no allocation once it is large enough).
+  void CopyRemainingRoute(std::size_t r, std::vector<PointId>& out) const;
   // RemainingRoute(r) == route, without copying the route (the gate asks every step).
   bool RemainingRouteIs(std::size_t r, const std::vector<PointId>& route) const;
   bool HasRoute(std::size_t r) const;  // some point is left to drive to

@@ -146,6 +146,7 @@ struct TrafficController::Impl {
   // ResolveDeadlocks' scratch: the walk each robot was reached on, the current wait chain.
   std::vector<std::uint32_t> deadlock_walk;
   std::vector<std::size_t> deadlock_path;
+  std::vector<int> corridor_scratch;  // ReconcileCorridors' copy of a robot's corridors
   // Route's recent answers (cleared when full: kRouteMemo entries bound its memory).
   static constexpr std::size_t kRouteMemo = 4096;
   std::unordered_map<traffic_detail::RouteQuery, traffic_detail::RouteAnswer, traffic_detail::RouteQueryHash> route_memo;

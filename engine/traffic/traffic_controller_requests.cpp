@@ -69,7 +69,9 @@ void TrafficController::Impl::DropCorridor(int c, std::size_t r) {
 // Keeps only the corridors the robot is inside of or drives on / looks ahead into.
 void TrafficController::Impl::ReconcileCorridors(std::size_t r) {
   RobotState& x = robots[r];
-  const std::vector<int> held = x.corridors;
+  if (x.corridors.empty()) return;
+  std::vector<int>& held = corridor_scratch;  // DropCorridor edits x.corridors
+  held = x.corridors;
   for (int c : held) {
     bool keep = lanes.interior_of[static_cast<std::size_t>(x.at)] == c;
     for (std::size_t k = x.pos; k < x.arcs.size() && k < x.pos + 2 && !keep; ++k) {

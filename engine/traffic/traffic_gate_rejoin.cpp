@@ -104,7 +104,7 @@ bool GateImpl::RejoinTeam(GateBot& b, const std::string& order, const TeamSpan& 
         return undo("point '" + map->point(leg[1]).name + "' is taken");
       }
       team.next_k = k_ahead;
-      team.leg = ctl.RemainingRoute(tr);
+      ctl.CopyRemainingRoute(tr, team.leg);
     }
   }
   for (const Member& v : members) {

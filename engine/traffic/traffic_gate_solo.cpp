@@ -228,7 +228,7 @@ void GateImpl::StepSolo(GateBot& b, double t, std::vector<GateEffect>& out) {
     if (aside) {
       b.stepped_aside = true;
       RewriteLeg(b, here, ctl.RemainingRoute(r), -1, t, out);  // a nudge: moves appended
-      b.leg = ctl.RemainingRoute(r);
+      ctl.CopyRemainingRoute(r, b.leg);
       b.leg_stop = -1;
       b.leg_stale = false;
     }
@@ -236,7 +236,7 @@ void GateImpl::StepSolo(GateBot& b, double t, std::vector<GateEffect>& out) {
     if (b.leg_stale || !ctl.RemainingRouteIs(r, b.leg)) {
       // The controller moves it (a nudge or back-off in deadlock breaking): the plan follows.
       RewriteLeg(b, here, ctl.RemainingRoute(r), -1, t, out);
-      b.leg = ctl.RemainingRoute(r);
+      ctl.CopyRemainingRoute(r, b.leg);
       b.leg_stop = -1;
       b.leg_stale = false;
     }
@@ -270,7 +270,7 @@ void GateImpl::StepSolo(GateBot& b, double t, std::vector<GateEffect>& out) {
       }
       b.leg_stop = stop;
     }
-    b.leg = ctl.RemainingRoute(r);
+    ctl.CopyRemainingRoute(r, b.leg);
     b.leg_stale = false;
     if (!ctl.HasRoute(r)) return;
   }
@@ -356,7 +356,7 @@ void GateImpl::OnReached(GateBot& b, std::uint64_t seq, double t) {
     }
     if (ctl.Next(r) != kNoPoint && p == ctl.Next(r)) {
       ctl.Arrived(r, t);
-      b.leg = ctl.RemainingRoute(r);
+      ctl.CopyRemainingRoute(r, b.leg);
       b.stepped_aside = false;  // idle where it arrived: may have to step aside again
       // Out of the formation's envelope around where it left the team: one agent of its own.
       const double envelope = config.point_clearance + FormationRadius();

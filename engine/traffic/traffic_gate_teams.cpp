@@ -234,7 +234,7 @@ void GateImpl::StepTeams(double t, std::vector<GateEffect>& out) {
             ctl.Arrived(tr, t);
             team.k = team.next_k;
             team.next_k = -1;
-            team.leg = ctl.RemainingRoute(tr);
+            ctl.CopyRemainingRoute(tr, team.leg);
           }
         }
         if (ctl.Next(tr) == kNoPoint) {
@@ -264,7 +264,7 @@ void GateImpl::StepTeams(double t, std::vector<GateEffect>& out) {
                   ++it;
                   continue;
                 }
-                team.leg = ctl.RemainingRoute(tr);
+                ctl.CopyRemainingRoute(tr, team.leg);
                 team.leg_stop = s;
                 team.leg_stale = false;
               }
