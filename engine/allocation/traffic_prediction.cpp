@@ -229,9 +229,16 @@ void TrafficPredictor::DensityAccumulator::NewZone(ZoneId zone, int n) {
     last_ = slot_[z];
     return;
   }
+  // A new zone: into its place by zone id (Flow and Finish sum in that order), the later
+  // zones' slots one further.
+  std::size_t at = peaks_.size();
+  while (at > 0 && peaks_[at - 1].first > zone) {
+    ++slot_[static_cast<std::size_t>(peaks_[at - 1].first)];
+    --at;
+  }
+  peaks_.insert(peaks_.begin() + static_cast<std::ptrdiff_t>(at), {zone, n});
   slot_seen_[z] = slot_stamp_;
-  slot_[z] = last_ = peaks_.size();
-  peaks_.emplace_back(zone, n);
+  slot_[z] = last_ = at;
 }
 
 void TrafficPredictor::DensityAccumulator::AddRun(ZoneId zone, const double* times,
@@ -277,10 +284,8 @@ void TrafficPredictor::DensityAccumulator::AddAtMost(ZoneId zone, double t, doub
 }
 
 double TrafficPredictor::DensityAccumulator::Flow() {
-  sorted_ = peaks_;
-  std::sort(sorted_.begin(), sorted_.end());
   double flow = 0.0;
-  for (const auto& [z, n_max] : sorted_) {
+  for (const auto& [z, n_max] : peaks_) {  // by zone id (NewZone)
     flow += n_max / predictor_->index_->zones()[static_cast<std::size_t>(z)].area;  // eqs. (7)-(8)
   }
   return flow;
@@ -288,8 +293,7 @@ double TrafficPredictor::DensityAccumulator::Flow() {
 
 DensityTerm TrafficPredictor::DensityAccumulator::Finish() const {
   DensityTerm term;
-  term.peaks = peaks_;
-  std::sort(term.peaks.begin(), term.peaks.end());
+  term.peaks = peaks_;  // by zone id (NewZone)
   for (const auto& [z, n_max] : term.peaks) {
     term.flow += n_max / predictor_->index_->zones()[static_cast<std::size_t>(z)].area;  // eqs. (7)-(8)
   }

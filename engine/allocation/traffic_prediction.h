@@ -228,14 +228,13 @@ class TrafficPredictor::DensityAccumulator {
   std::size_t own_first_ = 0, own_tail_ = 0, own_end_ = 0;
   const ZoneId* own_zones_ = nullptr;
   ZoneId tail_zone_ = -1;
-  std::vector<std::pair<ZoneId, int>> peaks_;  // N_p,max so far, in order of first visit
+  std::vector<std::pair<ZoneId, int>> peaks_;  // N_p,max so far, by zone id
   std::size_t last_ = 0;                       // index of the last zone added
   // peaks_'s entry of each zone: slot_[z], valid when slot_seen_[z] == slot_stamp_ (Reset
   // moves the stamp on instead of clearing them).
   std::vector<std::size_t> slot_;
   std::vector<std::uint32_t> slot_seen_;
   std::uint32_t slot_stamp_ = 0;
-  std::vector<std::pair<ZoneId, int>> sorted_;  // Flow's scratch
 
   std::size_t cursor_ = 0;  // the bucket of the last sample located (or 0)
 

@@ -80,6 +80,7 @@ struct BookRobot {
   Assignment assignment;  // plan.waypoints[0] anchors; then one segment per order
   RobotProgress progress;
   double blocked_at = -1.0;  // >= 0: in fault since then because the controller blocked it
+  GateBot* gate_entry = nullptr;  // its entry in the traffic gate, once it has one (GateEntry)
 };
 
 // One order's line in a Change: a state transition (to) or a journal note only.
@@ -269,6 +270,8 @@ class DispatchCore {
   bool Eligible(const BookRobot& r) const;
   PointId StartOf(const BookRobot& r) const;
   RoundKey KeyOf(const BookRobot& r) const;
+  // r's entry in the gate (nullptr: none yet), looked up by id until it has one.
+  GateBot* GateEntry(BookRobot& r, const std::string& id);
   // Releases `order_ids` (targets by PlanRelease) with `reason`.
   Change PlanReleaseOf(const std::vector<std::string>& order_ids,
                        const std::function<OrderState(OrderState)>& target, const std::string& reason,

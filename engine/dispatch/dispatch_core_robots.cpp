@@ -83,7 +83,7 @@ ReportOutcome DispatchCore::Report(const std::string& id, const Pose& pose, std:
   // at its plan's end and disregard its real progress from then on).
   std::uint64_t passed = 0;
   out.retry = TakeStateProgress(r->progress, r->assignment, claimed, &passed);
-  if (gate_) gate_->Report(id, pose.position, passed, now);
+  if (GateBot* g = GateEntry(*r, id)) gate_->Report(*g, pose.position, passed, now);
   return out;
 }
 
@@ -97,8 +97,9 @@ ReportOutcome DispatchCore::Reached(const std::string& id, std::uint64_t seq, co
     return out;
   }
   const std::optional<Eigen::Vector2d> xy = pose ? std::optional<Eigen::Vector2d>(pose->position) : std::nullopt;
-  Arrival arrival =
-      TakeArrival(r->progress, r->assignment, seq, ReleasedUpTo(id), xy, options_.robot_snap_tolerance);
+  GateBot* g = GateEntry(*r, id);
+  const std::uint64_t released = g ? gate_->ReleasedUpTo(*g) : ReleasedUpTo(id);
+  Arrival arrival = TakeArrival(r->progress, r->assignment, seq, released, xy, options_.robot_snap_tolerance);
   if (!arrival.verdict.taken) {
     out.taken = false;
     out.why = arrival.verdict.why;
@@ -112,7 +113,7 @@ ReportOutcome DispatchCore::Reached(const std::string& id, std::uint64_t seq, co
     r->robot.pose.position = *arrival.xy;
     if (pose && std::isfinite(pose->heading)) r->robot.pose.heading = pose->heading;
   }
-  if (gate_) gate_->Reached(id, seq, now, arrival.xy);
+  if (g) gate_->Reached(*g, seq, now, arrival.xy);
   if (w.action == WaypointAction::kPick) {
     const std::string order_id = OrderOfWaypoint(r->assignment, i);
     if (auto line = StartLine(order_id, id + " reached pick '" + map_->point(w.point).name + "'")) {
@@ -245,6 +246,11 @@ void DispatchCore::Recover(double now, StepOutcome& out) {
     out.notes.emplace_back(note);
     return true;
   });
+}
+
+GateBot* DispatchCore::GateEntry(BookRobot& r, const std::string& id) {
+  if (!r.gate_entry && gate_) r.gate_entry = gate_->Entry(id);
+  return r.gate_entry;
 }
 
 void DispatchCore::SampleDistances(double now) {

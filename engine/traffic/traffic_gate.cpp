@@ -232,24 +232,30 @@ void TrafficGate::Unblock(const std::string& robot, double t) {
 
 void TrafficGate::Reached(const std::string& robot, std::uint64_t sequence, double t,
                           const std::optional<Eigen::Vector2d>& xy) {
-  GateBot* bot = impl_->Find(robot);
-  if (!bot) return;
+  if (GateBot* bot = impl_->Find(robot)) Reached(*bot, sequence, t, xy);
+}
+
+void TrafficGate::Reached(GateBot& bot, std::uint64_t sequence, double t, const std::optional<Eigen::Vector2d>& xy) {
   if (xy) {
-    bot->xy = *xy;
-    bot->has_xy = true;
+    bot.xy = *xy;
+    bot.has_xy = true;
   }
-  impl_->OnReached(*bot, sequence, t);
+  impl_->OnReached(bot, sequence, t);
 }
 
 void TrafficGate::Report(const std::string& robot, const Eigen::Vector2d& xy, std::uint64_t last_waypoint,
                          double t) {
-  GateBot* bot = impl_->Find(robot);
-  if (!bot) return;
-  bot->xy = xy;
-  bot->has_xy = true;
-  if (last_waypoint > bot->reached_seq) impl_->OnReached(*bot, last_waypoint, t);
-  bot->synced = true;
+  if (GateBot* bot = impl_->Find(robot)) Report(*bot, xy, last_waypoint, t);
 }
+
+void TrafficGate::Report(GateBot& bot, const Eigen::Vector2d& xy, std::uint64_t last_waypoint, double t) {
+  bot.xy = xy;
+  bot.has_xy = true;
+  if (last_waypoint > bot.reached_seq) impl_->OnReached(bot, last_waypoint, t);
+  bot.synced = true;
+}
+
+GateBot* TrafficGate::Entry(const std::string& robot) { return impl_->Find(robot); }
 
 std::vector<GateEffect> TrafficGate::Step(double t) {
   Impl& s = *impl_;
@@ -302,6 +308,8 @@ std::uint64_t TrafficGate::ReleasedUpTo(const std::string& robot) const {
   const GateBot* bot = impl_->Find(robot);
   return bot ? bot->released : 0;
 }
+
+std::uint64_t TrafficGate::ReleasedUpTo(const GateBot& robot) const { return robot.released; }
 
 std::string TrafficGate::Describe(const std::string& robot) const {
   const Impl& s = *impl_;

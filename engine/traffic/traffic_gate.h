@@ -111,6 +111,8 @@ struct GateRobotState {
   std::array<std::string, 3> teams;
 };
 
+struct GateBot;  // the gate's entry of one robot (traffic_gate_impl.h)
+
 class TrafficGate {
  public:
   static Result<std::unique_ptr<TrafficGate>> Create(
@@ -138,6 +140,12 @@ class TrafficGate {
   // A state report: position and the last waypoint passed.
   void Report(const std::string& robot, const Eigen::Vector2d& xy, std::uint64_t last_waypoint,
               double t);
+  // The robot's entry (nullptr: unknown), for the overloads that skip the id lookup (a report
+  // per robot per tick). Valid for the gate's life: entries are never erased.
+  GateBot* Entry(const std::string& robot);
+  void Reached(GateBot& robot, std::uint64_t sequence, double t, const std::optional<Eigen::Vector2d>& xy);
+  void Report(GateBot& robot, const Eigen::Vector2d& xy, std::uint64_t last_waypoint, double t);
+  std::uint64_t ReleasedUpTo(const GateBot& robot) const;
   // Runs the controller for every agent and returns what to tell the robots.
   std::vector<GateEffect> Step(double t);
   // When the next Step may release a robot though no report came in: the earliest planned
