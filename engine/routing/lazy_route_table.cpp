@@ -94,6 +94,12 @@ double LazyRouteTable::Cost(PointId from, PointId to) const {
   return Lookup(to)->dist[static_cast<std::size_t>(from)];
 }
 
+const double* LazyRouteTable::CostsTo(PointId to) const {
+  // Without turn penalties the searched vertices are the points (dist[p] = Cost(p, to)).
+  if (graph_.expanded || !Known(to)) return nullptr;
+  return Lookup(to)->dist.data();
+}
+
 PointId LazyRouteTable::NextHop(PointId from, PointId to) const {
   if (!Known(from) || !Known(to) || from == to) return kNoPoint;
   const std::int32_t via = Lookup(to)->via[static_cast<std::size_t>(from)];

@@ -35,6 +35,7 @@ class LazyRouteTable final : public RouteTable {
   PointId NextHop(PointId from, PointId to) const override;
   Result<Route> Path(PointId from, PointId to) const override;
   void Prepare(PointId to) const override;
+  const double* CostsTo(PointId to) const override;
   std::string_view method() const override { return "lazy"; }
   RouteTableBuildInfo build_info() const override;
 

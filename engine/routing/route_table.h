@@ -57,6 +57,10 @@ class RouteTable {
   // Does now what later queries towards `to` need (a lazy table's reverse search), so that a
   // caller can pay it on another thread than the one that queries. Dense tables: nothing.
   virtual void Prepare(PointId /*to*/) const {}
+  // Cost(p, to) for every point p, by point id, when the table holds them side by side (a lazy
+  // table without turn penalties); nullptr otherwise (ask Cost). Valid until this thread's next
+  // query of the table towards another destination.
+  virtual const double* CostsTo(PointId /*to*/) const { return nullptr; }
 };
 
 enum class RouteTableMethod {

@@ -66,13 +66,15 @@ double TrafficController::Impl::CheapestCost(const traffic_detail::RouteQuery& q
   }
   std::vector<OpenItem>& heap = open;  // here h holds the entry's cost so far
   heap.clear();
+  const double* costs = bound_routes->CostsTo(to);  // read in place when the table allows
+  auto lower = [&](PointId v) { return costs ? costs[static_cast<std::size_t>(v)] : bound_routes->Cost(v, to); };
   // Ties to the entry furthest along (on a grid many routes cost the same: without this the
   // search would sweep all of them).
   auto later = [](const OpenItem& a, const OpenItem& b) { return a.key != b.key ? a.key > b.key : a.h < b.h; };
   auto relax = [&](PointId v, double d) {
     const auto i = static_cast<std::size_t>(v);
     if (seen[i] == stamp && dist[i] <= d) return;
-    const double key = d + bound_scale * bound_routes->Cost(v, to);
+    const double key = d + bound_scale * lower(v);
     if (!(key <= limit)) return;  // also unreachable (+infinity)
     seen[i] = stamp;
     dist[i] = d;
@@ -128,7 +130,9 @@ Detour TrafficController::Impl::Search(const traffic_detail::RouteQuery& q) {
   };
   const Eigen::Vector2d goal = point_xy[static_cast<std::size_t>(to)];
   auto h = [&](PointId v) { return (point_xy[static_cast<std::size_t>(v)] - goal).norm() / config.speed; };
-  const RouteTable* lower = bound_routes.get();
+  const RouteTable* table = bound_routes.get();
+  const double* costs = table ? table->CostsTo(to) : nullptr;  // read in place when the table allows
+  auto lower = [&](PointId v) { return costs ? costs[static_cast<std::size_t>(v)] : table->Cost(v, to); };
   if (++stamp == 0) {
     std::fill(seen.begin(), seen.end(), 0);
     stamp = 1;
@@ -136,7 +140,7 @@ Detour TrafficController::Impl::Search(const traffic_detail::RouteQuery& q) {
   auto relax = [&](PointId v, double d, ArcId a) {
     const auto i = static_cast<std::size_t>(v);
     if (seen[i] == stamp && dist[i] <= d) return;
-    if (lower && d + bound_scale * lower->Cost(v, to) > prune) return;
+    if (table && d + bound_scale * lower(v) > prune) return;
     seen[i] = stamp;
     dist[i] = d;
     via[i] = a;

@@ -94,6 +94,28 @@ TEST(LazyRouteTableTest, CacheIsBoundedAndEvictsLeastRecentlyUsed) {
   EXPECT_EQ(tiny->cached_destinations(), 1u);
 }
 
+// CostsTo(to)[p] is Cost(p, to) for every point (read in place by the traffic controller's
+// bounded searches); tables without such an array say so with nullptr.
+TEST(LazyRouteTableTest, CostsToHoldsEveryPointsCost) {
+  const auto map = RandomMap(35, 8);
+  const auto lazy = LazyRouteTable::Build(map, {}).value();
+  const auto n = static_cast<PointId>(map->point_count());
+  for (PointId to : {PointId{0}, PointId{5}, static_cast<PointId>(n - 1)}) {
+    const double* costs = lazy->CostsTo(to);
+    ASSERT_NE(costs, nullptr);
+    for (PointId p = 0; p < n; ++p) {
+      const double c = lazy->Cost(p, to);
+      EXPECT_TRUE(costs[static_cast<std::size_t>(p)] == c || (std::isinf(c) && std::isinf(costs[p]))) << p << "->" << to;
+    }
+  }
+  EXPECT_EQ(lazy->CostsTo(-1), nullptr);
+  EXPECT_EQ(lazy->CostsTo(n), nullptr);
+  RouteTableOptions turns;
+  turns.turn_penalty_s = 2.0;
+  EXPECT_EQ(LazyRouteTable::Build(map, turns).value()->CostsTo(0), nullptr);
+  EXPECT_EQ(FloydRouteTable::Build(map, {}).value()->CostsTo(0), nullptr);
+}
+
 TEST(LazyRouteTableTest, PrepareRunsTheSearchAheadOfTheQueries) {
   const auto map = RandomMap(33, 8);
   const auto lazy = LazyRouteTable::Build(map, {}).value();

@@ -22,7 +22,7 @@ struct Floor {
   std::shared_ptr<const RouteTable> routes;
 };
 
-Floor SmallFloor(double turn_penalty = 0.0) {
+Floor SmallFloor(double turn_penalty = 0.0, RouteTableMethod method = RouteTableMethod::kFloyd) {
   GridFloorOptions o;
   o.shelf_rows = 4;
   o.shelf_cols = 4;
@@ -32,6 +32,7 @@ Floor SmallFloor(double turn_penalty = 0.0) {
   f.map = std::make_shared<const WarehouseMap>(std::move(m).value());
   RouteTableOptions ro;
   ro.turn_penalty_s = turn_penalty;
+  ro.method = method;
   auto t = MakeRouteTable(f.map, ro);
   if (!t.ok()) throw std::runtime_error(t.error().message);
   f.routes = std::move(t).value();
@@ -102,14 +103,19 @@ std::size_t DriveSideBySide(const Floor& f, unsigned seed) {
   return bounded.stats().replans;
 }
 
+// A dense table (Cost per query) and a lazy one (costs read in place, RouteTable::CostsTo).
 TEST(TrafficControllerRouteBoundTest, BoundedSearchesTakeTheSameDecisions) {
-  const Floor f = SmallFloor();
-  std::size_t replans = 0;
-  for (unsigned seed : {1u, 2u, 3u}) {
-    SCOPED_TRACE(seed);
-    replans += DriveSideBySide(f, seed);
+  for (RouteTableMethod method : {RouteTableMethod::kFloyd, RouteTableMethod::kLazy}) {
+    SCOPED_TRACE(method == RouteTableMethod::kLazy ? "lazy" : "floyd");
+    const Floor f = SmallFloor(0.0, method);
+    ASSERT_EQ(f.routes->CostsTo(0) != nullptr, method == RouteTableMethod::kLazy);
+    std::size_t replans = 0;
+    for (unsigned seed : {1u, 2u, 3u}) {
+      SCOPED_TRACE(seed);
+      replans += DriveSideBySide(f, seed);
+    }
+    EXPECT_GT(replans, 20u) << "too few detours to exercise the bound";
   }
-  EXPECT_GT(replans, 20u) << "too few detours to exercise the bound";
 }
 
 // A table with turn penalties costs more than the controller's arc times: it is no lower
