@@ -448,8 +448,9 @@ void GateImpl::SampleDistances(double t) {
     const Eigen::Vector2d rel = xy - distance_origin;
     const long long cx = std::clamp(static_cast<long long>(rel.x()), 0LL, cols - 1);
     const long long cy = std::clamp(static_cast<long long>(rel.y()), 0LL, rows - 1);
-    const Eigen::Vector2d in_cell = xy == b.xy ? Eigen::Vector2d(rel.x() - static_cast<double>(cx), rel.y() - static_cast<double>(cy))
-                                               : Eigen::Vector2d::Constant(std::numeric_limits<double>::quiet_NaN());
+    const Eigen::Vector2d in_cell =
+        xy == b.xy ? Eigen::Vector2d(rel.x() - static_cast<double>(cx), rel.y() - static_cast<double>(cy))
+                   : Eigen::Vector2d::Constant(std::numeric_limits<double>::quiet_NaN());
     items.push_back({b.xy, cx, cy, &b, in_cell});
   }
   if (++distance_stamp == 0) {

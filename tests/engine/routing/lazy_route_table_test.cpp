@@ -105,7 +105,8 @@ TEST(LazyRouteTableTest, CostsToHoldsEveryPointsCost) {
     ASSERT_NE(costs, nullptr);
     for (PointId p = 0; p < n; ++p) {
       const double c = lazy->Cost(p, to);
-      EXPECT_TRUE(costs[static_cast<std::size_t>(p)] == c || (std::isinf(c) && std::isinf(costs[p]))) << p << "->" << to;
+      const double in_place = costs[static_cast<std::size_t>(p)];
+      EXPECT_TRUE(in_place == c || (std::isinf(c) && std::isinf(in_place))) << p << "->" << to;
     }
   }
   EXPECT_EQ(lazy->CostsTo(-1), nullptr);
