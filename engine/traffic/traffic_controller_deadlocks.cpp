@@ -92,11 +92,7 @@ double TrafficController::Impl::CheapestCost(const traffic_detail::RouteQuery& q
     if (u == to) return dist[ui];
     for (std::uint32_t k = search_begin[ui]; k < search_begin[ui + 1]; ++k) {
       const SearchArc& a = search_arcs[k];
-      const PointId v = a.to;
-      if (v == ban_point) continue;
-      if (ban_corridor >= 0 && a.corridor == ban_corridor) continue;
-      if (ban_guard >= 0 && guard_of[static_cast<std::size_t>(v)] == ban_guard && v != to) continue;
-      relax(v, item.h + a.time);
+      if (Allowed(a, q)) relax(a.to, item.h + a.time);
     }
   }
   return inf;
@@ -166,11 +162,7 @@ Detour TrafficController::Impl::Search(const traffic_detail::RouteQuery& q) {
     const auto ui = static_cast<std::size_t>(u);
     for (std::uint32_t k = search_begin[ui]; k < search_begin[ui + 1]; ++k) {
       const SearchArc& a = search_arcs[k];
-      const PointId v = a.to;
-      if (v == ban_point) continue;
-      if (ban_corridor >= 0 && a.corridor == ban_corridor) continue;
-      if (ban_guard >= 0 && guard_of[static_cast<std::size_t>(v)] == ban_guard && v != to) continue;
-      relax(v, d + a.time, a.arc);
+      if (Allowed(a, q)) relax(a.to, d + a.time, a.arc);
     }
   }
   const auto ti = static_cast<std::size_t>(to);

@@ -226,6 +226,12 @@ struct TrafficController::Impl {
                double bound = kInf);
   Detour Search(const traffic_detail::RouteQuery& q);  // Route without the memo
   double CheapestCost(const traffic_detail::RouteQuery& q);  // Search's route cost, by bound_routes
+  // Whether a search under q's bans may take arc a (its point, corridor and intersection).
+  bool Allowed(const SearchArc& a, const traffic_detail::RouteQuery& q) const {
+    if (a.to == q.ban_point) return false;
+    if (q.ban_corridor >= 0 && a.corridor == q.ban_corridor) return false;
+    return !(q.ban_guard >= 0 && guard_of[static_cast<std::size_t>(a.to)] == q.ban_guard && a.to != q.to);
+  }
   bool StartAllowed(std::size_t r, const std::vector<PointId>& points) const;
   bool TryDetour(std::size_t r, PointId ban_point, int ban_corridor, int ban_guard,
                  bool need_free_first_hop);
