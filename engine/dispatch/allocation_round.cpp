@@ -138,11 +138,12 @@ bool RoundRunner::ReplayQueue(FleetState& fleet, std::size_t index, const RoundR
     // the queue's end: no routing (on a large floor every random pick is a new destination
     // of the lazy route table, and re-routing every queue each round thrashed its cache).
     const std::size_t begin = starts[k], end = starts[k + 1];
+    const std::size_t stop = std::min(end, stored.size());
     std::vector<Waypoint> segment;
-    segment.reserve(std::min(end, stored.size()) - std::min(begin, std::min(end, stored.size())) + 1);
+    segment.reserve(stop - std::min(begin, stop) + 1);
     const PointId from = fleet.summary(index).end_point;
     segment.push_back({0, from, map_->point(from).position, 0.0, WaypointAction::kMove, 0.0});
-    for (std::size_t w = begin; w < end && w < stored.size(); ++w) {
+    for (std::size_t w = begin; w < stop; ++w) {
       Waypoint wp = stored[w];
       if (k == 0 && static_cast<std::uint64_t>(wp.seq) <= r.last_reached) continue;
       if (segment.size() == 1) {

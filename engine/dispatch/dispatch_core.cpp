@@ -50,7 +50,7 @@ BookRobot* DispatchCore::FindRobot(const std::string& id) {
 
 BookRobot& DispatchCore::Book(const std::string& id) {
   if (BookRobot* r = FindRobot(id)) return *r;
-  auto [it, inserted] = robots_.try_emplace(id);
+  const auto it = robots_.try_emplace(id).first;
   BookRobot& r = it->second;
   robot_index_.emplace(id, &r);
   const auto at = std::upper_bound(bidding_order_.begin(), bidding_order_.end(), id,

@@ -1,5 +1,6 @@
 // TrafficGate's state, shared by traffic_gate.cpp (plans, effects, interface),
-// traffic_gate_solo.cpp (solo agents), traffic_gate_teams.cpp (formations),
+// traffic_gate_solo.cpp (solo agents), traffic_gate_distances.cpp
+// (the minimum distance), traffic_gate_teams.cpp (formations),
 // traffic_gate_breakup.cpp (a formation breaking up before its drop),
 // traffic_gate_leaving.cpp (a formation leaving its drop) and traffic_gate_rejoin.cpp
 // (formations formed again after a restart). Internal to the gate; see
@@ -201,7 +202,9 @@ struct GateImpl {
   void OnReached(GateBot& b, std::uint64_t seq, double t);
   GateTeamKeys TeamKeys(const GateBot& b) const;
   // b's controller groups (and b.approach) from its team keys.
-  void SetGroups(GateBot& b, const GateTeamKeys& keys);
+  void SetGroups(GateBot& b);
+  // No team keys: in no team, left none that is still near, no formation order in its plan.
+  static bool Alone(const GateBot& b) { return b.team.empty() && b.former_team.empty() && b.plan.teams.empty(); }
   void SampleDistances(double t);
 
   // Teams (traffic_gate_teams.cpp).

@@ -1,5 +1,5 @@
 // TrafficGate's solo agents: placing robots on the floor, their legs (requests, adopted and
-// rewritten routes), reaching waypoints, and the minimum distance between agents. Formations
+// rewritten routes), reaching waypoints, and their team keys. Formations
 // are in traffic_gate_teams.cpp, the public interface in traffic_gate.cpp, the shared state in
 // traffic_gate_impl.h.
 #include <algorithm>
@@ -52,7 +52,7 @@ bool GateImpl::PlaceNear(GateBot& b) {
   if (current && b.idx >= 0 && b.idx < n) candidates.push_back(b.plan.waypoints[static_cast<std::size_t>(b.idx)].point);
   if (current && b.idx + 1 < n) candidates.push_back(b.plan.waypoints[static_cast<std::size_t>(b.idx + 1)].point);
   if (b.has_xy) candidates.push_back(map->NearestPoint(b.xy));
-  if (b.ctl >= 0) SetGroups(b, TeamKeys(b));  // teammates (a formation it is in or just left) do not keep it off
+  if (b.ctl >= 0) SetGroups(b);  // teammates (a formation it is in or just left) do not keep it off
   for (PointId p : candidates) {
     if (!PlaceBot(b, p)) continue;
     if (!b.former_team.empty() && !teams.count(b.former_team)) {
@@ -170,12 +170,7 @@ void GateImpl::StepSolo(GateBot& b, double t, std::vector<GateEffect>& out) {
   const auto& w = b.plan.waypoints;
   const long n = static_cast<long>(w.size());
   // On its way to a rendezvous, or leaving one, a member may come closer to its teammates.
-  if (b.team.empty() && b.former_team.empty() && b.plan.teams.empty()) {
-    b.approach.clear();  // a robot alone: TeamKeys(b) would be empty (no strings built per step)
-    ctl.SetGroup(r, 0, 0, 0);
-  } else {
-    SetGroups(b, TeamKeys(b));
-  }
+  SetGroups(b);
   const PointId next = ctl.Next(r);
   if (next != kNoPoint) {  // driving: the point behind is released once clear of it
     // Clear of it by eps2 (Chu2024 eq. (11)): a formation may be given the point behind.
@@ -387,7 +382,7 @@ void GateImpl::OnReached(GateBot& b, std::uint64_t seq, double t) {
 // and the teams it left (at a drop, or broken up) until it (and its teammates) have driven off.
 GateTeamKeys GateImpl::TeamKeys(const GateBot& b) const {
   GateTeamKeys keys;
-  if (b.team.empty() && b.former_team.empty() && b.plan.teams.empty()) return keys;  // a robot alone
+  if (Alone(b)) return keys;
   const std::string* current = &b.team;
   if (current->empty()) {
     // The waypoint it drives to; before the first one is reached, the first after the anchor
@@ -410,100 +405,17 @@ GateTeamKeys GateImpl::TeamKeys(const GateBot& b) const {
   return keys;
 }
 
-void GateImpl::SetGroups(GateBot& b, const GateTeamKeys& keys) {
+void GateImpl::SetGroups(GateBot& b) {
+  const auto r = static_cast<std::size_t>(b.ctl);
+  if (Alone(b)) {  // no team keys: no strings built (every robot, every step)
+    b.approach.clear();
+    ctl.SetGroup(r, 0, 0, 0);
+    return;
+  }
+  const GateTeamKeys keys = TeamKeys(b);
   b.approach = keys[0];
   auto group = [](const std::string& k) { return k.empty() ? 0 : GroupOf(k); };
-  ctl.SetGroup(static_cast<std::size_t>(b.ctl), group(keys[0]), group(keys[1]), group(keys[2]));
-}
-
-void GateImpl::SampleDistances(double t) {
-  // Robots in 1 m cells of a grid over the floor (linked lists through `distance_next`, no
-  // allocation per sample); every pair in neighbouring cells is measured once, the earlier
-  // robot in id order first. Team keys only for pairs closer than the minimum so far (rare
-  // once it is near eps1).
-  using Item = DistanceItem;
-  if (distance_cols == 0) {  // the grid, once: the floor's bounds and a cell's margin
-    Eigen::Vector2d lo = Eigen::Vector2d::Constant(std::numeric_limits<double>::infinity());
-    Eigen::Vector2d hi = -lo;
-    for (const auto& p : map->points()) {
-      lo = lo.cwiseMin(p.position);
-      hi = hi.cwiseMax(p.position);
-    }
-    if (!std::isfinite(lo.x())) lo = hi = Eigen::Vector2d::Zero();
-    distance_origin = lo - Eigen::Vector2d::Constant(2.0);
-    distance_cols = static_cast<std::size_t>(std::ceil(hi.x() - distance_origin.x())) + 3;
-    distance_rows = static_cast<std::size_t>(std::ceil(hi.y() - distance_origin.y())) + 3;
-    distance_head.assign(distance_cols * distance_rows, -1);
-  }
-  const auto cols = static_cast<long long>(distance_cols), rows = static_cast<long long>(distance_rows);
-  std::vector<Item>& items = distance_items;
-  items.clear();
-  for (GateBot* bot : in_order) {
-    GateBot& b = *bot;
-    if (!b.has_xy || !b.connected) continue;
-    // Off the grid (a pose the floor's margin does not cover): the nearest border cell.
-    const Eigen::Vector2d xy = b.xy.cwiseMax(distance_origin).cwiseMin(
-        distance_origin + Eigen::Vector2d(static_cast<double>(distance_cols) - 1e-6, static_cast<double>(distance_rows) - 1e-6));
-    // xy - origin >= 0 here: truncation is the floor.
-    const Eigen::Vector2d rel = xy - distance_origin;
-    const long long cx = std::clamp(static_cast<long long>(rel.x()), 0LL, cols - 1);
-    const long long cy = std::clamp(static_cast<long long>(rel.y()), 0LL, rows - 1);
-    const Eigen::Vector2d in_cell =
-        xy == b.xy ? Eigen::Vector2d(rel.x() - static_cast<double>(cx), rel.y() - static_cast<double>(cy))
-                   : Eigen::Vector2d::Constant(std::numeric_limits<double>::quiet_NaN());
-    items.push_back({b.xy, cx, cy, &b, in_cell});
-  }
-  if (++distance_stamp == 0) {
-    std::fill(distance_keys_stamp.begin(), distance_keys_stamp.end(), 0);
-    distance_stamp = 1;
-  }
-  if (distance_keys.size() < items.size()) {
-    distance_keys.resize(items.size());
-    distance_keys_stamp.resize(items.size(), 0);
-  }
-  auto keys_of = [this](std::size_t k) -> const GateTeamKeys& {
-    if (distance_keys_stamp[k] != distance_stamp) {
-      distance_keys[k] = TeamKeys(*distance_items[k].bot);
-      distance_keys_stamp[k] = distance_stamp;
-    }
-    return distance_keys[k];
-  };
-  auto same_agent = [&](std::size_t a, std::size_t b) {
-    const GateTeamKeys& kb = keys_of(b);
-    for (const std::string& x : keys_of(a)) {
-      if (!x.empty() && std::find(kb.begin(), kb.end(), x) != kb.end()) return true;
-    }
-    return false;
-  };
-  distance_next.assign(items.size(), -1);
-  for (std::size_t k = 0; k < items.size(); ++k) {
-    const Item& me = items[k];
-    // A neighbouring cell is skipped when me is further than the minimum so far from the
-    // side they share: every robot there is further than that too, and would be skipped
-    // below (a margin far above rounding; a robot off the grid scans all nine).
-    const double reach = min_distance.distance + 1e-9;
-    const Eigen::Vector2d& f = me.in_cell;
-    const bool all = !(f.x() == f.x());  // NaN: off the grid
-    const long long x0 = all || f.x() <= reach ? me.cx - 1 : me.cx;
-    const long long x1 = all || 1.0 - f.x() <= reach ? me.cx + 1 : me.cx;
-    const long long y0 = all || f.y() <= reach ? me.cy - 1 : me.cy;
-    const long long y1 = all || 1.0 - f.y() <= reach ? me.cy + 1 : me.cy;
-    for (long long x = std::max(x0, 0LL); x <= std::min(x1, cols - 1); ++x) {
-      for (long long y = std::max(y0, 0LL); y <= std::min(y1, rows - 1); ++y) {
-        for (int j = distance_head[static_cast<std::size_t>(y * cols + x)]; j >= 0;
-             j = distance_next[static_cast<std::size_t>(j)]) {
-          const auto jo = static_cast<std::size_t>(j);
-          const double d = (items[jo].xy - me.xy).norm();
-          if (d >= min_distance.distance || same_agent(jo, k)) continue;
-          min_distance = {d, items[jo].bot->id, me.bot->id, t};
-        }
-      }
-    }
-    const auto c = static_cast<std::size_t>(me.cy * cols + me.cx);
-    distance_next[k] = distance_head[c];  // the earlier robots only: each pair once
-    distance_head[c] = static_cast<int>(k);
-  }
-  for (const Item& me : items) distance_head[static_cast<std::size_t>(me.cy * cols + me.cx)] = -1;
+  ctl.SetGroup(r, group(keys[0]), group(keys[1]), group(keys[2]));
 }
 
 }  // namespace dispatch::engine
