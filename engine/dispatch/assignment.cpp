@@ -45,6 +45,30 @@ std::string OrderOfWaypoint(const Assignment& a, std::size_t index) {
   return drops < a.order_ids.size() ? a.order_ids[drops] : std::string();
 }
 
+std::string OrderOfWaypoint(const Assignment& a, std::size_t index, OrderCursor& cursor) {
+  const auto& w = a.plan.waypoints;
+  std::string order;
+  const std::size_t from =
+      cursor.seq >= 0 && !cursor.order.empty() ? FindWaypoint(a, static_cast<std::uint64_t>(cursor.seq)) : 0;
+  const auto ids = a.order_ids.begin(), end = a.order_ids.end();
+  const auto at = from >= 1 && from <= index && index < w.size() ? std::find(ids, end, cursor.order) : end;
+  if (at != end && std::find(at + 1, end, cursor.order) == end) {
+    // The cursor's waypoint serves *at: every drop from it up to `index` moves one order on.
+    auto k = static_cast<std::size_t>(at - ids);
+    for (std::size_t i = from; i < index; ++i) {
+      if (w[i].action == WaypointAction::kDrop) ++k;
+    }
+    if (k < a.order_ids.size()) order = a.order_ids[k];
+  } else {
+    order = OrderOfWaypoint(a, index);
+  }
+  if (index < w.size() && !order.empty()) {
+    cursor.seq = w[index].seq;
+    cursor.order = order;
+  }
+  return order;
+}
+
 std::uint64_t NextSequence(const Assignment& a) {
   return static_cast<std::uint64_t>(HighestNumbered(a) + 1);
 }

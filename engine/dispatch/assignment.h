@@ -37,8 +37,20 @@ std::size_t SegmentStart(const Assignment& a, std::size_t k);
 std::vector<std::size_t> SegmentStarts(const Assignment& a);
 // Per waypoint, the order it serves ("" for the anchor and for waypoints past the last drop).
 std::vector<std::string> OrdersOfWaypoints(const Assignment& a);
-// The order waypoint `index` serves (OrdersOfWaypoints for one waypoint).
+// The order waypoint `index` serves (OrdersOfWaypoints for one waypoint). O(index).
 std::string OrderOfWaypoint(const Assignment& a, std::size_t index);
+// A waypoint whose order is known: a waypoint's order never changes while it stays in the plan
+// (sequences are never reused; a plan only loses its first order's waypoints, is cut after a
+// segment or is rewritten after the waypoint the robot reached), so a robot's next arrivals
+// are found from it instead of from the plan's start.
+struct OrderCursor {
+  std::int64_t seq = -1;  // -1: none yet
+  std::string order;
+};
+// OrderOfWaypoint(a, index), counting the drops from the cursor's waypoint when it is still in
+// the plan before `index` and its order is in order_ids once; the cursor moves to `index`.
+// O(waypoints since the cursor) for arrivals in plan order.
+std::string OrderOfWaypoint(const Assignment& a, std::size_t index, OrderCursor& cursor);
 // The first sequence never issued to the robot: above released_up_to and every waypoint.
 std::uint64_t NextSequence(const Assignment& a);
 // The highest sequence ever numbered for the robot (-1: none): a robot cannot have passed a

@@ -115,7 +115,7 @@ ReportOutcome DispatchCore::Reached(const std::string& id, std::uint64_t seq, co
   }
   if (g) gate_->Reached(*g, seq, now, arrival.xy);
   if (w.action == WaypointAction::kPick) {
-    const std::string order_id = OrderOfWaypoint(r->assignment, i);
+    const std::string order_id = arrival.fresh ? arrival.order : OrderOfWaypoint(r->assignment, i);
     if (auto line = StartLine(order_id, id + " reached pick '" + map_->point(w.point).name + "'")) {
       out.change = Change{now, {std::move(*line)}, {}, {}, {}, 0};
     }

@@ -12,7 +12,7 @@ Arrival TakeArrival(RobotProgress& p, const Assignment& a, std::uint64_t seq, st
   const Waypoint& w = a.plan.waypoints[out.verdict.index];
   out.fresh = seq > p.last_reached;
   if (out.fresh) {
-    out.order = OrderOfWaypoint(a, out.verdict.index);
+    out.order = OrderOfWaypoint(a, out.verdict.index, p.order_cursor);
     if (p.last_xy) out.driven = (w.xy - *p.last_xy).norm();
     p.last_xy = w.xy;
     // A new arrival is fresher than the last state report (robots report at a few Hz).
@@ -25,8 +25,12 @@ Arrival TakeArrival(RobotProgress& p, const Assignment& a, std::uint64_t seq, st
 
 std::vector<TaskReport> TakeStateProgress(RobotProgress& p, const Assignment& a, std::uint64_t claimed,
                                           std::uint64_t* passed) {
-  const std::int64_t numbered = HighestNumbered(a);
-  *passed = numbered >= 0 && claimed <= static_cast<std::uint64_t>(numbered) ? claimed : 0;
+  // HighestNumbered(a) >= released_up_to: the plan's last waypoint is read only beyond it.
+  const bool sent = (a.released_up_to >= 0 && claimed <= static_cast<std::uint64_t>(a.released_up_to)) || [&] {
+    const std::int64_t numbered = HighestNumbered(a);
+    return numbered >= 0 && claimed <= static_cast<std::uint64_t>(numbered);
+  }();
+  *passed = sent ? claimed : 0;
   std::vector<TaskReport> retry;
   if (*passed > p.last_reached) retry.swap(p.waiting);
   p.last_reached = std::max(p.last_reached, *passed);

@@ -31,6 +31,7 @@ struct RobotProgress {
   std::uint64_t last_reached = 0;        // highest waypoint sequence reached
   std::optional<Eigen::Vector2d> last_xy;  // where it reached its last waypoint (distances)
   std::vector<TaskReport> waiting;       // reported before reached: tried again on progress
+  OrderCursor order_cursor;              // the order of its last arrival (TakeArrival)
 };
 
 // Picks and drops that may wait for a robot's progress (the oldest is dropped beyond it).

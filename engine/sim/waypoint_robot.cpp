@@ -14,7 +14,7 @@ bool IsTask(const Waypoint& w) { return w.action == WaypointAction::kPick || w.a
 }  // namespace
 
 WaypointRobot::WaypointRobot(std::string id, const Eigen::Vector2d& xy, double speed, double turn_time)
-    : id_(std::move(id)), xy_(xy), speed_(speed), turn_time_(turn_time) {}
+    : xy_(xy), speed_(speed), turn_time_(turn_time), id_(std::move(id)) {}
 
 bool WaypointRobot::idle() const {
   return !dwelling_ && (stops_.empty() || (stops_.size() == 1 && stops_.front().arrived));

@@ -34,7 +34,7 @@ struct RobotEvent {
   std::string order_id;        // kPicked, kDropped
 };
 
-class WaypointRobot {
+class alignas(64) WaypointRobot {
  public:
   WaypointRobot(std::string id, const Eigen::Vector2d& xy, double speed, double turn_time = 0.0);
 
@@ -63,25 +63,27 @@ class WaypointRobot {
   void Finish(const Stop& s, std::vector<RobotEvent>& out) const;
   bool Released(const Stop& s) const { return static_cast<std::uint64_t>(s.wp.seq) <= released_up_to_; }
 
-  std::string id_;
+  // What every step reads first, together (one cache line for a robot that stands, dwells or
+  // waits for a release; 500 robots' steps do not fit in a core's cache).
+  double now_ = 0.0;
   Eigen::Vector2d xy_;
-  double heading_ = 0.0;
-  bool has_heading_ = false;  // it has moved (before, its heading is not known)
+  std::uint64_t released_up_to_ = 0;
+  std::uint64_t hold_at_ = 0;  // stop at this waypoint (0: at once)
+  double dwell_until_ = 0.0;
   double speed_;
+  bool started_ = false;
+  bool moving_ = false;
+  bool held_ = false;
+  bool dwelling_ = false;
+  bool has_heading_ = false;  // it has moved (before, its heading is not known)
+  double heading_ = 0.0;
   double turn_time_;            // s per 90 degrees
   int turning_to_ = -1;         // the waypoint (seq) it turned, or turns, towards
   double turn_end_ = 0.0;       // when that turn is done
-  double now_ = 0.0;
-  bool started_ = false;
-  bool moving_ = false;
   double driven_ = 0.0;
-  std::deque<Stop> stops_;  // the front is the one driven to (or stood on)
-  std::uint64_t released_up_to_ = 0;
   std::uint64_t last_reached_ = 0;
-  bool held_ = false;
-  std::uint64_t hold_at_ = 0;  // stop at this waypoint (0: at once)
-  bool dwelling_ = false;
-  double dwell_until_ = 0.0;
+  std::deque<Stop> stops_;  // the front is the one driven to (or stood on)
+  std::string id_;
   Stop dwell_stop_;
 };
 

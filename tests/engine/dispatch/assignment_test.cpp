@@ -115,5 +115,51 @@ TEST(Assignment, GatePlanCarriesOrdersTeamsAndTheNextSequence) {
   EXPECT_EQ(HighestNumbered(Assignment{}), -1);
 }
 
+// A robot's arrivals in plan order with the cursor, while its plan loses finished orders, is
+// cut, grows and is rewritten behind it (a gate's detour: new sequences after the reached
+// waypoint): the same order as the scan from the plan's start at every arrival.
+TEST(Assignment, OrderCursorAgreesWithTheScanWhileThePlanChanges) {
+  Assignment a = TwoOrders();
+  AppendOrder(a, "o3", {At(17, 30), At(18, 31, WaypointAction::kPick, 2), At(19, 35, WaypointAction::kDrop, 2)},
+              30.0, false, 3.0);
+  OrderCursor cursor;
+  int checked = 0;
+  auto arrive = [&](std::size_t index) {
+    ASSERT_LT(index, a.plan.waypoints.size());
+    const std::string scan = OrderOfWaypoint(a, index);
+    EXPECT_EQ(OrderOfWaypoint(a, index, cursor), scan) << "index " << index << " seq " << a.plan.waypoints[index].seq;
+    ++checked;
+  };
+  for (std::size_t i = 1; i <= 3; ++i) arrive(i);  // o1 up to its drop
+  ASSERT_TRUE(TrimDone(a, "o1"));                   // the drop is the new anchor
+  arrive(0);
+  arrive(1);
+  arrive(2);
+  // A detour after waypoint 2: the rest renumbered from the next sequence.
+  std::vector<Waypoint> rest(a.plan.waypoints.begin() + 3, a.plan.waypoints.end());
+  a.plan.waypoints.resize(3);
+  std::uint64_t next = NextSequence(a);
+  a.plan.waypoints.push_back(At(40, 20));
+  for (Waypoint w : rest) {
+    w.seq = static_cast<int>(next++);
+    a.plan.waypoints.push_back(w);
+  }
+  a.released_up_to = a.plan.waypoints.back().seq;
+  for (std::size_t i = 3; i < a.plan.waypoints.size(); ++i) arrive(i);
+  // Cut after o2, then a new order: the cursor's waypoint (o3's drop) is gone.
+  EXPECT_EQ(CutPlan(a, "o3"), std::vector<std::string>{});
+  AppendOrder(a, "o4", {At(50, 40), At(51, 41, WaypointAction::kPick, 2), At(52, 45, WaypointAction::kDrop, 2)},
+              40.0, false, 4.0);
+  for (std::size_t i = 1; i < a.plan.waypoints.size(); ++i) arrive(i);
+  // Arrivals out of order (a repeat before the cursor) and past the last drop.
+  arrive(1);
+  a.plan.waypoints.push_back(At(60, 60));
+  a.plan.waypoints.back().seq = static_cast<int>(NextSequence(a));
+  arrive(a.plan.waypoints.size() - 1);
+  arrive(2);
+  EXPECT_GE(checked, 20);
+  EXPECT_EQ(OrderOfWaypoint(a, a.plan.waypoints.size() - 2, cursor), "o4");  // the drop
+}
+
 }  // namespace
 }  // namespace dispatch::engine
