@@ -64,7 +64,8 @@ void WaypointRobot::Apply(const RobotMessage& m) {
       next.wp.action = WaypointAction::kMove;
       next.wp.dwell = 0.0;
       next.order_id.clear();
-      stops_.assign(1, next);
+      stops_.clear();
+      stops_.push_back(std::move(next));
       break;
     }
     case Kind::kWelcome: break;

@@ -19,7 +19,6 @@
 #include <Eigen/Core>
 
 #include <cstdint>
-#include <deque>
 #include <string>
 #include <vector>
 
@@ -63,26 +62,55 @@ class alignas(64) WaypointRobot {
   void Finish(const Stop& s, std::vector<RobotEvent>& out) const;
   bool Released(const Stop& s) const { return static_cast<std::uint64_t>(s.wp.seq) <= released_up_to_; }
 
-  // What every step reads first, together (one cache line for a robot that stands, dwells or
-  // waits for a release; 500 robots' steps do not fit in a core's cache).
+  // The stops ahead, the front first: a vector read from `head` (the stops driven past are
+  // dropped in batches), so a step reads its front without a deque's chunk bookkeeping.
+  struct StopQueue {
+    std::vector<Stop> items;
+    std::size_t head = 0;
+    bool empty() const { return head == items.size(); }
+    std::size_t size() const { return items.size() - head; }
+    Stop& front() { return items[head]; }
+    const Stop& front() const { return items[head]; }
+    const Stop& operator[](std::size_t i) const { return items[head + i]; }
+    const Stop& back() const { return items.back(); }
+    std::vector<Stop>::const_iterator begin() const { return items.begin() + static_cast<std::ptrdiff_t>(head); }
+    std::vector<Stop>::const_iterator end() const { return items.end(); }
+    void push_back(Stop s) { items.push_back(std::move(s)); }
+    void pop_back() { items.pop_back(); }  // not empty
+    void pop_front() {                     // not empty
+      if (++head == items.size()) {
+        clear();
+      } else if (head >= 32 && 2 * head >= items.size()) {
+        items.erase(items.begin(), items.begin() + static_cast<std::ptrdiff_t>(head));
+        head = 0;
+      }
+    }
+    void clear() {
+      items.clear();
+      head = 0;
+    }
+  };
+
+  // What every step reads first, together in the first cache line (the stops' vector in the
+  // second): 500 robots' steps do not fit in a core's cache.
   double now_ = 0.0;
-  Eigen::Vector2d xy_;
-  std::uint64_t released_up_to_ = 0;
-  std::uint64_t hold_at_ = 0;  // stop at this waypoint (0: at once)
-  double dwell_until_ = 0.0;
-  double speed_;
   bool started_ = false;
   bool moving_ = false;
   bool held_ = false;
   bool dwelling_ = false;
   bool has_heading_ = false;  // it has moved (before, its heading is not known)
+  Eigen::Vector2d xy_;
+  std::uint64_t released_up_to_ = 0;
+  std::uint64_t hold_at_ = 0;  // stop at this waypoint (0: at once)
+  double dwell_until_ = 0.0;
+  double speed_;
+  StopQueue stops_;  // the front is the one driven to (or stood on)
   double heading_ = 0.0;
   double turn_time_;            // s per 90 degrees
   int turning_to_ = -1;         // the waypoint (seq) it turned, or turns, towards
   double turn_end_ = 0.0;       // when that turn is done
   double driven_ = 0.0;
   std::uint64_t last_reached_ = 0;
-  std::deque<Stop> stops_;  // the front is the one driven to (or stood on)
   std::string id_;
   Stop dwell_stop_;
 };

@@ -114,6 +114,7 @@ Result<std::size_t> TrafficController::AddRobot(const std::string& id, PointId a
   x.id = id;
   x.at = at;
   x.route = {at};
+  s.Touch(x);
   x.group = std::max(0, group);
   s.robots.push_back(std::move(x));
   const int b = s.PointBlocker(at, r);
@@ -162,6 +163,7 @@ bool TrafficController::RemainingRouteIs(std::size_t r, const std::vector<PointI
   if (x.route.empty()) return route.empty();
   return std::equal(x.route.begin() + static_cast<std::ptrdiff_t>(x.pos), x.route.end(), route.begin(), route.end());
 }
+std::uint64_t TrafficController::RouteEpoch(std::size_t r) const { return impl_->robots.at(r).route_epoch; }
 bool TrafficController::HasRoute(std::size_t r) const {
   const RobotState& x = impl_->robots.at(r);
   return !x.removed && x.pos + 1 < x.route.size();
@@ -214,6 +216,7 @@ Status TrafficController::Place(std::size_t r, PointId at) {
   x.route = {at};
   x.arcs.clear();
   x.pos = 0;
+  s.Touch(x);
   x.working = x.loaded = false;
   x.idle = true;
   s.ClearWait(x);

@@ -132,6 +132,10 @@ class TrafficController {
   void CopyRemainingRoute(std::size_t r, std::vector<PointId>& out) const;
   // RemainingRoute(r) == route, without copying the route (the gate asks every step).
   bool RemainingRouteIs(std::size_t r, const std::vector<PointId>& route) const;
+  // A number that changes whenever the remaining route may have changed (a route set, a point
+  // reached, the robot removed or placed) and is never the same for two robots: a caller that
+  // saw RemainingRouteIs(r, route) at one epoch knows it still holds while the epoch does.
+  std::uint64_t RouteEpoch(std::size_t r) const;
   bool HasRoute(std::size_t r) const;  // some point is left to drive to
   PointId At(std::size_t r) const;     // the point it stands at / last left
   PointId Next(std::size_t r) const;   // the point it drives to, or kNoPoint while standing

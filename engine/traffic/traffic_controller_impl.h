@@ -35,6 +35,9 @@ struct RobotState {
   std::vector<PointId> route;  // route[pos] == at
   std::vector<ArcId> arcs;     // arcs[k]: route[k] -> route[k + 1]
   std::size_t pos = 0;
+  // Moves on whenever route or pos changes (Impl::Touch): never the same for two values, of
+  // this robot or any other (RouteEpoch).
+  std::uint64_t route_epoch = 0;
   bool working = false, loaded = false, removed = false;
   int group = 0, group2 = 0, group3 = 0;  // > 0: robots sharing a group (a formation) may come closer
   double envelope = 0.0;  // extra clearance (a formation's D_f), <= config.max_envelope
@@ -113,6 +116,8 @@ struct TrafficController::Impl {
   std::vector<CorridorState> cstate;
   std::vector<RobotState> robots;
   std::unordered_map<std::string, std::size_t> index;
+  std::uint64_t route_epochs = 0;  // the last RobotState::route_epoch handed out
+  void Touch(RobotState& x) { x.route_epoch = ++route_epochs; }
   TrafficStats stats;
   // The map as Search reads it, in flat arrays (built once in Create): per point its position
   // and intersection, its out-arcs (in out_arcs order) from search_begin[p] with their end,

@@ -167,6 +167,7 @@ Status TrafficController::Impl::Assign(std::size_t r, std::vector<PointId> point
   x.route = std::move(points);
   x.arcs = std::move(arcs);
   x.pos = 0;
+  Touch(x);
   x.head_on_decided = -1;
   if (x.guard >= 0 && M().IntersectionOf(x.at) != x.guard) ReleaseGuard(r);
   ReconcileCorridors(r);
@@ -348,6 +349,7 @@ void TrafficController::Impl::Arrived(std::size_t r) {
   x.at = x.next;
   x.next = kNoPoint;
   ++x.pos;
+  Touch(x);
   if (holder[static_cast<std::size_t>(prev)] == static_cast<int>(r)) {
     holder[static_cast<std::size_t>(prev)] = -1;
   }
@@ -369,6 +371,7 @@ void TrafficController::Impl::Remove(std::size_t r) {
   x.route.clear();
   x.arcs.clear();
   x.pos = 0;
+  Touch(x);
   x.next = kNoPoint;
   ClearWait(x);
 }

@@ -280,7 +280,7 @@ std::vector<GateEffect> TrafficGate::Step(double t) {
     GateBot& b = *bot;
     if (!b.team.empty() || !s.OnFloor(b) || !b.connected || b.leg_stale) continue;
     const auto r = static_cast<std::size_t>(b.ctl);
-    if (s.ctl.Next(r) == kNoPoint && !s.ctl.RemainingRouteIs(r, b.leg)) s.AdoptRoute(b, t, out);
+    if (s.ctl.Next(r) == kNoPoint && !s.LegIsRemainingRoute(b)) s.AdoptRoute(b, t, out);
   }
   s.StepTeamsAfterDeadlocks(t, out);
   return out;

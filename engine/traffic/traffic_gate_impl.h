@@ -70,6 +70,9 @@ struct GateBot {
   // The team it counted as one with (TeamKeys()[0]) when its controller groups were last set.
   std::string approach;
   std::vector<PointId> leg;  // the controller route as last set or adopted
+  // The controller's RouteEpoch when leg was last seen to be its remaining route (0: not
+  // known; every write to leg sets it): LegIsRemainingRoute.
+  std::uint64_t leg_epoch = 0;
   long leg_stop = -1;     // plan index of the leg's last waypoint (-1: none)
   bool leg_stale = true;  // recompute the leg before the next request
   // Per formation order of the plan, its segment (none: no pick of it left); kept by Reindex.
@@ -114,6 +117,22 @@ struct GateImpl {
   // bots in id order as a flat array: every step walks all of them (Step, SampleDistances)
   // without chasing the map's tree nodes.
   std::vector<GateBot*> in_order;
+  // ctl.RemainingRouteIs(agent, b.leg) for a solo robot on the floor, without reading either
+  // route while the controller's route epoch is the one it was seen equal at (every step asks).
+  bool LegIsRemainingRoute(GateBot& b) {
+    const auto r = static_cast<std::size_t>(b.ctl);
+    const std::uint64_t epoch = ctl.RouteEpoch(r);
+    if (b.leg_epoch == epoch) return true;
+    if (!ctl.RemainingRouteIs(r, b.leg)) return false;
+    b.leg_epoch = epoch;
+    return true;
+  }
+  // b.leg = the controller's remaining route (equal at this epoch).
+  void CopyLeg(GateBot& b) {
+    const auto r = static_cast<std::size_t>(b.ctl);
+    ctl.CopyRemainingRoute(r, b.leg);
+    b.leg_epoch = ctl.RouteEpoch(r);
+  }
   GateBot* Find(const std::string& id) {
     auto it = bot_index.find(id);
     return it == bot_index.end() ? nullptr : it->second;

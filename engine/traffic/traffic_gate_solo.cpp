@@ -223,15 +223,15 @@ void GateImpl::StepSolo(GateBot& b, double t, std::vector<GateEffect>& out) {
     if (aside) {
       b.stepped_aside = true;
       RewriteLeg(b, here, ctl.RemainingRoute(r), -1, t, out);  // a nudge: moves appended
-      ctl.CopyRemainingRoute(r, b.leg);
+      CopyLeg(b);
       b.leg_stop = -1;
       b.leg_stale = false;
     }
     if (!ctl.HasRoute(r)) return;
-    if (b.leg_stale || !ctl.RemainingRouteIs(r, b.leg)) {
+    if (b.leg_stale || !LegIsRemainingRoute(b)) {
       // The controller moves it (a nudge or back-off in deadlock breaking): the plan follows.
       RewriteLeg(b, here, ctl.RemainingRoute(r), -1, t, out);
-      ctl.CopyRemainingRoute(r, b.leg);
+      CopyLeg(b);
       b.leg_stop = -1;
       b.leg_stale = false;
     }
@@ -265,7 +265,7 @@ void GateImpl::StepSolo(GateBot& b, double t, std::vector<GateEffect>& out) {
       }
       b.leg_stop = stop;
     }
-    ctl.CopyRemainingRoute(r, b.leg);
+    CopyLeg(b);
     b.leg_stale = false;
     if (!ctl.HasRoute(r)) return;
   }
@@ -326,6 +326,7 @@ void GateImpl::AdoptRoute(GateBot& b, double t, std::vector<GateEffect>& out) {
     b.leg_stale = resume >= 0;  // after the detour, route back into the plan
   }
   b.leg = route;
+  b.leg_epoch = 0;
 }
 
 void GateImpl::OnReached(GateBot& b, std::uint64_t seq, double t) {
@@ -351,7 +352,7 @@ void GateImpl::OnReached(GateBot& b, std::uint64_t seq, double t) {
     }
     if (ctl.Next(r) != kNoPoint && p == ctl.Next(r)) {
       ctl.Arrived(r, t);
-      ctl.CopyRemainingRoute(r, b.leg);
+      CopyLeg(b);
       b.stepped_aside = false;  // idle where it arrived: may have to step aside again
       // Out of the formation's envelope around where it left the team: one agent of its own.
       const double envelope = config.point_clearance + FormationRadius();

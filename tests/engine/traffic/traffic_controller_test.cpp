@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <memory>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -102,6 +103,40 @@ TEST(TrafficControllerTest, PointsAreExclusive) {
   EXPECT_EQ(ctl.Request(b, 1.0), TrafficDecision::kGo);
   // A route that does not start where the robot stands is refused.
   EXPECT_FALSE(ctl.SetRoute(a, Route(*map, {"c3", "c4"})).ok());
+}
+
+// The route epoch moves on with every change of a remaining route (set, reached, removed,
+// placed) and not otherwise, and no two robots share one: the gate trusts an unchanged epoch
+// instead of comparing routes every step.
+TEST(TrafficControllerTest, RouteEpochChangesExactlyWithTheRemainingRoute) {
+  auto map = Grid({"....."});
+  TrafficController ctl = Make(map);
+  const std::size_t a = *ctl.AddRobot("A", P(*map, "c1"));
+  const std::size_t b = *ctl.AddRobot("B", P(*map, "c4"));
+  std::set<std::uint64_t> seen = {ctl.RouteEpoch(a), ctl.RouteEpoch(b)};
+  EXPECT_EQ(seen.size(), 2u);
+  auto moved_on = [&](std::size_t r) {
+    const bool fresh = seen.insert(ctl.RouteEpoch(r)).second;
+    return fresh;
+  };
+  ASSERT_TRUE(ctl.SetRoute(a, Route(*map, {"c1", "c2", "c3"})).ok());
+  EXPECT_TRUE(moved_on(a));
+  const std::uint64_t set = ctl.RouteEpoch(a);
+  EXPECT_EQ(ctl.Request(a, 0.0), TrafficDecision::kGo);  // driving: the remaining route is the same
+  ctl.LeftPoint(a);
+  EXPECT_EQ(ctl.RouteEpoch(a), set);
+  EXPECT_TRUE(ctl.RemainingRouteIs(a, Route(*map, {"c1", "c2", "c3"})));
+  ctl.Arrived(a, 1.0);
+  EXPECT_TRUE(moved_on(a));
+  EXPECT_TRUE(ctl.RemainingRouteIs(a, Route(*map, {"c2", "c3"})));
+  ctl.Remove(a);
+  EXPECT_TRUE(moved_on(a));
+  ASSERT_TRUE(ctl.Place(a, P(*map, "c0")).ok());
+  EXPECT_TRUE(moved_on(a));
+  const std::uint64_t b_epoch = ctl.RouteEpoch(b);
+  ASSERT_TRUE(ctl.SetRoute(a, Route(*map, {"c0", "c1"})).ok());
+  EXPECT_TRUE(moved_on(a));
+  EXPECT_EQ(ctl.RouteEpoch(b), b_epoch);  // another robot's changes leave it alone
 }
 
 TEST(TrafficControllerTest, HeadOnWithoutDetourWaitsAndIsLogged) {
