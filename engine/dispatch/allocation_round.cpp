@@ -67,14 +67,14 @@ RoundResult RoundRunner::Run(const RoundInput& input) {
   // The predictor sees each robot once: its replayed queue (not once per order, nor its
   // start first), or its start.
   for (std::size_t i = 0; i < input.robots.size(); ++i) {
-    if (!input.robots[i].assignment.order_ids.empty()) ReplayQueue(state, i, input.robots[i], out.notes);
+    if (input.robots[i].has_queue()) ReplayQueue(state, i, input.robots[i], out.notes);
     state.Publish(i);
   }
   RoundSegments segments;  // where each robot's new work begins (the time-window planner)
   segments.first_new.assign(input.robots.size(), static_cast<std::size_t>(-1));
   segments.in_formation.assign(input.robots.size(), false);
   std::vector<bool> queued(input.robots.size());  // has orders (before or from this round)
-  for (std::size_t i = 0; i < input.robots.size(); ++i) queued[i] = !input.robots[i].assignment.order_ids.empty();
+  for (std::size_t i = 0; i < input.robots.size(); ++i) queued[i] = input.robots[i].has_queue();
   for (const auto& pending : input.pending) {
     const Order& order = *pending;
     if (static_cast<std::size_t>(order.team_size()) > input.robots.size()) continue;
@@ -114,7 +114,7 @@ RoundResult RoundRunner::Run(const RoundInput& input) {
 
 bool RoundRunner::ReplayQueue(FleetState& fleet, std::size_t index, const RoundRobot& r,
                               std::vector<std::string>& notes) const {
-  const Assignment& plan = r.assignment;
+  const Assignment& plan = *r.assignment;
   const auto& stored = plan.plan.waypoints;
   const std::vector<std::size_t> starts = SegmentStarts(plan);
   for (std::size_t k = 0; k < plan.order_ids.size(); ++k) {

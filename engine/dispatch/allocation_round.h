@@ -35,7 +35,10 @@ bool AllocationOrderLess(const Order& a, const Order& b);
 struct RoundRobot {
   std::string id;
   PointId start = kNoPoint;  // where a new plan of it starts (standing or arriving there)
-  Assignment assignment;     // empty order_ids: no queue
+  // Its plan as the round starts (shared, never changed once made); null or no order_ids: no
+  // queue.
+  std::shared_ptr<const Assignment> assignment;
+  bool has_queue() const { return assignment && !assignment->order_ids.empty(); }
   std::uint64_t last_reached = 0;
   std::vector<std::shared_ptr<const Order>> queue;  // the orders of assignment.order_ids
 };

@@ -224,7 +224,8 @@ std::optional<RoundInput> DispatchCore::MakeRound(double now, RoundCommit& commi
     rr.id = id;
     rr.start = StartOf(r);
     if (r.has_assignment && !r.assignment.order_ids.empty()) {
-      rr.assignment = r.assignment;
+      if (!r.round_copy) r.round_copy = std::make_shared<const Assignment>(r.assignment);
+      rr.assignment = r.round_copy;
       for (const auto& order_id : r.assignment.order_ids) {
         const BookOrder* o = order(order_id);
         rr.queue.push_back(o ? o->order : nullptr);
@@ -331,6 +332,7 @@ std::vector<RobotCommand> DispatchCore::Apply(const Change& change) {
     BookRobot* r = FindRobot(id);
     if (!r) continue;
     r->assignment = plan;
+    r->round_copy.reset();
     r->has_assignment = true;
     r->robot.task_queue = plan.order_ids;
   }

@@ -78,6 +78,10 @@ struct BookRobot {
   bool connected = false;
   bool has_assignment = false;
   Assignment assignment;  // plan.waypoints[0] anchors; then one segment per order
+  // `assignment` as the last allocation round took it (MakeRound shares it with every round
+  // until the plan changes, instead of copying the plan each round); every write to
+  // `assignment` resets it.
+  mutable std::shared_ptr<const Assignment> round_copy;
   RobotProgress progress;
   double blocked_at = -1.0;  // >= 0: in fault since then because the controller blocked it
   GateBot* gate_entry = nullptr;  // its entry in the traffic gate, once it has one (GateEntry)

@@ -17,6 +17,7 @@ void DispatchCore::RestoreRobot(Robot robot, std::optional<Assignment> plan, boo
   r.connected = false;
   if (plan) {
     r.assignment = std::move(*plan);
+    r.round_copy.reset();
     r.has_assignment = true;
     r.robot.task_queue = r.assignment.order_ids;
   }
@@ -205,6 +206,7 @@ StepOutcome DispatchCore::Step(double now) {
         a.plan.waypoints = std::move(e.waypoints);
         if (!a.plan.waypoints.empty()) a.released_up_to = std::max<std::int64_t>(a.released_up_to, a.plan.waypoints.back().seq);
         a.updated_time = now;
+        r->round_copy.reset();
         r->has_assignment = true;
         ++counts_.replans;
         out.rewritten.push_back(a);

@@ -89,7 +89,7 @@ TEST(AllocationRound, QueuesAreReplayedFromStoredPlansAndNewWorkFollowsThem) {
   // Round 2, a few seconds later, with the robot past its first waypoints: o2 goes behind o1.
   RoundInput second;
   second.now = 5.0;
-  RoundRobot robot{"R1", book.plan.waypoints.at(2).point, book, 2, {o1}};
+  RoundRobot robot{"R1", book.plan.waypoints.at(2).point, std::make_shared<const Assignment>(book), 2, {o1}};
   second.robots = {robot};
   second.pending = {MakeOrder("o2", picks.at(40), drops.at(5), 4.0)};
   RoundResult r2 = runner.Run(second);
@@ -115,7 +115,7 @@ TEST(AllocationRound, AQueueThatCannotBeReplayedIsNamed) {
   book.robot_id = "R1";
   book.order_ids = {"gone"};
   RoundInput input;
-  input.robots = {{"R1", parks.at(0), book, 0, {nullptr}}};  // its order's view is missing
+  input.robots = {{"R1", parks.at(0), std::make_shared<const Assignment>(book), 0, {nullptr}}};  // its order's view is missing
   input.pending = {MakeOrder("o1", PointsOfKind(map, PointKind::kPick).at(0), PointsOfKind(map, PointKind::kDrop).at(0), 0.0)};
   const RoundResult r = runner.Run(input);
   ASSERT_EQ(r.notes.size(), 1u);
