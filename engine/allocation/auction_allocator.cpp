@@ -143,34 +143,76 @@ void AuctionAllocator::PriceLowest(const AllocationConfig& c, std::vector<Bid>& 
   }
 }
 
+void AuctionAllocator::IndexBoundRuns(const ZoneRun* runs, std::size_t count, BoundRuns& out) {
+  out.runs = runs;
+  out.count = count;
+  out.zones.clear();
+  for (std::size_t r = 0; r < count; ++r) {
+    if (runs[r].zone >= 0) out.zones.push_back(runs[r].zone);
+  }
+  std::sort(out.zones.begin(), out.zones.end());
+  out.zones.erase(std::unique(out.zones.begin(), out.zones.end()), out.zones.end());
+  out.slot.assign(count, 0);
+  for (std::size_t r = 0; r < count; ++r) {
+    if (runs[r].zone < 0) continue;
+    out.slot[r] = static_cast<std::size_t>(
+        std::lower_bound(out.zones.begin(), out.zones.end(), runs[r].zone) - out.zones.begin());
+  }
+}
+
 double AuctionAllocator::FlowBound(const FleetState& state, std::size_t robot, PointId first,
                                    RouteSampler& sampler,
                                    TrafficPredictor::DensityAccumulator& density,
-                                   const ZoneRun* runs, std::size_t run_count,
-                                   const double* times, double known_to_go) {
+                                   const BoundRuns& runs, const double* times, double known_to_go) {
   const QueueSummary& s = state.summary(robot);
   const TrafficPredictor& predictor = state.predictor();
   const double to_go = known_to_go >= 0.0 ? known_to_go : sampler.TimeToTarget(s.end_point, first);
   if (!std::isfinite(to_go)) return 0.0;  // priced in time order, found unreachable there
   density.Reset(state.prediction(robot));
   // The leg's first sample exactly: its start point when it leaves (AddLegSamples' first).
+  ZoneId start_zone = -1;
+  int start_n = 0;
   if (s.end_point != first) {
-    density.Add(predictor.ZoneAt(state.map().point(s.end_point).position), s.end_time);
+    start_zone = predictor.ZoneAt(state.map().point(s.end_point).position);
+    if (start_zone >= 0) start_n = density.Count(start_zone, s.end_time);
   }
   // The first sample of every zone run of the order's route and every kBoundStride-th after
   // it (8 m apart at h = 0.5 m: fewer samples made the bound cheaper than the few extra bids
   // it lets through cost; allocation_bench). The arrival is the leg's own up to rounding (far
-  // below the slack), so each sample's bucket is in the window.
+  // below the slack), so each sample's bucket is in the window (DensityAccumulator::Fewest).
+  // Eq. (6)'s peaks go into one slot per zone of the runs (IndexBoundRuns, once per order).
   constexpr std::size_t kBoundStride = 16;
+  constexpr int kUnsampled = std::numeric_limits<int>::min();
   const double arrival = s.end_time + to_go;
-  for (std::size_t r = 0; r < run_count; ++r) {
-    const ZoneRun& run = runs[r];
+  bound_peaks_.assign(runs.zones.size(), kUnsampled);
+  for (std::size_t r = 0; r < runs.count; ++r) {
+    const ZoneRun& run = runs.runs[r];
+    if (run.zone < 0) continue;
+    int& peak = bound_peaks_[runs.slot[r]];
     for (std::size_t k = 0; k < run.size; k += kBoundStride) {
       const double t = times[run.begin + k] + arrival;
-      density.AddAtMost(run.zone, t, 1e-6 * std::max(1.0, std::abs(t)));
+      peak = std::max(peak, density.Fewest(run.zone, t, 1e-6 * std::max(1.0, std::abs(t))));
     }
   }
-  return density.Flow();
+  // Eqs. (7)-(8) over these samples, summed in ascending zone id as DensityAccumulator::Flow
+  // sums a route's: the route's F is at least this sum, rounding included.
+  double flow = 0.0;
+  bool start_summed = start_zone < 0;
+  for (std::size_t k = 0; k < runs.zones.size(); ++k) {
+    const ZoneId z = runs.zones[k];
+    int peak = bound_peaks_[k];
+    if (!start_summed && start_zone <= z) {
+      start_summed = true;
+      if (start_zone == z) {
+        peak = std::max(peak, start_n);
+      } else {
+        flow += start_n / predictor.ZoneArea(start_zone);
+      }
+    }
+    if (peak != kUnsampled) flow += peak / predictor.ZoneArea(z);
+  }
+  if (!start_summed) flow += start_n / predictor.ZoneArea(start_zone);
+  return flow;
 }
 
 bool AuctionAllocator::CostsAreSampledTimes(const RouteTable& routes, double speed) {
@@ -250,6 +292,7 @@ std::vector<Bid> AuctionAllocator::ComputeBids(const FleetState& state, const Pl
     ++shared_runs_.back().size;
     shared_times_.push_back(r.t);
   }
+  IndexBoundRuns(shared_runs_.data(), shared_runs_.size(), bound_runs_);
   const double task_travel = state.TaskTravelTime(task);
   const double task_work = TaskWorkTime(task);
   const PointId first = task.picks.front();
@@ -281,8 +324,7 @@ std::vector<Bid> AuctionAllocator::ComputeBids(const FleetState& state, const Pl
   TrafficPredictor::DensityAccumulator density(predictor, TrafficPredictor::PlanHandle{});
   // The lower bound of F: the leg's first sample and some of the order's own route.
   auto bound = [&](std::size_t i) {
-    return FlowBound(state, i, first, sampler, density, shared_runs_.data(), shared_runs_.size(),
-                     shared_times_.data(), legs_[i]);
+    return FlowBound(state, i, first, sampler, density, bound_runs_, shared_times_.data(), legs_[i]);
   };
   PriceLowest(c, bids, keep, bound, [&](std::size_t i) {
     const QueueSummary& s = state.summary(i);
@@ -334,8 +376,9 @@ std::vector<Bid> AuctionAllocator::ComputeReachBids(const FleetState& state, Poi
   // The lower bound of F': the leg's first sample and the first pick on arrival.
   const ZoneRun pick_run{pick_zone, 0, 1};
   const double on_arrival = 0.0;
+  IndexBoundRuns(&pick_run, 1, bound_runs_);
   auto bound = [&](std::size_t i) {
-    return FlowBound(state, i, first_pick, sampler, density, &pick_run, 1, &on_arrival);
+    return FlowBound(state, i, first_pick, sampler, density, bound_runs_, &on_arrival);
   };
   PriceLowest(c, bids, keep, bound, [&](std::size_t i) {
     const QueueSummary& s = state.summary(i);

@@ -256,31 +256,20 @@ void TrafficPredictor::DensityAccumulator::AddRun(ZoneId zone, const double* tim
     }
     peak = std::max(peak, c);
   }
-  if (last_ >= peaks_.size() || peaks_[last_].first != zone) NewZone(zone, peak);
-  peaks_[last_].second = std::max(peaks_[last_].second, peak);
+  Record(zone, peak);
 }
 
-void TrafficPredictor::DensityAccumulator::AddAtMost(ZoneId zone, double t, double slack) {
-  if (zone < 0) return;
+int TrafficPredictor::DensityAccumulator::FewestFrom(const std::int32_t* row, ZoneId zone, std::size_t lo,
+                                                     double t_hi) const {
   const TrafficPredictor& p = *predictor_;
-  const std::int32_t* row = p.counts_.data() + static_cast<std::size_t>(zone) * p.bucket_stride_;
   const double* starts = p.bucket_starts_.data();  // bucket_count_ + 1 entries
-  int n = 0;  // an unstored bucket in the window (or a NaN time): no robot there
-  std::size_t lo = 0;
-  if (Locate(t - slack, &lo)) {
-    // hi = bucket(t + slack): from lo up (s_b is non-decreasing in b).
-    const double t_hi = t + slack;
-    std::size_t hi = lo;
-    while (hi < p.bucket_count_ && starts[hi + 1] <= t_hi) ++hi;
-    if (hi < p.bucket_count_) {
-      n = std::numeric_limits<int>::max();
-      for (std::size_t b = lo; b <= hi; ++b) {
-        n = std::min(n, row[b] - (OwnZone(b) == zone ? 1 : 0));
-      }
-    }
-  }
-  if (last_ >= peaks_.size() || peaks_[last_].first != zone) NewZone(zone, n);
-  peaks_[last_].second = std::max(peaks_[last_].second, n);
+  // hi = bucket(t_hi): from lo up (s_b is non-decreasing in b).
+  std::size_t hi = lo;
+  while (hi < p.bucket_count_ && starts[hi + 1] <= t_hi) ++hi;
+  if (hi >= p.bucket_count_) return 0;
+  int n = std::numeric_limits<int>::max();
+  for (std::size_t b = lo; b <= hi; ++b) n = std::min(n, row[b] - (OwnZone(b) == zone ? 1 : 0));
+  return n;
 }
 
 double TrafficPredictor::DensityAccumulator::Flow() {

@@ -111,6 +111,8 @@ class TrafficPredictor {
   // ZoneIndex::ArcZone.
   ZoneId ArcZone(ArcId arc) const { return index_->ArcZone(arc); }
   const std::shared_ptr<const ZoneIndex>& zone_index() const { return index_; }
+  // S_p of zone p (>= 0): the area Chu2024 eq. (7) divides by.
+  double ZoneArea(ZoneId zone) const { return index_->zones()[static_cast<std::size_t>(zone)].area; }
   // Robots predicted in `zone` at time t (see the bucket rule above), not counting
   // `exclude_robot` (may be empty). 0 for an unknown zone, a NaN time or a time past the
   // last stored bucket. O(1) (one hash lookup when `exclude_robot` is given).
@@ -193,17 +195,15 @@ class TrafficPredictor::DensityAccumulator {
   void Reset(PlanHandle own);
   // A sample in `zone` (skipped when < 0) at time t. Inline: every route sample comes here.
   void Add(ZoneId zone, double t) {
-    if (zone < 0) return;
-    int n = 0;  // N_p^k(i): other robots in a_p when robot i is at sample k
+    if (zone >= 0) Record(zone, Count(zone, t));
+  }
+  // What Add records for a sample in `zone` (>= 0) at time t, without recording it:
+  // N_p^k(i), the other robots in a_p when robot i is at sample k.
+  int Count(ZoneId zone, double t) {
     std::size_t b = 0;
-    if (Locate(t, &b)) {
-      n = predictor_->counts_[static_cast<std::size_t>(zone) * predictor_->bucket_stride_ + b];
-      if (OwnZone(b) == zone) --n;
-    }
-    // Eq. (6): N_p,max(i) = max over the samples in zone p. A route visits few zones and
-    // consecutive samples mostly share one: a short list with a last-zone shortcut.
-    if (last_ >= peaks_.size() || peaks_[last_].first != zone) NewZone(zone, n);
-    peaks_[last_].second = std::max(peaks_[last_].second, n);
+    if (!Locate(t, &b)) return 0;
+    const int n = predictor_->counts_[static_cast<std::size_t>(zone) * predictor_->bucket_stride_ + b];
+    return OwnZone(b) == zone ? n - 1 : n;
   }
   void Add(const Eigen::Vector2d& xy, double t) { Add(predictor_->ZoneAt(xy), t); }
   // n samples in `zone` (none when < 0) at times times[k] + shift: the same as
@@ -213,7 +213,22 @@ class TrafficPredictor::DensityAccumulator {
   // counts the fewest other robots of the buckets [bucket(t - slack), bucket(t + slack)] (0 for
   // unstored ones), so the peaks stay at or below those of the exact time. For lower bounds
   // of F; O(buckets in the window).
-  void AddAtMost(ZoneId zone, double t, double slack);
+  void AddAtMost(ZoneId zone, double t, double slack) {
+    if (zone >= 0) Record(zone, Fewest(zone, t, slack));
+  }
+  // What AddAtMost records for a sample in `zone` (>= 0), without recording it: the fewest
+  // other robots over the window's buckets. O(buckets in the window); no cursor walk (for
+  // samples far apart). Inline: a window mostly holds one bucket.
+  int Fewest(ZoneId zone, double t, double slack) const {
+    const TrafficPredictor& p = *predictor_;
+    std::size_t lo = 0;
+    // An unstored bucket in the window (or a NaN time): no robot there.
+    if (!p.StoredBucketOf(t - slack, &lo)) return 0;
+    const std::int32_t* row = p.counts_.data() + static_cast<std::size_t>(zone) * p.bucket_stride_;
+    // lo < bucket_count_: bucket_starts_ holds s_(lo + 1).
+    if (p.bucket_starts_[lo + 1] > t + slack) return row[lo] - (OwnZone(lo) == zone ? 1 : 0);
+    return FewestFrom(row, zone, lo, t + slack);
+  }
   // Eqs. (6)-(8) over the samples added so far; peaks sorted by zone id.
   DensityTerm Finish() const;
   // Finish().flow without building the term (summed in the same zone order, so a route's F
@@ -245,8 +260,16 @@ class TrafficPredictor::DensityAccumulator {
     return b >= own_first_ ? own_zones_[b - own_first_] : -1;
   }
 
+  // Eq. (6): N_p,max(i) = max over the samples in zone p. A route visits few zones and
+  // consecutive samples mostly share one: a short list with a last-zone shortcut.
+  void Record(ZoneId zone, int n) {
+    if (last_ >= peaks_.size() || peaks_[last_].first != zone) NewZone(zone, n);
+    peaks_[last_].second = std::max(peaks_[last_].second, n);
+  }
   // Points last_ at zone's entry, appending (zone, n) if the zone is new.
   void NewZone(ZoneId zone, int n);
+  // Fewest over the buckets [lo, bucket(t_hi)] of `row` (zone's counts), 0 if one is unstored.
+  int FewestFrom(const std::int32_t* row, ZoneId zone, std::size_t lo, double t_hi) const;
   // StoredBucketOf(t), walking from the last sample's bucket when t is at most kWalk buckets
   // past it (a route's samples come in time order, one to a few buckets apart). bucket(t) is
   // the largest b with s_b <= t and s_b is non-decreasing in b, so s_c <= t < s_(c+1) pins
