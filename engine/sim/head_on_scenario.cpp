@@ -4,14 +4,15 @@
 
 #include "engine/map/map_builder.h"
 #include "engine/routing/route_table.h"
+#include "engine/sim/core_stream.h"
 
 namespace dispatch::engine {
 namespace {
 
 Result<WarehouseMap> HeadOnFloor() {
   MapBuilder b("wang2019-head-on");
-  b.SetFloor({0, -1}, {18, 11});
-  b.AddRectZone("z", {0, -1}, {18, 11});
+  b.SetFloor({0, -1}, {18, 12});
+  b.AddRectZone("z", {0, -1}, {18, 12});
   b.AddPoint("S1", {14, 0}, PointKind::kPark);
   b.AddPoint("B", {14, 2}, PointKind::kLane);
   for (int y = 3; y <= 7; ++y) {
@@ -19,6 +20,7 @@ Result<WarehouseMap> HeadOnFloor() {
   }
   b.AddPoint("T", {14, 8}, PointKind::kLane);
   b.AddPoint("U", {14, 10}, PointKind::kPick);
+  b.AddPoint("P", {14, 11}, PointKind::kPark);
   b.AddPoint("V", {16, 8}, PointKind::kDrop);
   b.AddPoint("X", {16, 2}, PointKind::kDrop);
   b.AddPoint("D1", {7, 2}, PointKind::kLane);
@@ -34,6 +36,7 @@ Result<WarehouseMap> HeadOnFloor() {
   lane("c6", "c7");
   lane("c7", "T");
   lane("T", "U");
+  lane("U", "P");
   lane("T", "V");
   lane("B", "X");
   lane("B", "D1");
@@ -48,7 +51,7 @@ Result<HeadOnRun> RunOnce(std::shared_ptr<const WarehouseMap> map,
                           std::shared_ptr<const RouteTable> routes, double h1_work,
                           HeadOnPolicy policy) {
   const WarehouseMap& m = *map;
-  std::vector<FleetRobot> robots{{"h1", *m.FindPoint("S1"), 0.0}, {"h2", *m.FindPoint("U"), 0.0}};
+  std::vector<FleetRobot> robots{{"h1", *m.FindPoint("S1"), 0.0}, {"h2", *m.FindPoint("P"), 0.0}};
   Order o1;
   o1.id = "O1";
   o1.picks = {*m.FindPoint("c5")};
@@ -60,19 +63,20 @@ Result<HeadOnRun> RunOnce(std::shared_ptr<const WarehouseMap> map,
   o2.picks = {*m.FindPoint("U")};
   o2.drop = *m.FindPoint("X");
   o2.work_time = 1.0;
-  o2.release_time = 10.0;
-  o2.created_time = 10.0;
+  o2.release_time = 9.0;
+  o2.created_time = 9.0;
   StreamConfig config;
-  config.strategy = AllocationStrategy::kPreassigned;
-  config.preassigned = {{"O1", "h1"}, {"O2", "h2"}};
   config.traffic.head_on = policy;
   config.traffic.t_w1 = 1000.0;  // the policies alone decide
-  config.return_home = false;
-  config.idle_step_aside = false;  // h2 waits at U for its release
   config.max_time = 600.0;
-  auto r = SimulateOrderStream(map, routes, robots, {o1, o2}, config);
+  auto r = SimulateOnCore(map, routes, robots, {o1, o2}, config);
   if (!r.ok()) return r.error();
   if (!r->all_completed()) return InvalidArgument("head-on scenario: an order did not complete");
+  // The auction gives each order to the robot the scenario means (h1 is nearer c5 than h2 at
+  // 0 s; h2 waits at P, next to O2's pick, when O2 is released).
+  if (r->orders[0].robot != "h1" || r->orders[1].robot != "h2") {
+    return InvalidArgument("head-on scenario: O1, O2 went to " + r->orders[0].robot + ", " + r->orders[1].robot);
+  }
   HeadOnRun run;
   run.h1_time = r->orders[0].completion_time - r->orders[0].release_time;
   run.h2_time = r->orders[1].completion_time - r->orders[1].release_time;

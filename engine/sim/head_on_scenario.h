@@ -1,23 +1,25 @@
-// The head-on conflict of Wang2019 §4.3 (Table 6) on a small bidirectional-lane floor, run
-// with the "wait only", "re-plan" and "choose the faster" policies of the traffic controller.
+// The head-on conflict of Wang2019 §4.3 (Table 6) on a small bidirectional-lane floor, run on
+// the dispatch core (SimulateOnCore, the service's allocation rounds and traffic gate) with the
+// "wait only", "re-plan" and "choose the faster" policies of the traffic controller.
 //
 // Floor (metres; every path a bidirectional single lane):
-//   S1 (14,0) - B (14,2) - c3..c7 (14,3..7) - T (14,8) - U (14,10)
-//   T - V (16,8) [drop]    B - X (16,2) [drop]    c5 (14,5) is a pick point
+//   S1 (14,0) - B (14,2) - c3..c7 (14,3..7) - T (14,8) - U (14,10) - P (14,11)
+//   T - V (16,8) [drop]    B - X (16,2) [drop]    c5 (14,5) and U are pick points
 //   detour: B - D1 (7,2) 7 m, D1 - D2 (7,8) 6 m, D2 - T 7 m
 // h1 (higher priority: it works first in the corridor) starts at S1, picks at c5 for
-// `h1_work` seconds, drops at V. h2 starts at U, is released at 10 s, picks at U (1 s) and
-// drops at X: its direct route runs down the corridor against h1, its detour is 14 m (14 s)
-// longer - the paper's "re-planning costs 14 s more than no conflict". With h1_work = 30 s
-// the wait is ~29 s (the paper's h2 waited 30 s): re-planning is faster; with h1_work = 5 s
-// waiting is. T_w1 is lifted so that "wait only" really only waits.
+// `h1_work` seconds, drops at V. h2 waits at its park P, is released at 9 s, picks at U (1 s)
+// and drops at X: its direct route runs down the corridor against h1, its detour is 14 m
+// (14 s) longer - the paper's "re-planning costs 14 s more than no conflict". The auction
+// awards the orders so (h1 is the nearer to c5; h2 stands next to U). With h1_work = 30 s the
+// wait is ~24 s (the paper's h2 waited 30 s): re-planning is faster; with h1_work = 5 s
+// waiting is. T_w1 is lifted so that "wait only" really only waits. (h2 parks at P rather
+// than on the pick point U: an idle robot on a pick point is sent aside by the gate.)
 // Pure functions; thread-safe.
 #pragma once
 
 #include <string>
 
 #include "engine/common/result.h"
-#include "engine/sim/order_stream.h"
 
 namespace dispatch::engine {
 

@@ -1,6 +1,7 @@
 // Order-stream simulation under the online traffic controller: the strategy
-// comparison on the Chu2024 floor, release times, seed 004 §4.3 (wait vs. re-plan) and
-// seeded liveness on small dense grids where every lane is a bidirectional single lane.
+// comparison on the Chu2024 floor, release times and seeded liveness on small dense grids
+// where every lane is a bidirectional single lane. (The Wang2019 head-on scenario runs on the
+// dispatch core: head_on_scenario_test.cpp.)
 #include "engine/sim/order_stream.h"
 
 #include <gtest/gtest.h>
@@ -13,7 +14,6 @@
 #include <string>
 
 #include "engine/cli/scenario.h"
-#include "engine/sim/head_on_scenario.h"
 #include "tests/engine/sim/order_stream_test_support.h"
 
 namespace dispatch::engine::testing {
@@ -123,36 +123,6 @@ TEST(OrderStreamTest, RejectsBadConfigAndFormationsWithoutThreeRobots) {
   bad.time_step = 0;
   EXPECT_FALSE(SimulateOrderStream(w.map, w.routes, *robots, {}, bad).ok());
   EXPECT_FALSE(SimulateOrderStream(w.map, w.routes, {}, {}, {}).ok());
-}
-
-// Seed 004 §4.3 / Table 6: h2 meets h1 head-on in a single lane. The controller compares the
-// expected wait with the detour's extra time and picks the faster; both runs are printed.
-TEST(OrderStreamTest, Wang2019HeadOnWaitVersusReplan) {
-  for (double work : {30.0, 5.0}) {
-    auto c = RunHeadOnComparison(work);
-    ASSERT_TRUE(c.ok()) << c.error().message;
-    std::printf("h1 work %.0f s: wait only %.1f s, re-plan %.1f s, controller %.1f s (%s; "
-                "wait estimate %.1f s, detour +%.1f s)\n",
-                work, c->wait.h2_time, c->replan.h2_time, c->chosen.h2_time,
-                c->chosen.replanned ? "re-plan" : "wait", c->chosen.wait_estimate,
-                c->chosen.replan_extra);
-    EXPECT_FALSE(c->wait.replanned);
-    EXPECT_TRUE(c->replan.replanned);
-    EXPECT_NEAR(c->chosen.h2_time, std::min(c->wait.h2_time, c->replan.h2_time), 1e-6);
-    EXPECT_NEAR(c->replan.replan_extra, 14.0, 1e-6);  // the paper's 14 s detour
-    // h1 has priority: waiting h2 never delays it (S1 -> c5 5 m, work, c5 -> V 5 m, work);
-    // a detouring h2 may cross T just before it (at most that arc's time).
-    const double h1_free = 5.0 + work + 5.0 + work;
-    EXPECT_NEAR(c->wait.h1_time, h1_free, 1e-6);
-    EXPECT_NEAR(c->chosen.h1_time, c->chosen.replanned ? c->replan.h1_time : h1_free, 1e-6);
-    EXPECT_LE(c->replan.h1_time, h1_free + 2.0 + 1e-6);
-  }
-  auto slow = RunHeadOnComparison(30.0);
-  EXPECT_TRUE(slow->chosen.replanned);              // waiting ~29 s > 14 s detour
-  EXPECT_GT(slow->wait.h2_time - slow->replan.h2_time, 10.0);
-  auto fast = RunHeadOnComparison(5.0);
-  EXPECT_FALSE(fast->chosen.replanned);             // h1 clears the lane within seconds
-  EXPECT_LT(fast->wait.h2_time, fast->replan.h2_time);
 }
 
 // Liveness: seeded random streams on small dense grids (every lane a bidirectional single
