@@ -225,9 +225,16 @@ class TrafficPredictor::DensityAccumulator {
     // An unstored bucket in the window (or a NaN time): no robot there.
     if (!p.StoredBucketOf(t - slack, &lo)) return 0;
     const std::int32_t* row = p.counts_.data() + static_cast<std::size_t>(zone) * p.bucket_stride_;
-    // lo < bucket_count_: bucket_starts_ holds s_(lo + 1).
-    if (p.bucket_starts_[lo + 1] > t + slack) return row[lo] - (OwnZone(lo) == zone ? 1 : 0);
-    return FewestFrom(row, zone, lo, t + slack);
+    // lo < bucket_count_: bucket_starts_ holds s_(lo + 1). A window of one bucket, or of two
+    // (a sample time on a bucket start: route times on a 1 m grid at 1 m/s often are).
+    const double* starts = p.bucket_starts_.data();
+    const double t_hi = t + slack;
+    const int at_lo = row[lo] - (OwnZone(lo) == zone ? 1 : 0);
+    if (starts[lo + 1] > t_hi) return at_lo;
+    if (lo + 1 < p.bucket_count_ && starts[lo + 2] > t_hi) {
+      return std::min(at_lo, row[lo + 1] - (OwnZone(lo + 1) == zone ? 1 : 0));
+    }
+    return FewestFrom(row, zone, lo, t_hi);
   }
   // Eqs. (6)-(8) over the samples added so far; peaks sorted by zone id.
   DensityTerm Finish() const;
