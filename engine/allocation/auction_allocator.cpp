@@ -143,9 +143,7 @@ void AuctionAllocator::PriceLowest(const AllocationConfig& c, std::vector<Bid>& 
   }
 }
 
-void AuctionAllocator::IndexBoundRuns(const ZoneRun* runs, std::size_t count, BoundRuns& out) {
-  out.runs = runs;
-  out.count = count;
+void AuctionAllocator::IndexZones(const ZoneRun* runs, std::size_t count, RunZones& out) {
   out.zones.clear();
   for (std::size_t r = 0; r < count; ++r) {
     if (runs[r].zone >= 0) out.zones.push_back(runs[r].zone);
@@ -163,7 +161,8 @@ void AuctionAllocator::IndexBoundRuns(const ZoneRun* runs, std::size_t count, Bo
 double AuctionAllocator::FlowBound(const FleetState& state, std::size_t robot, PointId first,
                                    RouteSampler& sampler,
                                    TrafficPredictor::DensityAccumulator& density,
-                                   const BoundRuns& runs, const double* times, double known_to_go) {
+                                   const ZoneRun* runs, std::size_t run_count, const RunZones& zones,
+                                   const double* times, double known_to_go) {
   const QueueSummary& s = state.summary(robot);
   const TrafficPredictor& predictor = state.predictor();
   const double to_go = known_to_go >= 0.0 ? known_to_go : sampler.TimeToTarget(s.end_point, first);
@@ -180,15 +179,15 @@ double AuctionAllocator::FlowBound(const FleetState& state, std::size_t robot, P
   // it (8 m apart at h = 0.5 m: fewer samples made the bound cheaper than the few extra bids
   // it lets through cost; allocation_bench). The arrival is the leg's own up to rounding (far
   // below the slack), so each sample's bucket is in the window (DensityAccumulator::Fewest).
-  // Eq. (6)'s peaks go into one slot per zone of the runs (IndexBoundRuns, once per order).
+  // Eq. (6)'s peaks go into one slot per zone of the runs (IndexZones, once per order).
   constexpr std::size_t kBoundStride = 16;
   constexpr int kUnsampled = std::numeric_limits<int>::min();
   const double arrival = s.end_time + to_go;
-  bound_peaks_.assign(runs.zones.size(), kUnsampled);
-  for (std::size_t r = 0; r < runs.count; ++r) {
-    const ZoneRun& run = runs.runs[r];
+  bound_peaks_.assign(zones.zones.size(), kUnsampled);
+  for (std::size_t r = 0; r < run_count; ++r) {
+    const ZoneRun& run = runs[r];
     if (run.zone < 0) continue;
-    int& peak = bound_peaks_[runs.slot[r]];
+    int& peak = bound_peaks_[zones.slot[r]];
     for (std::size_t k = 0; k < run.size; k += kBoundStride) {
       const double t = times[run.begin + k] + arrival;
       peak = std::max(peak, density.Fewest(run.zone, t, 1e-6 * std::max(1.0, std::abs(t))));
@@ -198,8 +197,8 @@ double AuctionAllocator::FlowBound(const FleetState& state, std::size_t robot, P
   // sums a route's: the route's F is at least this sum, rounding included.
   double flow = 0.0;
   bool start_summed = start_zone < 0;
-  for (std::size_t k = 0; k < runs.zones.size(); ++k) {
-    const ZoneId z = runs.zones[k];
+  for (std::size_t k = 0; k < zones.zones.size(); ++k) {
+    const ZoneId z = zones.zones[k];
     int peak = bound_peaks_[k];
     if (!start_summed && start_zone <= z) {
       start_summed = true;
@@ -292,7 +291,7 @@ std::vector<Bid> AuctionAllocator::ComputeBids(const FleetState& state, const Pl
     ++shared_runs_.back().size;
     shared_times_.push_back(r.t);
   }
-  IndexBoundRuns(shared_runs_.data(), shared_runs_.size(), bound_runs_);
+  IndexZones(shared_runs_.data(), shared_runs_.size(), run_zones_);
   const double task_travel = state.TaskTravelTime(task);
   const double task_work = TaskWorkTime(task);
   const PointId first = task.picks.front();
@@ -324,7 +323,8 @@ std::vector<Bid> AuctionAllocator::ComputeBids(const FleetState& state, const Pl
   TrafficPredictor::DensityAccumulator density(predictor, TrafficPredictor::PlanHandle{});
   // The lower bound of F: the leg's first sample and some of the order's own route.
   auto bound = [&](std::size_t i) {
-    return FlowBound(state, i, first, sampler, density, bound_runs_, shared_times_.data(), legs_[i]);
+    return FlowBound(state, i, first, sampler, density, shared_runs_.data(), shared_runs_.size(), run_zones_,
+                     shared_times_.data(), legs_[i]);
   };
   PriceLowest(c, bids, keep, bound, [&](std::size_t i) {
     const QueueSummary& s = state.summary(i);
@@ -376,9 +376,9 @@ std::vector<Bid> AuctionAllocator::ComputeReachBids(const FleetState& state, Poi
   // The lower bound of F': the leg's first sample and the first pick on arrival.
   const ZoneRun pick_run{pick_zone, 0, 1};
   const double on_arrival = 0.0;
-  IndexBoundRuns(&pick_run, 1, bound_runs_);
+  IndexZones(&pick_run, 1, run_zones_);
   auto bound = [&](std::size_t i) {
-    return FlowBound(state, i, first_pick, sampler, density, bound_runs_, &on_arrival);
+    return FlowBound(state, i, first_pick, sampler, density, &pick_run, 1, run_zones_, &on_arrival);
   };
   PriceLowest(c, bids, keep, bound, [&](std::size_t i) {
     const QueueSummary& s = state.summary(i);

@@ -93,23 +93,22 @@ class AuctionAllocator final : public Allocator {
     std::size_t begin = 0;
     std::size_t size = 0;
   };
-  // The runs a flow bound samples with their distinct zones, ascending (the order eqs. (7)-(8)
+  // The zones of the runs a flow bound samples, distinct and ascending (the order eqs. (7)-(8)
   // are summed in), and each run's zone's place among them: the same for every bidder of an
-  // order, so indexed once per order (IndexBoundRuns). Points at the runs.
-  struct BoundRuns {
-    const ZoneRun* runs = nullptr;
-    std::size_t count = 0;
+  // order, so indexed once per order (IndexZones).
+  struct RunZones {
     std::vector<ZoneId> zones;      // the runs' zones >= 0, distinct, ascending
     std::vector<std::size_t> slot;  // per run: its zone's index in `zones` (zone < 0: unused)
   };
-  static void IndexBoundRuns(const ZoneRun* runs, std::size_t count, BoundRuns& out);
+  static void IndexZones(const ZoneRun* runs, std::size_t run_count, RunZones& out);
   // A lower bound of robot `robot`'s F over samples of its leg to `first` and of the runs
-  // (their times in `times`, from t = 0 at the first pick) shifted to its arrival (see
-  // FlowBound in the .cpp).
+  // (their times in `times`, from t = 0 at the first pick; `zones` indexed from them) shifted to
+  // its arrival (see FlowBound in the .cpp).
   // `to_go`: the robot's time to `first` when known (< 0: the sampler walks its route).
   double FlowBound(const FleetState& state, std::size_t robot, PointId first,
                    RouteSampler& sampler, TrafficPredictor::DensityAccumulator& density,
-                   const BoundRuns& runs, const double* times, double to_go = -1.0);
+                   const ZoneRun* runs, std::size_t run_count, const RunZones& zones, const double* times,
+                   double to_go = -1.0);
 
   std::vector<std::pair<double, std::size_t>> order_;  // PriceLowest's heap of (bound, robot)
   std::vector<double> flow_bounds_;  // PriceLowest's bound(i) per robot (0 until taken)
@@ -127,8 +126,8 @@ class AuctionAllocator final : public Allocator {
   // shared_ as runs of consecutive samples in one zone (ZoneAt), over shared_times_.
   std::vector<ZoneRun> shared_runs_;
   std::vector<double> shared_times_;  // shared_[k].t
-  BoundRuns bound_runs_;              // the runs FlowBound samples (this order's)
-  std::vector<int> bound_peaks_;      // FlowBound: per zone of bound_runs_, N_p,max so far
+  RunZones run_zones_;                // the zones of the runs FlowBound samples (this order's)
+  std::vector<int> bound_peaks_;      // FlowBound: per zone of run_zones_, N_p,max so far
 };
 
 }  // namespace dispatch::engine

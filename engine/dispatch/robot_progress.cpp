@@ -26,10 +26,11 @@ Arrival TakeArrival(RobotProgress& p, const Assignment& a, std::uint64_t seq, st
 std::vector<TaskReport> TakeStateProgress(RobotProgress& p, const Assignment& a, std::uint64_t claimed,
                                           std::uint64_t* passed) {
   // HighestNumbered(a) >= released_up_to: the plan's last waypoint is read only beyond it.
-  const bool sent = (a.released_up_to >= 0 && claimed <= static_cast<std::uint64_t>(a.released_up_to)) || [&] {
+  bool sent = a.released_up_to >= 0 && claimed <= static_cast<std::uint64_t>(a.released_up_to);
+  if (!sent) {
     const std::int64_t numbered = HighestNumbered(a);
-    return numbered >= 0 && claimed <= static_cast<std::uint64_t>(numbered);
-  }();
+    sent = numbered >= 0 && claimed <= static_cast<std::uint64_t>(numbered);
+  }
   *passed = sent ? claimed : 0;
   std::vector<TaskReport> retry;
   if (*passed > p.last_reached) retry.swap(p.waiting);
