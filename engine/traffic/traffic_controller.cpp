@@ -217,6 +217,7 @@ Status TrafficController::Place(std::size_t r, PointId at) {
   x.arcs.clear();
   x.pos = 0;
   s.Touch(x);
+  Impl::ForgetProgress(x);
   x.working = x.loaded = false;
   x.idle = true;
   s.ClearWait(x);
@@ -259,6 +260,7 @@ void TrafficController::WaitOn(std::size_t r, int other, double t, const std::st
 }
 void TrafficController::RestartWaitClock(std::size_t r, double t) {
   RobotState& x = impl_->robots.at(r);
+  Impl::ForgetProgress(x);
   if (x.wait == WaitKind::kNone) return;
   x.wait_start = t;
   x.next_detour_try = 0.0;

@@ -201,7 +201,7 @@ bool TrafficController::Impl::TryDetour(std::size_t r, PointId ban_point, int ba
   if (d.points.size() < 2 || !StartAllowed(r, d.points)) return false;
   if (need_free_first_hop && PointBlocker(d.points[1], r) >= 0) return false;
   if (!Assign(r, std::move(d.points)).ok()) return false;
-  ++stats.replans;
+  Replanned(x);
   ClearWait(x);
   return true;
 }
@@ -228,7 +228,7 @@ bool TrafficController::Impl::TryBackOff(std::size_t r, PointId avoid, PointId b
       route.push_back(n);
     }
     if (!Assign(r, std::move(route)).ok()) continue;
-    ++stats.replans;
+    Replanned(x);
     ClearWait(x);
     return true;
   }

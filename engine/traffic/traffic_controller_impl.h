@@ -60,6 +60,17 @@ struct RobotState {
   // What `why` was formatted from when a keyed wait wrote it (WaitFor): the same key again
   // leaves the text as it is (a waiting robot asks every step); any other write clears it.
   WhyKey why_key;
+  // Progress towards the route's goal (NoteProgress): the least table cost to the goal from a
+  // point it asked to leave, since when it is that low, the points it re-planned at since and
+  // how often it re-planned again at one of them. A robot that re-plans back and forth
+  // without getting closer (a detour livelock: each detour restarts its wait clock) is blocked
+  // like one that waits (Request).
+  PointId progress_goal = kNoPoint;
+  PointId progress_at = kNoPoint;  // the point last measured from (a waiting robot asks again)
+  double progress_best = std::numeric_limits<double>::infinity();
+  double progress_since = 0.0;
+  std::vector<PointId> replanned_at;
+  int replans_again = 0;
 };
 
 struct CorridorState {
@@ -118,6 +129,19 @@ struct TrafficController::Impl {
   std::unordered_map<std::string, std::size_t> index;
   std::uint64_t route_epochs = 0;  // the last RobotState::route_epoch handed out
   void Touch(RobotState& x) { x.route_epoch = ++route_epochs; }
+  // Robot x asks to leave its point at time t: its progress towards its goal
+  // (RobotState::progress_*), measured on the bound route table (not without one).
+  void NoteProgress(RobotState& x, double t);
+  static void ForgetProgress(RobotState& x) { x.progress_goal = kNoPoint; }
+  // A re-plan of robot x (a detour, a back-off) at the point it stands at.
+  void Replanned(RobotState& x) {
+    ++stats.replans;
+    if (std::find(x.replanned_at.begin(), x.replanned_at.end(), x.at) != x.replanned_at.end()) {
+      ++x.replans_again;
+    } else {
+      x.replanned_at.push_back(x.at);
+    }
+  }
   TrafficStats stats;
   // The map as Search reads it, in flat arrays (built once in Create): per point its position
   // and intersection, its out-arcs (in out_arcs order) from search_begin[p] with their end,

@@ -202,13 +202,27 @@ TrafficDecision TrafficController::Impl::HeadOn(std::size_t r, int c, int oncomi
     rec.replanned = replan;
     if (stats.head_on.size() < 1000) stats.head_on.push_back(rec);
     if (replan && Assign(r, std::move(d.points)).ok()) {
-      ++stats.replans;
+      Replanned(x);
       ClearWait(x);
       return TrafficDecision::kReplanned;
     }
   }
   return WaitFor(r, WaitKind::kCorridor, oncoming, t, WhyKey{1, oncoming},
                  [&] { return "head-on: corridor held by " + robots[static_cast<std::size_t>(oncoming)].id; });
+}
+
+void TrafficController::Impl::NoteProgress(RobotState& x, double t) {
+  if (!bound_routes) return;
+  const PointId goal = x.route.back();
+  if (goal == x.progress_goal && x.at == x.progress_at) return;
+  x.progress_at = x.at;
+  const double cost = bound_routes->Cost(x.at, goal);
+  if (goal == x.progress_goal && !(cost < x.progress_best - 1e-9)) return;
+  x.progress_goal = goal;  // a new goal, or closer to it
+  x.progress_best = cost;
+  x.progress_since = t;
+  x.replanned_at.clear();
+  x.replans_again = 0;
 }
 
 TrafficDecision TrafficController::Impl::Request(std::size_t r, double t) {
@@ -219,8 +233,20 @@ TrafficDecision TrafficController::Impl::Request(std::size_t r, double t) {
     return TrafficDecision::kWait;
   }
   const PointId q = x.route[x.pos + 1];
+  NoteProgress(x, t);
   const TrafficDecision d = Check(r, q, t);
   if (d != TrafficDecision::kWait) return d;
+  // A detour livelock: re-planned back and forth (twice again at points it had re-planned at)
+  // and no closer to its goal for blocked_after. Its alternatives are taken by robots that
+  // wait for it: it has none left, like a robot blocked after waiting (Wang2019 §3.2 step 4).
+  if (x.progress_goal != kNoPoint && x.replans_again >= 3 && t - x.progress_since >= config.blocked_after) {
+    char buf[160];
+    std::snprintf(buf, sizeof buf, "blocked after %.0f s at %s re-planning back and forth, no closer to %s: ",
+                  t - x.progress_since, M().point(x.at).name.c_str(), M().point(x.progress_goal).name.c_str());
+    x.why = buf + x.why;
+    x.why_key = {};
+    return TrafficDecision::kBlocked;
+  }
   // Timeouts (Wang2019 §3.2 steps 3-4): re-plan, else blocked after blocked_after.
   const double waited = t - x.wait_start;
   const double limit = x.wait == WaitKind::kCorridor ? config.t_w1 : config.t_w2;
@@ -368,6 +394,7 @@ void TrafficController::Impl::Remove(std::size_t r) {
   for (int c : held) DropCorridor(c, r);
   ReleaseGuard(r);
   x.removed = true;
+  ForgetProgress(x);
   x.route.clear();
   x.arcs.clear();
   x.pos = 0;
