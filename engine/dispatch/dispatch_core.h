@@ -302,6 +302,7 @@ class DispatchCore {
   CoreCounts counts_;
   std::vector<BookRobot*> blocked_;  // in fault since the controller blocked them
   bool allocation_due_ = false;
+  std::uint64_t leaving_seen_ = 0;  // the gate's LeavingEnded() when last stepped
 };
 
 }  // namespace dispatch::engine

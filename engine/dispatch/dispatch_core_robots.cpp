@@ -174,6 +174,10 @@ StepOutcome DispatchCore::Step(double now) {
   StepOutcome out;
   if (!gate_) return out;
   std::vector<GateEffect> effects = gate_->Step(now);
+  if (gate_->LeavingEnded() != leaving_seen_) {  // members free to bid again
+    leaving_seen_ = gate_->LeavingEnded();
+    allocation_due_ = true;
+  }
   for (GateEffect& e : effects) {
     BookRobot* r = FindRobot(e.robot);
     if (!r) continue;

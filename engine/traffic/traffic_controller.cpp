@@ -164,6 +164,11 @@ bool TrafficController::RemainingRouteIs(std::size_t r, const std::vector<PointI
   return std::equal(x.route.begin() + static_cast<std::ptrdiff_t>(x.pos), x.route.end(), route.begin(), route.end());
 }
 std::uint64_t TrafficController::RouteEpoch(std::size_t r) const { return impl_->robots.at(r).route_epoch; }
+bool TrafficController::InExclusiveCorridor(PointId p) const {
+  if (p < 0 || static_cast<std::size_t>(p) >= impl_->lanes.interior_of.size()) return false;
+  const int c = impl_->lanes.interior_of[static_cast<std::size_t>(p)];
+  return c >= 0 && impl_->cstate[static_cast<std::size_t>(c)].exclusive;
+}
 bool TrafficController::HasRoute(std::size_t r) const {
   const RobotState& x = impl_->robots.at(r);
   return !x.removed && x.pos + 1 < x.route.size();

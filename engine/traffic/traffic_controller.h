@@ -139,6 +139,9 @@ class TrafficController {
   bool HasRoute(std::size_t r) const;  // some point is left to drive to
   PointId At(std::size_t r) const;     // the point it stands at / last left
   PointId Next(std::size_t r) const;   // the point it drives to, or kNoPoint while standing
+  // True when p is inside a corridor that takes one robot at a time (a service point inside):
+  // a robot standing there closes the whole corridor.
+  bool InExclusiveCorridor(PointId p) const;
   // Working (picking/dropping) until `work_end` (s): top priority, never asked to yield; the
   // remaining work counts in oncoming robots' wait estimates.
   void SetWorking(std::size_t r, bool working, double work_end = 0.0);

@@ -42,8 +42,26 @@ int TrafficController::Impl::PointBlocker(PointId q, std::size_t r, double envel
 int TrafficController::Impl::CorridorBlocker(int c, int d, std::size_t r) const {
   const CorridorState& s = cstate[static_cast<std::size_t>(c)];
   if (s.dir == d && !s.exclusive) return -1;
+  // Inside a one-robot corridor already, r may drive on away from holders behind it (found on
+  // a dense grid: an idle robot inside such a corridor could not step aside for a formation,
+  // the corridor held by one that waited for that formation behind it).
+  long mine = -1;
+  const auto& points = lanes.corridors[static_cast<std::size_t>(c)].points;
+  auto index = [&](PointId p) {
+    const auto it = std::find(points.begin(), points.end(), p);
+    return it == points.end() ? -1L : static_cast<long>(it - points.begin());
+  };
+  const PointId at = robots[r].at;
+  if (s.exclusive && at >= 0 && lanes.interior_of[static_cast<std::size_t>(at)] == c) mine = index(at);
   for (int h : s.holders) {
-    if (static_cast<std::size_t>(h) != r) return h;
+    const RobotState& o = robots[static_cast<std::size_t>(h)];
+    // A teammate (a member leaving its team's agent) is exempt, as in PointBlocker.
+    if (static_cast<std::size_t>(h) == r || Mates(robots[r], o)) continue;
+    if (mine >= 0 && o.next == kNoPoint) {
+      const long k = index(o.at);
+      if (k >= 0 && (k - mine) * d < 0) continue;
+    }
+    return h;
   }
   return -1;
 }

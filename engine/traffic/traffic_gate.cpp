@@ -290,6 +290,8 @@ void TrafficGate::SampleDistances(double t) { impl_->SampleDistances(t); }
 
 double TrafficGate::NextWake() const { return impl_->next_wake; }
 
+std::uint64_t TrafficGate::LeavingEnded() const { return impl_->leaving_ended; }
+
 bool TrafficGate::Available(const std::string& robot) const {
   const GateBot* bot = impl_->Find(robot);
   return !bot || bot->team.empty() || impl_->teams.count(bot->team) == 0 ||

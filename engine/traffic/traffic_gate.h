@@ -157,6 +157,9 @@ class TrafficGate {
 
   // False while the robot still stands in a finished formation's slot, waiting to leave it.
   bool Available(const std::string& robot) const;
+  // How many teams have ended while leaving their drop (their members Available again): the
+  // owner runs an allocation round when it changes (nothing else says they may bid again).
+  std::uint64_t LeavingEnded() const;
   // Where a new plan of the robot must start: the point it drives to, or stands at.
   PointId StartPoint(const std::string& robot) const;
   // Highest waypoint sequence released to the robot.

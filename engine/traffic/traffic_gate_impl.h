@@ -154,6 +154,7 @@ struct GateImpl {
   }
   std::map<std::string, GateTeam> teams;  // by formation order id
   std::set<std::string> finished_teams;   // formations that have left their drop point
+  std::uint64_t leaving_ended = 0;        // teams erased while leaving (TrafficGate::LeavingEnded)
   std::set<std::string> strays;  // broken-up teams' members not back on the floor (PlaceStrays)
   std::vector<std::size_t> team_pool;     // removed team agents, reusable
   std::size_t team_agents = 0;            // team agents ever added (their ids)

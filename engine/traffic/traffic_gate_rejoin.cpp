@@ -56,6 +56,7 @@ bool GateImpl::RejoinTeam(GateBot& b, const std::string& order, const TeamSpan& 
     BreakTeam(team);
     finished_teams.insert(order);
     teams.erase(order);
+    ++leaving_ended;
     notes.push_back("formation " + order + " was leaving its drop: its members go on alone");
     return false;
   }

@@ -66,9 +66,14 @@ bool GateImpl::PlaceNear(GateBot& b) {
 void GateImpl::PlaceStrays() {
   for (auto it = strays.begin(); it != strays.end();) {
     auto bot = bots.find(*it);
-    const bool stray = bot != bots.end() && bot->second.team.empty() && !bot->second.former_team.empty() &&
-                       !teams.count(bot->second.former_team) && !OnFloor(bot->second);
-    if (stray && !PlaceNear(bot->second)) {
+    // Off the floor and in no team, it stands where it stands (the controller keeps strangers
+    // clear of it) until it is placed: while a team it was in still holds the point (its
+    // former team, or one it was given next and never joined), it waits. Found by the
+    // safety check: a stray given a formation that broke up before it joined was dropped from
+    // the strays, and a robot drove up to it at 0.231 m.
+    const bool stray = bot != bots.end() && bot->second.team.empty() && !OnFloor(bot->second);
+    const bool wait = stray && !bot->second.former_team.empty() && teams.count(bot->second.former_team);
+    if (stray && (wait || !PlaceNear(bot->second))) {
       ++it;
     } else {
       // Placed, or no longer a stray (placed elsewhere, in a team again).
@@ -206,14 +211,32 @@ void GateImpl::StepSolo(GateBot& b, double t, std::vector<GateEffect>& out) {
   }
   ctl.SetWorking(r, false);
   if (join >= 0 && here == join - 1) {  // at the rendezvous approach: join the team
+    // Only next to the rendezvous point: from there its drive to the slot stays inside the
+    // team's envelope. A back-off or nudge may have left it farther (the plan continues from
+    // where it ended): it drives back first. Found by the safety check on a dense grid: a
+    // member backed off one point joined there and drove to its slot through the point
+    // between, where another robot stood (0.000 m).
+    const PointId p = w[static_cast<std::size_t>(join)].point;
+    bool next_to = at == p;
+    for (ArcId a : map->out_arcs(at)) next_to = next_to || map->arc(a).to == p;
+    if (!next_to) {
+      auto path = routes->Path(at, p);
+      if (path.ok() && path->points.size() > 2) {
+        RewriteLeg(b, here, path->points, join, t, out);
+        b.leg_stale = true;
+        return;
+      }
+    }
     JoinTeam(b, join_order, t, out);
     return;
   }
   if (here + 1 >= n) {  // nothing ahead: idle
     ctl.SetIdle(r, true);
     bool aside = false;
-    if (!ctl.HasRoute(r) && !b.stepped_aside && blocks_service[static_cast<std::size_t>(at)]) {
-      // Out of the way of the next robot to serve here: a siding nearby, else home.
+    if (!ctl.HasRoute(r) && !b.stepped_aside &&
+        (blocks_service[static_cast<std::size_t>(at)] || ctl.InExclusiveCorridor(at))) {
+      // Out of the way of the next robot to serve here (or to pass through the one-robot
+      // corridor it stands in): a siding nearby, else home.
       aside = ctl.StepAside(r, {at});
       if (!aside && b.home != kNoPoint && b.home != at) {
         auto path = routes->Path(at, b.home);

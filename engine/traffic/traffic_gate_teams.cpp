@@ -305,6 +305,7 @@ void GateImpl::StepTeams(double t, std::vector<GateEffect>& out) {
       BreakTeam(team);
       resync.push_back(team.order);
       it = teams.erase(it);
+      ++leaving_ended;
       continue;
     }
     if (team.phase == GateTeam::Phase::kLeaving && StepLeaving(team, t, out)) {
@@ -316,6 +317,7 @@ void GateImpl::StepTeams(double t, std::vector<GateEffect>& out) {
         finished_teams.insert(order);
       }
       it = teams.erase(it);
+      ++leaving_ended;
       continue;
     }
     ++it;
