@@ -130,8 +130,12 @@ bool GateImpl::StepLeaving(GateTeam& team, double t, std::vector<GateEffect>& ou
                     map->point(target).name + "' (onward waypoint " + std::to_string(j) + ")");
     long first_new = j;
     if (j < 0) {  // idle: a move to the neighbour (and home, see home_route)
-      RewriteLeg(b, static_cast<long>(b.plan.waypoints.size()) - 1, home_route(target), -1, t, out);
-      first_new = static_cast<long>(b.plan.waypoints.size()) - 1;
+      // Its first new waypoint is the move to the neighbour, not the last one: with the way
+      // home appended, every waypoint up to home was taken as passed (reached, released) and
+      // the robot drove home unguarded (found by the safety check: 0.019 m, a member of a
+      // broken-up team driving through a robot on its way home).
+      first_new = static_cast<long>(b.plan.waypoints.size());
+      RewriteLeg(b, first_new - 1, home_route(target), -1, t, out);
     }
     b.leave_seq = static_cast<std::uint64_t>(b.plan.waypoints[static_cast<std::size_t>(first_new)].seq);
     if (first_new - 1 > b.idx) {  // the waypoints still at D are passed on the way out

@@ -388,10 +388,21 @@ void GateImpl::OnReached(GateBot& b, std::uint64_t seq, double t) {
         }
         return true;
       };
+      // Nor beside one of them where it arrived: exempt from them, it may have driven up to one
+      // closer than eps1 (found by the safety check: a member of a broken-up team arrived
+      // 0.400 m from a former teammate and lost the exemption there).
+      auto none_beside = [&] {
+        const Eigen::Vector2d& here = map->point(ctl.At(r)).position;
+        for (const auto& [id, o] : bots) {
+          if (&o == &b || (o.former_team != b.former_team && o.team != b.former_team)) continue;
+          if (o.has_xy && (o.xy - here).norm() < config.point_clearance - 1e-9) return false;
+        }
+        return true;
+      };
       if (!b.former_team.empty() && !teams.count(b.former_team) &&
           (b.former_at == kNoPoint ||
            (map->point(ctl.At(r)).position - map->point(b.former_at).position).norm() >= envelope - 1e-9) &&
-          teammates_out()) {
+          teammates_out() && none_beside()) {
         b.former_team.clear();
         b.older_former.clear();
         ctl.SetEnvelope(r, 0.0);

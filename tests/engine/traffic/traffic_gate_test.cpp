@@ -400,20 +400,38 @@ TEST_F(TrafficGateTest, RegressionABlockedFormationMemberIsNeverPlacedAtItsHome)
     cut.order_of = {""};
     gate_->SetPlan(id, cut);
   }
-  Eigen::Vector2d centre = Eigen::Vector2d::Zero();
-  for (const auto& [id, xy] : stands) centre += xy / static_cast<double>(stands.size());
-  const PointId team_point = map_->NearestPoint(centre);
   auto all_left = [&] {
     for (const auto& id : team_) {
       if (gate_->RobotState(id).formation != "") return false;
     }
     return true;
   };
-  for (int step = 0; step < 2000 && !all_left(); ++step) Run(1);
+  // Where the gate puts each member back on the floor, the step it leaves the team. From then on
+  // it is released point by point like any robot: never more than the next point's waypoints
+  // ahead.
+  std::map<std::string, PointId> placed;
+  for (int step = 0; step < 2000 && !all_left(); ++step) {
+    Run(1);
+    for (const auto& id : team_) {
+      if (!gate_->RobotState(id).formation.empty()) continue;
+      if (!placed.count(id)) placed[id] = gate_->StartPoint(id);
+      const Sim& s = sims_[id];
+      std::set<PointId> ahead;
+      for (std::size_t k = s.at + 1; k < s.plan.size() && static_cast<std::uint64_t>(s.plan[k].seq) <= gate_->ReleasedUpTo(id); ++k) {
+        if (s.plan[k].point != s.plan[s.at].point) ahead.insert(s.plan[k].point);
+      }
+      ASSERT_LE(ahead.size(), 1u) << gate_->Describe(id);
+    }
+  }
   ASSERT_TRUE(all_left()) << DescribeAll();
+  Eigen::Vector2d centre = Eigen::Vector2d::Zero();
+  for (const auto& [id, xy] : stands) centre += xy / static_cast<double>(stands.size());
+  const PointId team_point = map_->NearestPoint(centre);
+  // On the team's point or next to it (an idle member of a broken-up team drives on home from
+  // there, as it should), never at its home.
   int on_floor = 0;
   for (const auto& id : team_) {
-    const PointId at = gate_->StartPoint(id);
+    const PointId at = placed[id];
     if (at == kNoPoint) continue;  // still in its slot (no way off in time): a stray, seen standing
     ++on_floor;
     EXPECT_NE(at, home[id]) << gate_->Describe(id);
