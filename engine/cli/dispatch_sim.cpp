@@ -3,12 +3,12 @@
 //       allocate a task table with the auction on the Chu2024 floor (R1..R18), execute the
 //       timed plans with the Chu2024 rules off and/or on (seed 000 Fig. 8, Tables 3-4).
 //   dispatch-sim stream --map chu2024 --robots 18 (--orders FILE... [--repeat N] | --random 200 --seed 1
-//       [--formations 0.2]) [--strategy auction|greedy] [--zeta 100] [--csv series.csv]
+//       [--formations 0.2]) [--strategy auction|greedy] [--zeta 100]
 //       [--orders-csv out.csv] [--check-safety] [--journal run.db] [--max-queue N]
 //       [--formation-max-queue N] [--one-formation-per-pick true|false] [--trace R1,R2 [--trace-from T] [--trace-to T]]
 //       [--planner rules|time-windows] [--routing floyd|heat [--heat-period S]] [--turn-time S]
-//       an order stream with release times (formation orders too) under the online traffic
-//       controller; with --planner time-windows single-robot awards are planned through the
+//       an order stream with release times (formation orders too) on the dispatch core (the
+//       service's allocation rounds and traffic gate, robots following its messages); with --planner time-windows single-robot awards are planned through the
 //       others' time windows (Wang2019, window_awards.h).
 //   dispatch-sim compare [--random 200 --seed 1 --robots 18 --map chu2024]
 //       [--planners rules,time-windows] [--routings floyd,heat] [--strategy S] [--zeta Z]
@@ -44,7 +44,6 @@
 #include "engine/io/map_source.h"
 #include "engine/routing/route_table.h"
 #include "engine/sim/head_on_scenario.h"
-#include "engine/sim/order_stream.h"
 #include "engine/sim/simulator.h"
 #include "engine/traffic/safety_check.h"
 

@@ -262,7 +262,6 @@ int RunReplay(const ReplayArgs& a) {
     c.one_formation_per_pick = loaded->setup.core.one_formation_per_pick;
     c.blocked_recovery = loaded->setup.core.blocked_recovery;
     c.check_safety = false;
-    c.record_series = false;
     return SimulateOnCore(loaded->replay.map, loaded->replay.routes,
                           std::vector<FleetRobot>(fleet.begin(), fleet.begin() + static_cast<std::ptrdiff_t>(count)),
                           orders, c);

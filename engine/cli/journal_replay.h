@@ -16,7 +16,7 @@
 #include "engine/common/result.h"
 #include "engine/dispatch/core_journal.h"
 #include "engine/map/warehouse_map.h"
-#include "engine/sim/order_stream.h"
+#include "engine/sim/stream_result.h"
 
 namespace dispatch::engine {
 

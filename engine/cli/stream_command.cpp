@@ -16,7 +16,6 @@
 #include "engine/routing/route_table.h"
 #include "engine/sim/core_stream.h"
 #include "engine/sim/fleet_placement.h"
-#include "engine/sim/order_stream.h"
 #include "engine/sim/random_orders.h"
 
 namespace dispatch::engine {
@@ -125,16 +124,6 @@ std::string TablesLabel(const StreamArgs& a) {
 Result<StreamResult> Simulate(const StreamArgs& a, const Setup& s, const StreamConfig& c) {
   if (!ParsePlanner(a.planner)) return InvalidArgument("--planner must be one of " + PlannerList());
   if (!ParseRouting(a.routing)) return InvalidArgument("--routing must be floyd or heat");
-  if (a.model != "core" && c.allocation.routing != RoutingKind::kFloyd) {
-    return InvalidArgument("--routing " + a.routing + " routes in the dispatch core's rounds: --model core");
-  }
-  if (a.model != "core" && c.allocation.planner != PlannerKind::kRules) {
-    return InvalidArgument("--planner " + a.planner + " plans in the dispatch core's rounds: --model core");
-  }
-  if (a.model != "core") {
-    if (!a.journal.empty()) return InvalidArgument("--journal records the dispatch core's calls: --model core");
-    return SimulateOrderStream(s.map, s.routes, s.robots, s.orders, c);
-  }
   if (a.journal.empty()) return SimulateOnCore(s.map, s.routes, s.robots, s.orders, c);
   std::vector<JournalEntry> journal;
   auto r = SimulateOnCore(s.map, s.routes, s.robots, s.orders, c, &journal);
@@ -204,16 +193,6 @@ int RunStream(const StreamArgs& a) {
       out << ',' << (o.completed ? 1 : 0) << ",\"" << o.failure << "\"," << team << '\n';
     }
   }
-  if (!a.csv.empty()) {
-    std::ofstream out(a.csv);
-    if (!out) return Fail("cannot write " + a.csv);
-    out << "t,min_distance\n";
-    for (std::size_t i = 0; i < r->times.size(); ++i) {
-      out << r->times[i] << ',';
-      if (std::isfinite(r->min_distance[i])) out << r->min_distance[i];
-      out << '\n';
-    }
-  }
   return r->all_completed() && (!r->safety || r->safety->ok()) ? 0 : 2;
 }
 
@@ -276,7 +255,6 @@ int RunCompare(StreamArgs a) {
     with.planner = planner;
     with.routing = routing;
     StreamConfig c = ConfigOf(with, strategy, zeta);
-    c.record_series = false;
     auto r = Simulate(with, *setup, c);
     if (!r.ok()) return Fail(r.error().message);
     const FailureCounts failed = CountFailures(*r);
@@ -308,9 +286,6 @@ StreamCommands AddStreamCommands(CLI::App& app, StreamArgs& stream_args, StreamA
         ->capture_default_str()->check(CLI::Range(0.0, 1.0));
     c->add_option("--dt", a.dt, "Time step, s")->capture_default_str()->check(CLI::PositiveNumber);
     c->add_option("--max-time", a.max_time, "Simulated seconds before giving up")->capture_default_str();
-    c->add_option("--model", a.model, "core (the service's dispatch core, robots following its messages) "
-                                      "or stream (the order-stream model)")
-        ->capture_default_str()->check(CLI::IsMember({"core", "stream"}));
     c->add_option("--planner", a.planner, "How awards get their routes: " + PlannerList())
         ->capture_default_str();
     c->add_option("--turn-time", a.turn_s, "Turning time per 90 degrees, s (plans, route costs, robots)")
@@ -327,16 +302,16 @@ StreamCommands AddStreamCommands(CLI::App& app, StreamArgs& stream_args, StreamA
                   "Orders a robot may hold and still join a formation (0: no limit)")
         ->capture_default_str();
     c->add_option("--one-formation-per-pick", a.one_formation_per_pick,
-                  "Allocate a formation only while no other is heading for its first pick (core model): true or false")
+                  "Allocate a formation only while no other is heading for its first pick: true or false")
         ->capture_default_str();
     c->add_option("--blocked-recovery", a.blocked_recovery,
-                  "s a blocked robot stays in fault before it is back in service (core model; 0: never)")
+                  "s a blocked robot stays in fault before it is back in service (0: never)")
         ->capture_default_str()
         ->check(CLI::NonNegativeNumber);
     c->add_flag("--check-safety", a.check_safety,
                 "Run CheckSafety over every step (eps1 spacing, crossings in intersections)");
     c->add_option("--trace", a.trace,
-                  "Robots to trace every step (core model): true position, motion, the gate's view")
+                  "Robots to trace every step: true position, motion, the gate's view")
         ->delimiter(',');
     c->add_option("--trace-from", a.trace_from, "Start of the trace window, s")->capture_default_str();
     c->add_option("--trace-to", a.trace_to, "End of the trace window, s");
@@ -346,7 +321,6 @@ StreamCommands AddStreamCommands(CLI::App& app, StreamArgs& stream_args, StreamA
   s->add_option("--strategy", stream_args.strategy, "auction or greedy")->capture_default_str()
       ->check(CLI::IsMember(AllocatorNames()));
   s->add_option("--zeta", stream_args.zeta, "Traffic weight of the auction")->capture_default_str();
-  s->add_option("--csv", stream_args.csv, "Write t,min_distance here");
   s->add_option("--orders-csv", stream_args.orders_csv, "Write per-order results here");
   s->add_option("--journal", stream_args.journal,
                 "Journal the core's calls as a run of this SQLite file (dispatch-sim replay --db, SQL)");

@@ -1,5 +1,5 @@
-// dispatch-sim stream and compare: order streams on a floor through the dispatch core (or the
-// older order-stream model) under the online traffic controller, one run or side by side
+// dispatch-sim stream and compare: order streams on a floor through the dispatch core (its
+// allocation rounds and traffic gate, robots following its messages), one run or side by side
 // (strategies, or planners x routings). The subcommands' options, the set-up of a run
 // (map, route table, robots, orders) and the printed summaries.
 #pragma once
@@ -17,21 +17,18 @@ class App;
 namespace dispatch::engine {
 
 struct StreamArgs {
-  std::string map = "chu2024", csv, orders_csv, strategy = "auction", journal;
+  std::string map = "chu2024", orders_csv, strategy = "auction", journal;
   std::vector<std::string> orders;  // task tables, submitted together
   std::size_t robots = 18, random = 0, repeat = 1, max_queue = 0, formation_max_queue = 1;
   std::uint64_t seed = 1;
   double interval = 2.0, zeta = 100.0, dt = 0.1, max_time = 36000.0, formations = 0.0;
   bool check_safety = false, one_formation_per_pick = true;
-  double blocked_recovery = 60.0;  // core model: CoreOptions::blocked_recovery
-  std::vector<std::string> trace;  // robots to trace (core model)
+  double blocked_recovery = 60.0;  // CoreOptions::blocked_recovery
+  std::vector<std::string> trace;  // robots to trace
   double trace_from = 0.0, trace_to = std::numeric_limits<double>::infinity();
-  // "core": the service's dispatch core with robots following its messages (core_stream.h);
-  // "stream": the order-stream model (order_stream.h).
-  std::string model = "core";
-  std::string planner = "rules";           // AllocationConfig::planner (core model)
+  std::string planner = "rules";           // AllocationConfig::planner
   std::vector<std::string> planners;       // compare: one column per planner (x routing)
-  std::string routing = "floyd";           // AllocationConfig::routing (core model)
+  std::string routing = "floyd";           // AllocationConfig::routing
   std::vector<std::string> routings;       // compare: one column per routing (x planner)
   double turn_s = 0.0;                     // turning time per 90 degrees (AllocationConfig::turn_time)
   double heat_period = 60.0;               // path heat: δ, s

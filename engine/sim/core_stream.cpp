@@ -343,9 +343,6 @@ Result<StreamResult> SimulateOnCore(std::shared_ptr<const WarehouseMap> map, std
       !(config.allocation_period >= 0)) {
     return InvalidArgument("order stream: time_step and max_time must be > 0");
   }
-  if (config.strategy == AllocationStrategy::kPreassigned) {
-    return InvalidArgument("order stream on the core: preassigned orders are not supported; use auction or greedy");
-  }
   if (auto valid = ValidateAllocationConfig(config.allocation); !valid.ok()) return valid.error();
   auto allocator = MakeAllocator(AllocationStrategyName(config.strategy));
   if (!allocator.ok()) return allocator.error();

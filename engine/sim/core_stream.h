@@ -24,8 +24,11 @@
 // gate's (centre distance of robots of different agents, from the robots' positions at every
 // step). With check_safety, CheckSafety over every step's true robot positions (not the gate's
 // belief), a formation's members grouped as the gate groups them; record_frames keeps those
-// frames. The per-step distance series (record_series) is not recorded, and `preassigned` is
-// not supported.
+// frames.
+//
+// This is the product's only order-stream simulator: the older order-stream model, with its
+// own motion and its own copy of the formation teams, is gone (issue 15 §3). The plan
+// simulator (simulator.h) is a different thing: timed plans executed under the Chu2024 rules.
 //
 // Pure function of its inputs; thread-safe.
 #pragma once
@@ -35,7 +38,7 @@
 
 #include "engine/dispatch/core_journal.h"
 #include "engine/dispatch/dispatch_core.h"
-#include "engine/sim/order_stream.h"
+#include "engine/sim/stream_result.h"
 
 namespace dispatch::engine {
 
@@ -44,7 +47,7 @@ CoreOptions CoreOptionsOf(const StreamConfig& config);
 
 // With `journal`, every call the run made on the core is journaled there (the service's format,
 // engine/dispatch/core_journal.h): CoreReplay reproduces the run from it.
-// Errors: bad config, null map/routes, no robots, the preassigned strategy, robots that cannot
+// Errors: bad config, null map/routes, no robots, robots that cannot
 // be placed (unknown or shared start points), a formation order with fewer than 3 robots.
 Result<StreamResult> SimulateOnCore(std::shared_ptr<const WarehouseMap> map, std::shared_ptr<const RouteTable> routes,
                                     const std::vector<FleetRobot>& robots, std::vector<Order> orders,

@@ -6,8 +6,8 @@
 // seed's own experiment (Chu2024 Fig. 8, Tables 3-4), in which timed plans made once by the
 // auction are executed under the paper's offline rules (IntersectionGrants on the plan's
 // times, the rear-end rule) with no dispatcher in the loop: no order stream, no re-allocation,
-// no robot reports. The order-stream simulator (order_stream.h) is the one that models the
-// service and is moving onto the core.
+// no robot reports. The order-stream simulator (core_stream.h) is the one that models the
+// service: it drives the dispatch core itself.
 //
 // Motion: each robot follows its plan's waypoint polyline in order; every segment takes its
 // planned duration (eta[i+1] - departure[i], i.e. speed v or an arc's limit) while the robot

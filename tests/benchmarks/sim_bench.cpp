@@ -1,17 +1,18 @@
-// sim_bench: order streams under the online traffic controller on a large generated floor, as
-// fast as the CPU allows (issue 4 §5): the order-stream model (engine/sim/order_stream.h) and
-// the dispatch core driven by in-process robots (engine/sim/core_stream.h, issue 15 §3).
+// sim_bench: order streams on the dispatch core driven by in-process robots
+// (engine/sim/core_stream.h, issue 15 §3) on a large generated floor, as fast as the CPU
+// allows (issue 4 §5).
 //
-//   BM_Simulate/R   R robots on a 20 x 20-shelf grid floor (engine/map/grid_floor.h: 4 x 2
+//   BM_SimulateOnCore/R   R robots on a 20 x 20-shelf grid floor (engine/map/grid_floor.h: 4 x 2
 //                   cell shelves, 2-cell aisles, 122 x 82 cells, ~6800 points, lazy route
-//                   table, all lanes bidirectional), auction (zeta = 100) allocating every
-//                   10 s (one FleetState rebuild per batch), a steady stream of random orders (one every 110 / R s: about one
-//                   order per robot per task duration), 300 simulated seconds, dt = 0.1 s.
-//   BM_SimulateFormations/R   the same with 10% of the orders formation orders (3 robots each,
-//                   Chu2024 §3.2: gathering, one agent with the formation's envelope, leaving).
-//   BM_SimulateOnCore/R, BM_SimulateFormationsOnCore/R   the same streams on SimulateOnCore:
-//                   the service's DispatchCore, its TrafficGate and robots following its
-//                   messages (a round whenever one is due, at most every 10 s).
+//                   table, all lanes bidirectional): the service's DispatchCore, its
+//                   TrafficGate and robots following its messages, auction (zeta = 100) in a
+//                   round whenever one is due, at most every 10 s, a steady stream of random
+//                   orders (one every 110 / R s: about one order per robot per task duration),
+//                   300 simulated seconds, dt = 0.1 s. (Named "OnCore" since the older
+//                   order-stream model's BM_Simulate/R, which the core was measured against
+//                   until that model was deleted.)
+//   BM_SimulateFormationsOnCore/R   the same with 10% of the orders formation orders (3 robots
+//                   each, Chu2024 §3.2: gathering, one agent with the formation's envelope).
 //   BM_SimulatePlannerTimeWindows/R, BM_SimulatePlannerHeat/R   BM_SimulateOnCore's stream with
 //                   AllocationConfig::planner = time-windows / routing = heat (issue 16).
 // Counter `speedup` = simulated seconds per wall second (target: R = 500 at >= 100x).
@@ -27,7 +28,6 @@
 #include "engine/routing/route_table.h"
 #include "engine/sim/core_stream.h"
 #include "engine/sim/fleet_placement.h"
-#include "engine/sim/order_stream.h"
 #include "engine/sim/random_orders.h"
 
 namespace dispatch::engine {
@@ -61,8 +61,8 @@ const Floor& LargeFloor() {
   return floor;
 }
 
-void Simulate(benchmark::State& state, double formation_share, bool on_core = false,
-              PlannerKind planner = PlannerKind::kRules, RoutingKind routing = RoutingKind::kFloyd) {
+void Simulate(benchmark::State& state, double formation_share, PlannerKind planner = PlannerKind::kRules,
+              RoutingKind routing = RoutingKind::kFloyd) {
   const Floor& f = LargeFloor();
   const auto robots_count = static_cast<std::size_t>(state.range(0));
   auto robots = PlaceRobots(*f.map, robots_count);
@@ -77,15 +77,13 @@ void Simulate(benchmark::State& state, double formation_share, bool on_core = fa
   StreamConfig config;
   config.max_time = kHorizon;
   config.allocation_period = 10.0;
-  config.record_series = false;
   config.allocation.planner = planner;
   config.allocation.routing = routing;
   double simulated = 0;
   std::size_t completed = 0, total = 0, deadlocks = 0, replans = 0, blocked = 0;
   double waiting = 0.0, completion = 0.0, recovered = 0.0, head_on = 0.0;
   for (auto _ : state) {
-    auto r = on_core ? SimulateOnCore(f.map, f.routes, *robots, *orders, config)
-                     : SimulateOrderStream(f.map, f.routes, *robots, *orders, config);
+    auto r = SimulateOnCore(f.map, f.routes, *robots, *orders, config);
     if (!r.ok()) throw std::runtime_error(r.error().message);
     simulated += r->end_time;
     completed += r->completed;
@@ -108,21 +106,13 @@ void Simulate(benchmark::State& state, double formation_share, bool on_core = fa
   state.counters["waiting"] = waiting / static_cast<double>(state.iterations());
   state.counters["mean_done"] = completion / static_cast<double>(state.iterations());
   state.counters["head_on"] = head_on / static_cast<double>(state.iterations());
-  if (on_core) state.counters["recovered"] = recovered / static_cast<double>(state.iterations());
+  state.counters["recovered"] = recovered / static_cast<double>(state.iterations());
 }
 
-void BM_Simulate(benchmark::State& state) { Simulate(state, 0.0); }
-void BM_SimulateFormations(benchmark::State& state) { Simulate(state, 0.1); }
-void BM_SimulateOnCore(benchmark::State& state) { Simulate(state, 0.0, true); }
-void BM_SimulateFormationsOnCore(benchmark::State& state) { Simulate(state, 0.1, true); }
-void BM_SimulatePlannerTimeWindows(benchmark::State& state) {
-  Simulate(state, 0.0, true, PlannerKind::kTimeWindows);
-}
-void BM_SimulatePlannerHeat(benchmark::State& state) { Simulate(state, 0.0, true, PlannerKind::kRules, RoutingKind::kHeat); }
-BENCHMARK(BM_Simulate)->Arg(18)->Arg(100)->Arg(500)->Unit(benchmark::kMillisecond)
-    ->UseRealTime()->Iterations(2);
-BENCHMARK(BM_SimulateFormations)->Arg(100)->Arg(500)->Unit(benchmark::kMillisecond)
-    ->UseRealTime()->Iterations(2);
+void BM_SimulateOnCore(benchmark::State& state) { Simulate(state, 0.0); }
+void BM_SimulateFormationsOnCore(benchmark::State& state) { Simulate(state, 0.1); }
+void BM_SimulatePlannerTimeWindows(benchmark::State& state) { Simulate(state, 0.0, PlannerKind::kTimeWindows); }
+void BM_SimulatePlannerHeat(benchmark::State& state) { Simulate(state, 0.0, PlannerKind::kRules, RoutingKind::kHeat); }
 BENCHMARK(BM_SimulateOnCore)->Arg(18)->Arg(100)->Arg(500)->Unit(benchmark::kMillisecond)
     ->UseRealTime()->Iterations(2);
 BENCHMARK(BM_SimulateFormationsOnCore)->Arg(100)->Arg(500)->Unit(benchmark::kMillisecond)

@@ -11,7 +11,7 @@
 #include <string>
 #include <utility>
 
-#include "tests/engine/sim/order_stream_test_support.h"
+#include "tests/engine/sim/stream_test_support.h"
 
 namespace dispatch::engine::testing {
 namespace {
@@ -36,7 +36,6 @@ std::pair<std::size_t, std::size_t> CoreDenseGridLiveness(double formation_share
         if (!robots.ok() || !orders.ok()) continue;
         StreamConfig c;
         c.max_time = 2000;
-        c.record_series = false;
         c.check_safety = true;
         c.allocation.formation_max_queue = 1;  // the product's formation settings
         c.one_formation_per_pick = true;

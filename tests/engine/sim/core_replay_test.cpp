@@ -11,7 +11,7 @@
 
 #include "engine/cli/scenario.h"
 #include "engine/sim/core_stream.h"
-#include "order_stream_test_support.h"
+#include "tests/engine/sim/stream_test_support.h"
 
 namespace dispatch::engine::testing {
 namespace {
@@ -19,7 +19,6 @@ namespace {
 StreamConfig Config() {
   StreamConfig c;
   c.max_time = 3000;
-  c.record_series = false;
   return c;
 }
 

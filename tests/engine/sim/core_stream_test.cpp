@@ -11,7 +11,7 @@
 #include <vector>
 
 #include "engine/cli/scenario.h"
-#include "order_stream_test_support.h"
+#include "tests/engine/sim/stream_test_support.h"
 
 namespace dispatch::engine::testing {
 namespace {
@@ -54,7 +54,6 @@ StreamConfig Config(AllocationStrategy strategy = AllocationStrategy::kAuction, 
   c.strategy = strategy;
   c.allocation.zeta = zeta;
   c.max_time = 20000;
-  c.record_series = false;
   return c;
 }
 
@@ -174,8 +173,6 @@ TEST(CoreStreamTest, RunsAreDeterministic) {
 TEST(CoreStreamTest, RejectsWhatItCannotRun) {
   const World w = Chu();
   const Stream s = ChuStream(w, 5, 1);
-  StreamConfig pre = Config(AllocationStrategy::kPreassigned);
-  EXPECT_FALSE(SimulateOnCore(w.map, w.routes, s.robots, s.orders, pre).ok());
   EXPECT_FALSE(SimulateOnCore(w.map, w.routes, {}, s.orders, Config()).ok());
   StreamConfig zero = Config();
   zero.time_step = 0;

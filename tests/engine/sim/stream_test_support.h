@@ -1,5 +1,5 @@
-// Helpers of the order-stream tests (order_stream_test.cpp, order_stream_formation_test.cpp):
-// floors, streams and the invariants every run must satisfy.
+// Helpers of the order-stream tests on the dispatch core (core_*_test.cpp): floors, streams
+// and the invariants every run must satisfy.
 #pragma once
 
 #include <gtest/gtest.h>
@@ -17,7 +17,7 @@
 #include "engine/map/chu2024_floor.h"
 #include "engine/routing/route_table.h"
 #include "engine/sim/fleet_placement.h"
-#include "engine/sim/order_stream.h"
+#include "engine/sim/stream_result.h"
 #include "engine/sim/random_orders.h"
 
 namespace dispatch::engine::testing {
@@ -79,19 +79,6 @@ inline void ExpectSane(const World& w, const std::vector<Order>& orders, const S
     EXPECT_GT(r.mean_completion, 0.0);
   }
   EXPECT_LT(r.end_time, c.max_time);  // nothing hit the time limit ("waits forever")
-  EXPECT_EQ(r.times.size(), r.min_distance.size());
-}
-
-// The run's own CheckSafety (StreamConfig::check_safety): eps1 between every pair of robots
-// and no crossing movements inside one intersection at a time.
-inline void ExpectSafe(const StreamResult& r) {
-  ASSERT_TRUE(r.safety.has_value());
-  EXPECT_TRUE(r.safety->ok()) << r.safety->violations.size() << " violations, first: "
-                              << r.safety->violations.front().Describe();
-  // The series measures pairs within distance_cap only (+inf when none was that close).
-  if (std::isfinite(r.overall_min_distance)) {
-    EXPECT_NEAR(r.safety->min_robot_distance, r.overall_min_distance, 1e-9);
-  }
 }
 
 // 18 robots at the Chu2024 floor's stations and `count` random orders (RandomOrders, `seed`,
@@ -111,16 +98,6 @@ inline Stream ChuStream(const World& w, std::size_t count, std::uint64_t seed,
   auto orders = RandomOrders(*w.map, ro);
   if (!orders.ok()) throw std::runtime_error(orders.error().message);
   return {std::move(robots).value(), std::move(orders).value()};
-}
-
-// Failures a run may report: blocked with no alternative, as the controller or a formation's
-// rendezvous says.
-inline void ExpectStatedFailures(const StreamResult& r) {
-  for (const StreamOrderOutcome& o : r.orders) {
-    if (!o.completed) {
-      EXPECT_EQ(o.failure.rfind("blocked: ", 0), 0u) << o.order_id << ": " << o.failure;
-    }
-  }
 }
 
 // Small dense grids: every lane a bidirectional single lane, picks and drops inside one-cell
@@ -146,46 +123,6 @@ inline const std::vector<std::string>& DenseGrids() {
       "............\n"
       "S..S..S..S..\n"};
   return maps;
-}
-
-// Liveness on DenseGrids(): 4, 6 and 8 robots, seeds 1..5, 40 random orders each (a
-// `formation_share` of them formation orders). Every run is safe (eps1, no crossings),
-// sane, nothing runs into the time limit, and every order that fails says it was blocked.
-// Returns (completed, total) over all runs.
-inline std::pair<std::size_t, std::size_t> DenseGridLiveness(double formation_share) {
-  std::size_t total = 0, completed = 0;
-  for (const std::string& rows : DenseGrids()) {
-    const World w = GridWorld(rows);
-    for (std::size_t n : {4u, 6u, 8u}) {
-      for (std::uint64_t seed = 1; seed <= 5; ++seed) {
-        SCOPED_TRACE("robots " + std::to_string(n) + " seed " + std::to_string(seed));
-        auto robots = PlaceRobots(*w.map, n);
-        EXPECT_TRUE(robots.ok());
-        RandomOrderOptions ro;
-        ro.count = 40;
-        ro.seed = seed;
-        ro.interval = 2.0;
-        ro.formation_share = formation_share;
-        auto orders = RandomOrders(*w.map, ro);
-        EXPECT_TRUE(orders.ok());
-        if (!robots.ok() || !orders.ok()) continue;
-        StreamConfig c;
-        c.max_time = 2000;
-        c.record_series = false;
-        c.check_safety = true;
-        auto r = SimulateOrderStream(w.map, w.routes, *robots, *orders, c);
-        EXPECT_TRUE(r.ok()) << r.error().message;
-        if (!r.ok()) continue;
-        ExpectSafe(*r);
-        ExpectSane(w, *orders, *r, c);
-        ExpectStatedFailures(*r);
-        EXPECT_GE(r->overall_min_distance, 0.6 - 1e-9);  // point clearance (eps1)
-        total += r->orders.size();
-        completed += r->completed;
-      }
-    }
-  }
-  return {completed, total};
 }
 
 }  // namespace dispatch::engine::testing
