@@ -179,10 +179,10 @@ int Main(int argc, char** argv) {
       }
       auto loaded = LoadOrderFile(file, prefix);
       if (!loaded.ok()) {
-        std::fprintf(stderr, "wmsctl: %s\n", loaded.error().message.c_str());
+        std::fprintf(stderr, "wmsctl: %s\n", loaded.error.c_str());
         return 1;
       }
-      requests = std::move(loaded).value();
+      requests = std::move(loaded.orders);
     } else {
       if (picks.empty() || drop.empty()) {
         std::fprintf(stderr, "wmsctl: submit needs a FILE, or --pick (at least one) and --drop\n");

@@ -14,9 +14,9 @@ const std::string kShared = DISPATCH_SHARED_DIR;
 
 TEST(OrderFileTest, SeedTable1AsItIs) {
   auto orders = LoadOrderFile(kShared + "/scenarios/chu2024-table1.csv");
-  ASSERT_TRUE(orders.ok()) << orders.error().message;
-  ASSERT_EQ(orders->size(), 6u);
-  const v1::SubmitOrderRequest& t1 = (*orders)[0];
+  ASSERT_TRUE(orders.ok()) << orders.error;
+  ASSERT_EQ(orders.orders.size(), 6u);
+  const v1::SubmitOrderRequest& t1 = orders.orders[0];
   EXPECT_EQ(t1.client_order_id(), "chu2024-table1-1");
   EXPECT_TRUE(t1.formation());
   ASSERT_EQ(t1.picks_size(), 2);
@@ -26,17 +26,17 @@ TEST(OrderFileTest, SeedTable1AsItIs) {
   EXPECT_EQ(t1.drop().position().x(), 6.5);
   EXPECT_EQ(t1.drop().position().y(), 2.75);
   EXPECT_FALSE(t1.has_work_time());  // the server's default
-  EXPECT_FALSE((*orders)[3].formation());
-  EXPECT_EQ((*orders)[3].picks_size(), 3);
+  EXPECT_FALSE(orders.orders[3].formation());
+  EXPECT_EQ(orders.orders[3].picks_size(), 3);
 }
 
 TEST(OrderFileTest, SameFileGivesTheSameClientIds) {
   auto a = LoadOrderFile(kShared + "/scenarios/chu2024-table2.csv");
   auto b = LoadOrderFile(kShared + "/scenarios/chu2024-table2.csv", "x-");
   ASSERT_TRUE(a.ok() && b.ok());
-  ASSERT_EQ(a->size(), b->size());
-  EXPECT_EQ((*a)[7].client_order_id(), "chu2024-table2-8");
-  EXPECT_EQ((*b)[7].client_order_id(), "x-8");
+  ASSERT_EQ(a.orders.size(), b.orders.size());
+  EXPECT_EQ(a.orders[7].client_order_id(), "chu2024-table2-8");
+  EXPECT_EQ(b.orders[7].client_order_id(), "x-8");
 }
 
 TEST(OrderFileTest, JsonOrdersWithNamesAndCoordinates) {
@@ -45,9 +45,9 @@ TEST(OrderFileTest, JsonOrdersWithNamesAndCoordinates) {
        "drop": {"point": "D-T3"}, "formation": true, "work_time": 3, "release_time": 30},
       {"picks": ["P1"], "drop": {"x": 6.5, "y": 2.75}}])",
                                true, "file-");
-  ASSERT_TRUE(orders.ok()) << orders.error().message;
-  ASSERT_EQ(orders->size(), 2u);
-  const auto& a = (*orders)[0];
+  ASSERT_TRUE(orders.ok()) << orders.error;
+  ASSERT_EQ(orders.orders.size(), 2u);
+  const auto& a = orders.orders[0];
   EXPECT_EQ(a.client_order_id(), "A-1");
   EXPECT_EQ(a.priority(), 2);
   EXPECT_TRUE(a.formation());
@@ -55,10 +55,10 @@ TEST(OrderFileTest, JsonOrdersWithNamesAndCoordinates) {
   EXPECT_EQ(a.release_time(), 30.0);
   EXPECT_EQ(a.picks(1).point_name(), "K2-4-3S");
   EXPECT_EQ(a.drop().point_name(), "D-T3");
-  EXPECT_EQ((*orders)[1].client_order_id(), "file-2");
+  EXPECT_EQ(orders.orders[1].client_order_id(), "file-2");
   auto single = ParseOrderText(R"({"picks": ["P1"], "drop": "D1"})", true, "s-");
   ASSERT_TRUE(single.ok());
-  EXPECT_EQ(single->size(), 1u);
+  EXPECT_EQ(single.orders.size(), 1u);
 }
 
 TEST(OrderFileTest, BadFilesNameTheProblem) {
@@ -82,12 +82,12 @@ TEST(OrderFileTest, BadFilesNameTheProblem) {
   for (const Case& c : cases) {
     auto r = ParseOrderText(c.text, c.json, "p-");
     ASSERT_FALSE(r.ok()) << c.text;
-    EXPECT_NE(r.error().message.find(c.expect), std::string::npos)
-        << c.text << " -> " << r.error().message;
+    EXPECT_NE(r.error.find(c.expect), std::string::npos)
+        << c.text << " -> " << r.error;
   }
   auto missing = LoadOrderFile("/nonexistent/orders.csv");
   ASSERT_FALSE(missing.ok());
-  EXPECT_NE(missing.error().message.find("/nonexistent/orders.csv"), std::string::npos);
+  EXPECT_NE(missing.error.find("/nonexistent/orders.csv"), std::string::npos);
 }
 
 TEST(OrderFileTest, StopArguments) {
