@@ -63,9 +63,9 @@ struct GateBot {
   // The team it left (at point former_at), until it has driven out of the team's envelope.
   std::string former_team;
   PointId former_at = kNoPoint;
-  // The team it had left before former_team, while it had not driven off from that one either
-  // (a member of two teams in turn at one rendezvous); cleared with former_team.
-  std::string older_former;
+  // The teams it had left before former_team, while it had not driven off from those either
+  // (a member of several teams in turn at one place), newer first; cleared with former_team.
+  std::string older_former, oldest_former;
   std::uint64_t leave_seq = 0;  // leaving a team: the waypoint it was placed at (to reach first)
   // The team it counted as one with (TeamKeys()[0]) when its controller groups were last set.
   std::string approach;
@@ -199,9 +199,11 @@ struct GateImpl {
   static std::optional<TeamSpan> FindSpan(const GateBot& b, const std::string& order);
   long NextJoin(const GateBot& b, long from, std::string* order) const;
   void Reindex(GateBot& b);  // after b.plan changed: its index, idx and spans
-  using Offset = std::function<Eigen::Vector2d(PointId from, PointId to)>;
+  // `member` >= 0: b is that slot of a moving formation (StepTeamsAfterDeadlocks): its
+  // waypoints are its slot along the route (eq. (9)), turning in place about the centre where
+  // the heading changes, as BuildFormationPlans plans them.
   long RewriteLeg(GateBot& b, long cut, const std::vector<PointId>& route, long resume, double t,
-                  std::vector<GateEffect>& out, const Offset& offset = {});
+                  std::vector<GateEffect>& out, int member = -1);
 
   // Effects.
   void Release(GateBot& b, long upto, int intersection, std::vector<GateEffect>& out);
@@ -251,9 +253,8 @@ struct GateImpl {
   void BreakTeam(GateTeam& team);
   bool DissolveTeam(GateTeam& team);  // true: gone (BreakTeam); false: it leaves (kLeaving)
   // b leaves (or never joins) `order`'s team at `at` (kNoPoint: until its next point): exempt
-  // from its members until it has driven off; a former team it still had moves to older_former,
-  // which makes way, unless one of its members still stands beside b and none of the newer
-  // one's does (then the newer one makes way).
+  // from its members until it has driven off; of the former teams it still had, two stay
+  // (older_former, oldest_former): those with a member still beside b first, then the newer.
   void BecomeFormer(GateBot& b, const std::string& order, PointId at);
   // A robot of team `order` (in it, approaching it or having left it) other than b stands
   // within the formation's envelope (eps1 + the formation's radius) of b.

@@ -6,6 +6,7 @@
 #include <optional>
 #include <cmath>
 #include <limits>
+#include <numbers>
 #include <unordered_map>
 #include <iterator>
 #include <utility>
@@ -83,12 +84,31 @@ void GateImpl::PlaceStrays() {
   }
 }
 
+namespace {
+
+// The heading of a formation whose slot `member` is `offset` from the centre (eq. (9) solved
+// for the heading).
+double HeadingOfSlot(const Eigen::Vector2d& offset, int member) {
+  const Eigen::Vector2d base = FormationOffsets(0.0)[static_cast<std::size_t>(member)];
+  return std::atan2(offset.y(), offset.x()) - std::atan2(base.y(), base.x());
+}
+
+double WrapAngle(double a) { return std::remainder(a, 2.0 * std::numbers::pi); }
+
+}  // namespace
+
 // Rewrites b's waypoints after index `cut` (-1: a new anchor too) with moves along `route`
 // (route[0] = the point it stands at), then continues with the old waypoints from `resume`
-// on (re-sequenced and re-timed; -1: none); returns the new index of `resume` (or -1). When the old waypoint at `resume` is at the
-// route's last point it stands for that point (a stop keeps its action and dwell).
+// on (re-sequenced and re-timed; -1: none); returns the new index of `resume` (or -1). When
+// the old waypoint at `resume` is at the route's last point it stands for that point (a stop
+// keeps its action and dwell). A formation member (`member` >= 0) turns in place about the
+// centre before each segment with a new heading, and at the route's end to the heading of the
+// waypoint it resumes at, in steps of at most FormationOptions::max_rotation_step, each as long
+// as its slot's arc takes at speed v: the three members' moves stay as long as each other's,
+// so they keep their triangle (members driven straight from one heading's slot to the next
+// drove legs of different lengths, and the triangle's sides ranged over 0.21-0.53 m).
 long GateImpl::RewriteLeg(GateBot& b, long cut, const std::vector<PointId>& route, long resume, double t,
-                          std::vector<GateEffect>& out, const Offset& offset) {
+                          std::vector<GateEffect>& out, int member) {
   double clock = std::max(t, cut >= 0 ? Departure(b, cut) : t);
   // The plan is rebuilt from its old self, taken out (not copied).
   const std::vector<Waypoint> old = std::move(b.plan.waypoints);
@@ -102,24 +122,54 @@ long GateImpl::RewriteLeg(GateBot& b, long cut, const std::vector<PointId>& rout
                                  ? static_cast<std::uint64_t>(old[static_cast<std::size_t>(cut + 1)].seq)
                                  : b.plan.next_sequence;
   const std::string order = resume >= 0 ? old_orders[static_cast<std::size_t>(resume)] : std::string();
-  auto move = [&](PointId p, PointId prev) {
+  const bool team = member >= 0 && cut >= 0;
+  const double speed = std::max(1e-6, config.speed);
+  // A formation's heading: as its slot at the cut says, then each segment's.
+  double heading = 0.0;
+  if (team) {
+    const Waypoint& c = old[static_cast<std::size_t>(cut)];
+    heading = HeadingOfSlot(c.xy - map->point(c.point).position, member);
+  }
+  auto move = [&](PointId p) {
     Waypoint m;
     m.seq = static_cast<int>(b.plan.next_sequence++);
     m.point = p;
-    m.xy = map->point(p).position + (offset ? offset(prev, p) : Eigen::Vector2d::Zero());
+    m.xy = map->point(p).position;
+    if (team) m.xy += FormationOffsets(heading)[static_cast<std::size_t>(member)];
     m.eta = clock;
     m.action = WaypointAction::kMove;
     w.push_back(m);
     ow.push_back(w.size() == 1 ? std::string() : order);
   };
-  if (cut < 0) move(route.front(), route.front());  // the anchor: where it stands
+  auto turn = [&](PointId p, double to) {  // in place about the centre at p
+    const double delta = WrapAngle(to - heading);
+    if (!team || std::abs(delta) <= 1e-6) return;
+    const FormationOptions options;
+    const int steps = std::max(1, static_cast<int>(std::ceil(std::abs(delta) / options.max_rotation_step - 1e-9)));
+    const double start = heading;
+    for (int s = 1; s <= steps; ++s) {
+      clock += FormationRadius() * std::abs(delta) / steps / speed;
+      heading = start + delta * s / steps;
+      move(p);
+    }
+    heading = to;
+  };
+  if (cut < 0) move(route.front());  // the anchor: where it stands
   Eigen::Vector2d at = map->point(route.front()).position;
   for (std::size_t k = 1; k < route.size(); ++k) {
     const Eigen::Vector2d xy = map->point(route[k]).position;
-    clock += (xy - at).norm() / std::max(1e-6, config.speed);
+    if ((xy - at).norm() > 1e-9) turn(route[k - 1], std::atan2(xy.y() - at.y(), xy.x() - at.x()));
+    clock += (xy - at).norm() / speed;
     at = xy;
-    if (k + 1 == route.size() && resume >= 0 && old[static_cast<std::size_t>(resume)].point == route[k]) break;
-    move(route[k], route[k - 1]);
+    if (k + 1 == route.size() && resume >= 0 && old[static_cast<std::size_t>(resume)].point == route[k]) {
+      const Waypoint& r = old[static_cast<std::size_t>(resume)];
+      const double resumed_heading = team ? HeadingOfSlot(r.xy - map->point(r.point).position, member) : heading;
+      if (!team || std::abs(WrapAngle(resumed_heading - heading)) <= 1e-6) break;
+      move(route[k]);  // arrive, then turn to the heading the plan resumes with
+      turn(route[k], resumed_heading);
+      break;
+    }
+    move(route[k]);
   }
   const long resumed = resume >= 0 ? static_cast<long>(w.size()) : -1;
   if (resume >= 0) {
@@ -405,6 +455,7 @@ void GateImpl::OnReached(GateBot& b, std::uint64_t seq, double t) {
           teammates_out() && none_beside()) {
         b.former_team.clear();
         b.older_former.clear();
+        b.oldest_former.clear();
         ctl.SetEnvelope(r, 0.0);
       }
     }
@@ -433,7 +484,8 @@ GateTeamKeys GateImpl::TeamKeys(const GateBot& b) const {
   // member of two broken-up teams in turn that was given its next formation dropped the older
   // one and was 0.400 m from a teammate of that team still standing in its slot.
   std::size_t n = 0;
-  for (const std::string* k : {current, &b.former_team, &b.older_former}) {
+  for (const std::string* k : {current, &b.former_team, &b.older_former, &b.oldest_former}) {
+    if (n == keys.size()) break;
     const auto end = keys.begin() + static_cast<std::ptrdiff_t>(n);
     if (!k->empty() && std::find(keys.begin(), end, *k) == end) keys[n++] = *k;
   }

@@ -330,7 +330,8 @@ void GateImpl::StepTeams(double t, std::vector<GateEffect>& out) {
 }
 
 // A detour of a moving team (head-on, timeouts, deadlocks): every member's waypoints follow
-// the new centre route with its rigid offset (eq. (9)) for each segment's heading.
+// the new centre route with its rigid offset (eq. (9)) for each segment's heading, turning in
+// place where the heading changes (RewriteLeg).
 void GateImpl::StepTeamsAfterDeadlocks(double t, std::vector<GateEffect>& out) {
   for (auto& [order, team] : teams) {
     if (team.phase != GateTeam::Phase::kMoving || team.ctl < 0) continue;
@@ -355,13 +356,8 @@ void GateImpl::StepTeamsAfterDeadlocks(double t, std::vector<GateEffect>& out) {
       const bool to_stop = stop > rk && stop < length &&
                            bot.plan.waypoints[static_cast<std::size_t>(span->first_pick + stop)].point == route.back();
       const long resume = to_stop ? span->first_pick + stop : span->first_pick + rk + 1;
-      const Offset offset = [this, i](PointId from, PointId to) {
-        const Eigen::Vector2d d = map->point(to).position - map->point(from).position;
-        const double heading = d.norm() > 1e-9 ? std::atan2(d.y(), d.x()) : 0.0;
-        return FormationOffsets(heading)[i];
-      };
       RewriteLeg(bot, span->first_pick + rk, route, resume < static_cast<long>(bot.plan.waypoints.size()) ? resume : -1,
-                 t, out, offset);
+                 t, out, static_cast<int>(i));
     }
     // The new stop's formation index is the same for every member (same rewrite).
     auto lead = bots.find(team.members.front());
