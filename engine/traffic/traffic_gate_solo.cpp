@@ -1,7 +1,7 @@
-// TrafficGate's solo agents: placing robots on the floor, their legs (requests, adopted and
-// rewritten routes), reaching waypoints, and their team keys. Formations
-// are in traffic_gate_teams.cpp, the public interface in traffic_gate.cpp, the shared state in
-// traffic_gate_impl.h.
+// TrafficGate's solo agents: placing robots on the floor, their legs (requests, adopted
+// routes), reaching waypoints, and their team keys. Rewriting a plan is in
+// traffic_gate_rewrite.cpp, formations in traffic_gate_teams.cpp, the public interface in
+// traffic_gate.cpp, the shared state in traffic_gate_impl.h.
 #include <algorithm>
 #include <optional>
 #include <cmath>
@@ -80,132 +80,6 @@ void GateImpl::PlaceStrays() {
       // Placed, or no longer a stray (placed elsewhere, in a team again).
       if (bot != bots.end() && bot->second.ctl >= 0) ctl.ClearStanding(static_cast<std::size_t>(bot->second.ctl));
       it = strays.erase(it);
-    }
-  }
-}
-
-namespace {
-
-// The heading of a formation whose slot `member` is `offset` from the centre (eq. (9) solved
-// for the heading).
-double HeadingOfSlot(const Eigen::Vector2d& offset, int member) {
-  const Eigen::Vector2d base = FormationOffsets(0.0)[static_cast<std::size_t>(member)];
-  return std::atan2(offset.y(), offset.x()) - std::atan2(base.y(), base.x());
-}
-
-double WrapAngle(double a) { return std::remainder(a, 2.0 * std::numbers::pi); }
-
-}  // namespace
-
-// Rewrites b's waypoints after index `cut` (-1: a new anchor too) with moves along `route`
-// (route[0] = the point it stands at), then continues with the old waypoints from `resume`
-// on (re-sequenced and re-timed; -1: none); returns the new index of `resume` (or -1). When
-// the old waypoint at `resume` is at the route's last point it stands for that point (a stop
-// keeps its action and dwell). A formation member (`member` >= 0) turns in place about the
-// centre before each segment with a new heading, and at the route's end to the heading of the
-// waypoint it resumes at, in steps of at most FormationOptions::max_rotation_step, each as long
-// as its slot's arc takes at speed v: the three members' moves stay as long as each other's,
-// so they keep their triangle (members driven straight from one heading's slot to the next
-// drove legs of different lengths, and the triangle's sides ranged over 0.21-0.53 m).
-long GateImpl::RewriteLeg(GateBot& b, long cut, const std::vector<PointId>& route, long resume, double t,
-                          std::vector<GateEffect>& out, int member) {
-  double clock = std::max(t, cut >= 0 ? Departure(b, cut) : t);
-  // The plan is rebuilt from its old self, taken out (not copied).
-  const std::vector<Waypoint> old = std::move(b.plan.waypoints);
-  std::vector<std::string> old_orders = std::move(b.plan.order_of);
-  std::vector<Waypoint> w(old.begin(), old.begin() + (cut + 1));
-  std::vector<std::string> ow(std::make_move_iterator(old_orders.begin()),
-                              std::make_move_iterator(old_orders.begin() + (cut + 1)));
-  w.reserve(old.size() + route.size());
-  ow.reserve(old.size() + route.size());
-  const std::uint64_t from = cut + 1 < static_cast<long>(old.size())
-                                 ? static_cast<std::uint64_t>(old[static_cast<std::size_t>(cut + 1)].seq)
-                                 : b.plan.next_sequence;
-  const std::string order = resume >= 0 ? old_orders[static_cast<std::size_t>(resume)] : std::string();
-  const bool team = member >= 0 && cut >= 0;
-  const double speed = std::max(1e-6, config.speed);
-  // A formation's heading: as its slot at the cut says, then each segment's.
-  double heading = 0.0;
-  if (team) {
-    const Waypoint& c = old[static_cast<std::size_t>(cut)];
-    heading = HeadingOfSlot(c.xy - map->point(c.point).position, member);
-  }
-  auto move = [&](PointId p) {
-    Waypoint m;
-    m.seq = static_cast<int>(b.plan.next_sequence++);
-    m.point = p;
-    m.xy = map->point(p).position;
-    if (team) m.xy += FormationOffsets(heading)[static_cast<std::size_t>(member)];
-    m.eta = clock;
-    m.action = WaypointAction::kMove;
-    w.push_back(m);
-    ow.push_back(w.size() == 1 ? std::string() : order);
-  };
-  auto turn = [&](PointId p, double to) {  // in place about the centre at p
-    const double delta = WrapAngle(to - heading);
-    if (!team || std::abs(delta) <= 1e-6) return;
-    const FormationOptions options;
-    const int steps = std::max(1, static_cast<int>(std::ceil(std::abs(delta) / options.max_rotation_step - 1e-9)));
-    const double start = heading;
-    for (int s = 1; s <= steps; ++s) {
-      clock += FormationRadius() * std::abs(delta) / steps / speed;
-      heading = start + delta * s / steps;
-      move(p);
-    }
-    heading = to;
-  };
-  if (cut < 0) move(route.front());  // the anchor: where it stands
-  Eigen::Vector2d at = map->point(route.front()).position;
-  for (std::size_t k = 1; k < route.size(); ++k) {
-    const Eigen::Vector2d xy = map->point(route[k]).position;
-    if ((xy - at).norm() > 1e-9) turn(route[k - 1], std::atan2(xy.y() - at.y(), xy.x() - at.x()));
-    clock += (xy - at).norm() / speed;
-    at = xy;
-    if (k + 1 == route.size() && resume >= 0 && old[static_cast<std::size_t>(resume)].point == route[k]) {
-      const Waypoint& r = old[static_cast<std::size_t>(resume)];
-      const double resumed_heading = team ? HeadingOfSlot(r.xy - map->point(r.point).position, member) : heading;
-      if (!team || std::abs(WrapAngle(resumed_heading - heading)) <= 1e-6) break;
-      move(route[k]);  // arrive, then turn to the heading the plan resumes with
-      turn(route[k], resumed_heading);
-      break;
-    }
-    move(route[k]);
-  }
-  const long resumed = resume >= 0 ? static_cast<long>(w.size()) : -1;
-  if (resume >= 0) {
-    const double shift = std::max(0.0, clock - old[static_cast<std::size_t>(resume)].eta);
-    for (long i = resume; i < static_cast<long>(old.size()); ++i) {
-      Waypoint m = old[static_cast<std::size_t>(i)];
-      m.seq = static_cast<int>(b.plan.next_sequence++);
-      m.eta += shift;
-      w.push_back(m);
-      ow.push_back(std::move(old_orders[static_cast<std::size_t>(i)]));
-    }
-  }
-  b.plan.waypoints = std::move(w);
-  b.plan.order_of = std::move(ow);
-  Reindex(b);
-  GateEffect e;
-  e.kind = GateEffect::Kind::kRewrite;
-  e.robot = b.id;
-  e.waypoints = b.plan.waypoints;
-  e.from_sequence = from;
-  out.push_back(std::move(e));
-  return resumed;
-}
-
-void GateImpl::Reindex(GateBot& b) {
-  ++b.plan_version;
-  for (const Waypoint& w : b.plan.waypoints) {
-    b.plan.next_sequence = std::max<std::uint64_t>(b.plan.next_sequence, w.seq + 1);
-  }
-  b.spans.clear();
-  for (const auto& team : b.plan.teams) b.spans.emplace(team.first, FindSpan(b, team.first));
-  b.idx = -1;
-  for (long i = static_cast<long>(b.plan.waypoints.size()) - 1; i >= 0; --i) {
-    if (static_cast<std::uint64_t>(b.plan.waypoints[static_cast<std::size_t>(i)].seq) <= b.reached_seq) {
-      b.idx = i;
-      break;
     }
   }
 }
