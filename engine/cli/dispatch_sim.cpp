@@ -8,8 +8,9 @@
 //       [--formation-max-queue N] [--one-formation-per-pick true|false] [--trace R1,R2 [--trace-from T] [--trace-to T]]
 //       [--planner rules|time-windows] [--routing floyd|heat [--heat-period S]] [--turn-time S]
 //       an order stream with release times (formation orders too) on the dispatch core (the
-//       service's allocation rounds and traffic gate, robots following its messages); with --planner time-windows single-robot awards are planned through the
-//       others' time windows (Wang2019, window_awards.h).
+//       service's allocation rounds and traffic gate, robots following its messages); with
+//       --planner time-windows single-robot awards are planned through the others' time
+//       windows (Wang2019, window_awards.h).
 //   dispatch-sim compare [--random 200 --seed 1 --robots 18 --map chu2024]
 //       [--planners rules,time-windows] [--routings floyd,heat] [--strategy S] [--zeta Z]
 //       auction zeta=100, auction zeta=0 and greedy on one random stream (issue 4 §4), or the

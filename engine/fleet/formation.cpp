@@ -9,12 +9,6 @@
 namespace dispatch::engine {
 namespace {
 
-// Wraps an angle to (-pi, pi].
-double WrapAngle(double a) {
-  a = std::remainder(a, 2.0 * std::numbers::pi);
-  return a <= -std::numbers::pi ? a + 2.0 * std::numbers::pi : a;
-}
-
 // A member's own leg from `start` to the first pick point: waypoint 0 at `start`, every
 // route point after it as a move. Returns the arrival time at the pick point.
 Result<double> AppendRendezvousLeg(const WarehouseMap& map, const RouteTable& routes,
@@ -53,6 +47,25 @@ FormationOffsetArray FormationOffsets(double heading, const FormationOptions& op
     offsets[static_cast<std::size_t>(i)] = Eigen::Rotation2Dd(theta) * Eigen::Vector2d(d_f, 0.0);
   }
   return offsets;
+}
+
+double FormationHeadingOfSlot(const Eigen::Vector2d& offset, int member, const FormationOptions& options) {
+  const Eigen::Vector2d base = FormationOffsets(0.0, options)[static_cast<std::size_t>(member)];
+  return std::atan2(offset.y(), offset.x()) - std::atan2(base.y(), base.x());
+}
+
+double WrapAngle(double a) {
+  a = std::remainder(a, 2.0 * std::numbers::pi);
+  return a <= -std::numbers::pi ? a + 2.0 * std::numbers::pi : a;
+}
+
+FormationTurn PlanFormationTurn(double delta, double speed, const FormationOptions& options) {
+  const double angle = std::abs(WrapAngle(delta));
+  if (angle <= 1e-9) return {};
+  FormationTurn turn;
+  turn.steps = std::max(1, static_cast<int>(std::ceil(angle / options.max_rotation_step - 1e-9)));
+  turn.step_time = FormationRadius(options) * angle / turn.steps / speed;
+  return turn;
 }
 
 Result<FormationPlans> BuildFormationPlans(const WarehouseMap& map, const RouteTable& routes,
@@ -136,10 +149,8 @@ Result<FormationPlans> BuildFormationPlans(const WarehouseMap& map, const RouteT
     const Eigen::Vector2d d = track[k + 1].xy - track[k].xy;
     if (d.norm() <= 1e-9) continue;
     const double delta = WrapAngle(std::atan2(d.y(), d.x()) - heading);
-    if (std::abs(delta) <= 1e-9) continue;
-    const double turns = std::abs(delta) / options.max_rotation_step;
-    const int steps = std::max(1, static_cast<int>(std::ceil(turns - 1e-9)));
-    const double step_time = d_f * std::abs(delta) / steps / speed;
+    const auto [steps, step_time] = PlanFormationTurn(delta, speed, options);
+    if (steps == 0) continue;
     Waypoint turn;
     turn.point = w.point;
     turn.xy = w.xy;

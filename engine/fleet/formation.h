@@ -49,6 +49,22 @@ double FormationRadius(const FormationOptions& options = {});
 // D_f * (cos theta_i, sin theta_i), via Eigen::Rotation2Dd.
 FormationOffsetArray FormationOffsets(double heading, const FormationOptions& options = {});
 
+// The structure heading at which member `member` is `offset` from the centre (eq. (9) solved
+// for the heading; not wrapped).
+double FormationHeadingOfSlot(const Eigen::Vector2d& offset, int member, const FormationOptions& options = {});
+
+// Wraps an angle to (-pi, pi].
+double WrapAngle(double a);
+
+// A turn in place about the centre by `delta` radians (wrapped): `steps` steps of at most
+// max_rotation_step each, each taking `step_time` s, the members' arc (D_f * angle) at
+// `speed`. steps = 0 for no turn.
+struct FormationTurn {
+  int steps = 0;
+  double step_time = 0.0;
+};
+FormationTurn PlanFormationTurn(double delta, double speed, const FormationOptions& options = {});
+
 struct FormationPlans {
   Plan centre;                   // the virtual centre's plan, from T_r on
   std::vector<double> headings;  // structure heading at each centre waypoint

@@ -45,14 +45,13 @@ int TrafficController::Impl::CorridorBlocker(int c, int d, std::size_t r) const 
   // Inside a one-robot corridor already, r may drive on away from holders behind it (found on
   // a dense grid: an idle robot inside such a corridor could not step aside for a formation,
   // the corridor held by one that waited for that formation behind it).
-  long mine = -1;
   const auto& points = lanes.corridors[static_cast<std::size_t>(c)].points;
   auto index = [&](PointId p) {
     const auto it = std::find(points.begin(), points.end(), p);
     return it == points.end() ? -1L : static_cast<long>(it - points.begin());
   };
   const PointId at = robots[r].at;
-  if (s.exclusive && at >= 0 && lanes.interior_of[static_cast<std::size_t>(at)] == c) mine = index(at);
+  const long mine = s.exclusive && at >= 0 && lanes.interior_of[static_cast<std::size_t>(at)] == c ? index(at) : -1;
   for (int h : s.holders) {
     const RobotState& o = robots[static_cast<std::size_t>(h)];
     // A teammate (a member leaving its team's agent) is exempt, as in PointBlocker.

@@ -5,7 +5,6 @@
 #include <algorithm>
 #include <cmath>
 #include <iterator>
-#include <numbers>
 #include <string>
 #include <vector>
 
@@ -13,19 +12,6 @@
 #include "engine/traffic/traffic_gate_impl.h"
 
 namespace dispatch::engine {
-
-namespace {
-
-// The heading of a formation whose slot `member` is `offset` from the centre (eq. (9) solved
-// for the heading).
-double HeadingOfSlot(const Eigen::Vector2d& offset, int member) {
-  const Eigen::Vector2d base = FormationOffsets(0.0)[static_cast<std::size_t>(member)];
-  return std::atan2(offset.y(), offset.x()) - std::atan2(base.y(), base.x());
-}
-
-double WrapAngle(double a) { return std::remainder(a, 2.0 * std::numbers::pi); }
-
-}  // namespace
 
 // Rewrites b's waypoints after index `cut` (-1: a new anchor too) with moves along `route`
 // (route[0] = the point it stands at), then continues with the old waypoints from `resume`
@@ -58,7 +44,7 @@ long GateImpl::RewriteLeg(GateBot& b, long cut, const std::vector<PointId>& rout
   double heading = 0.0;
   if (team) {
     const Waypoint& c = old[static_cast<std::size_t>(cut)];
-    heading = HeadingOfSlot(c.xy - map->point(c.point).position, member);
+    heading = FormationHeadingOfSlot(c.xy - map->point(c.point).position, member);
   }
   auto move = [&](PointId p) {
     Waypoint m;
@@ -73,13 +59,12 @@ long GateImpl::RewriteLeg(GateBot& b, long cut, const std::vector<PointId>& rout
   };
   auto turn = [&](PointId p, double to) {  // in place about the centre at p
     const double delta = WrapAngle(to - heading);
-    if (!team || std::abs(delta) <= 1e-6) return;
-    const FormationOptions options;
-    const int steps = std::max(1, static_cast<int>(std::ceil(std::abs(delta) / options.max_rotation_step - 1e-9)));
+    if (!team || std::abs(delta) <= 1e-6) return;  // the same for every member (heading noise)
+    const FormationTurn rotation = PlanFormationTurn(delta, speed);
     const double start = heading;
-    for (int s = 1; s <= steps; ++s) {
-      clock += FormationRadius() * std::abs(delta) / steps / speed;
-      heading = start + delta * s / steps;
+    for (int s = 1; s <= rotation.steps; ++s) {
+      clock += rotation.step_time;
+      heading = start + delta * s / rotation.steps;
       move(p);
     }
     heading = to;
@@ -93,7 +78,7 @@ long GateImpl::RewriteLeg(GateBot& b, long cut, const std::vector<PointId>& rout
     at = xy;
     if (k + 1 == route.size() && resume >= 0 && old[static_cast<std::size_t>(resume)].point == route[k]) {
       const Waypoint& r = old[static_cast<std::size_t>(resume)];
-      const double resumed_heading = team ? HeadingOfSlot(r.xy - map->point(r.point).position, member) : heading;
+      const double resumed_heading = team ? FormationHeadingOfSlot(r.xy - map->point(r.point).position, member) : heading;
       if (!team || std::abs(WrapAngle(resumed_heading - heading)) <= 1e-6) break;
       move(route[k]);  // arrive, then turn to the heading the plan resumes with
       turn(route[k], resumed_heading);
