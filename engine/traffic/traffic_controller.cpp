@@ -255,6 +255,10 @@ int TrafficController::WaitsOn(std::size_t r) const {
   const RobotState& x = impl_->robots.at(r);
   return x.wait == WaitKind::kNone ? -1 : x.waits_on;
 }
+double TrafficController::WaitedFor(std::size_t r, double t) const {
+  const RobotState& x = impl_->robots.at(r);
+  return x.wait == WaitKind::kNone ? 0.0 : t - x.wait_start;
+}
 void TrafficController::WaitOn(std::size_t r, int other, double t, const std::string& why) {
   RobotState& x = impl_->robots.at(r);
   if (other < 0 || static_cast<std::size_t>(other) >= impl_->robots.size() || static_cast<std::size_t>(other) == r) {

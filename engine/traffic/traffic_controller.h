@@ -33,7 +33,8 @@
 //    to a free neighbouring point and re-plans from there (a member that could not act is
 //    retried after 1 s; detours are bounded to blocked_after beyond the current route's
 //    cost, A* with the straight-line heuristic). An idle robot (no route) that
-//    somebody waits for is sent to a siding off the waiter's route (StepAside, "nudge").
+//    somebody waits for is sent to a siding off the waiter's route (StepAside, "nudge"), else
+//    backs off, else an idle robot boxing it in steps aside first (MakeRoom).
 //
 // Costs: Request/Arrived are O(route look-ahead + clearance neighbours); ResolveDeadlocks is
 // O(robots); detours run one bounded A* over the map (reused buffers). No all-pairs work.
@@ -197,6 +198,8 @@ class TrafficController {
   int BlockerOf(PointId p, std::size_t r, double envelope) const;
   // The robot r waits on (see ResolveDeadlocks), or -1 when it does not wait.
   int WaitsOn(std::size_t r) const;
+  // Seconds r has waited at `t` in its current wait (0 when it does not wait).
+  double WaitedFor(std::size_t r, double t) const;
   // A wait the owner sees and the controller cannot: robot r (standing, no route: e.g. a
   // formation's agent waiting for a member to arrive, or for a point to put a member on) waits
   // on robot `other` since t (-1: no longer). ResolveDeadlocks then breaks cycles through it

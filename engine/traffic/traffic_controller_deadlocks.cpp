@@ -289,6 +289,27 @@ bool TrafficController::Impl::StepAside(std::size_t r, const std::vector<PointId
   return false;
 }
 
+bool TrafficController::Impl::StandingIdle(std::size_t r) const {
+  const RobotState& y = robots[r];
+  return y.idle && !y.removed && !y.working && y.next == kNoPoint && y.pos + 1 >= y.route.size();
+}
+
+// Found on the Wang2019 grid: a robot done at a corner drop stood boxed in by two idle robots
+// that had stepped aside next to the drop and by the robot waiting to drop there; none could
+// move, and the waiting robot was blocked.
+bool TrafficController::Impl::MakeRoom(std::size_t h, const std::vector<PointId>& keep) {
+  std::vector<PointId> clear = keep;
+  clear.push_back(robots[h].at);
+  for (ArcId a : M().out_arcs(robots[h].at)) {
+    const int q = PointBlocker(M().arc(a).to, h);
+    if (q < 0 || static_cast<std::size_t>(q) == h || !StandingIdle(static_cast<std::size_t>(q))) continue;
+    clear.push_back(robots[static_cast<std::size_t>(q)].at);  // it leaves that point too
+    if (StepAside(static_cast<std::size_t>(q), clear)) return true;
+    clear.pop_back();
+  }
+  return false;
+}
+
 bool TrafficController::Impl::BreakCycle(const std::vector<std::size_t>& members, double t) {
   std::vector<std::size_t> order = members;
   std::sort(order.begin(), order.end(),
@@ -336,16 +357,14 @@ std::size_t TrafficController::Impl::ResolveDeadlocks(double t) {
       // The chain ends at a robot that does not wait: nudge it aside if it is idle.
       const std::size_t h = path.back();
       const RobotState& w = robots[path[path.size() - 2]];
-      RobotState& y = robots[h];
-      if (y.idle && !y.removed && !y.working && y.next == kNoPoint &&
-          y.pos + 1 >= y.route.size()) {
+      if (StandingIdle(h)) {
         std::vector<PointId> keep(w.route.begin() + static_cast<std::ptrdiff_t>(w.pos),
                                   w.route.end());
         if (StepAside(h, keep)) {
           ++stats.nudges;
         } else {
           const PointId want = w.pos + 1 < w.route.size() ? w.route[w.pos + 1] : kNoPoint;
-          if (TryBackOff(h, w.at, want)) ++stats.nudges;
+          if (TryBackOff(h, w.at, want) || MakeRoom(h, keep)) ++stats.nudges;
         }
       }
     }

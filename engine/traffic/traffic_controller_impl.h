@@ -267,6 +267,10 @@ struct TrafficController::Impl {
   bool TryBackOff(std::size_t r, PointId avoid, PointId ban_point);
   bool Siding(PointId p) const;
   bool StepAside(std::size_t r, const std::vector<PointId>& keep_clear);
+  // An idle robot standing next to idle robot h steps aside (keeping `keep` and h's point
+  // clear), so that h can move next; false when none can.
+  bool MakeRoom(std::size_t h, const std::vector<PointId>& keep);
+  bool StandingIdle(std::size_t r) const;
   bool BreakCycle(const std::vector<std::size_t>& members, double t);
   std::size_t ResolveDeadlocks(double t);
 };

@@ -77,6 +77,15 @@ long GateImpl::RunEnd(const GateBot& b, long from, PointId p, long limit) {
   return j;
 }
 
+long GateImpl::GrantedRunEnd(const GateBot& b, PointId at, PointId next) {
+  // A robot nudged before it ever had a plan gets one whose anchor (where it stands) it has
+  // not reported: released from the run at `next` on only, it stood granted and unreleased for
+  // ever, holding its corridor (found on the Wang2019 grid: an idle robot nudged into the
+  // drop corridor of a corner blocked every robot bound for that drop).
+  const long last = static_cast<long>(b.plan.waypoints.size()) - 1;
+  return RunEnd(b, RunEnd(b, b.idx + 1, at, last) + 1, next, last);
+}
+
 double GateImpl::Departure(const GateBot& b, long i) const {
   if (i < 0) return 0.0;
   const Waypoint& w = b.plan.waypoints[static_cast<std::size_t>(i)];

@@ -4,6 +4,7 @@
 // stays exempt from whom afterwards (BecomeFormer, TeammateBeside). The teams' other phases are
 // in traffic_gate_teams.cpp.
 #include <algorithm>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -26,7 +27,16 @@ void GateImpl::BecomeFormer(GateBot& b, const std::string& order, PointId at) {
   for (const std::string* o : {&b.former_team, &b.older_former, &b.oldest_former}) {
     if (!o->empty() && *o != order && std::find(kept.begin(), kept.end(), *o) == kept.end()) kept.push_back(*o);
   }
-  std::stable_partition(kept.begin(), kept.end(), [&](const std::string& o) { return TeammateBeside(b, o); });
+  // Closer than eps1 first: dropping that team makes the two strangers standing too close
+  // (found by the core's safety check, Tables 1+2 x10 with the paper's formation settings: a
+  // member with many formations queued was in three more teams that broke up at once, each
+  // with a member within the envelope, and dropped the one whose member stood 0.400 m away).
+  auto rank = [&](const std::string& o) {
+    const double d = TeammateDistance(b, o);
+    return d < config.point_clearance - 1e-9 ? 0 : (d < config.point_clearance + FormationRadius() - 1e-9 ? 1 : 2);
+  };
+  std::stable_sort(kept.begin(), kept.end(),
+                   [&](const std::string& x, const std::string& y) { return rank(x) < rank(y); });
   kept.resize(std::min<std::size_t>(kept.size(), 2));
   b.older_former = kept.size() > 0 ? kept[0] : std::string();
   b.oldest_former = kept.size() > 1 ? kept[1] : std::string();
@@ -35,16 +45,20 @@ void GateImpl::BecomeFormer(GateBot& b, const std::string& order, PointId at) {
 }
 
 bool GateImpl::TeammateBeside(const GateBot& b, const std::string& order) const {
-  if (!b.has_xy) return false;
-  const double envelope = config.point_clearance + FormationRadius();
+  return TeammateDistance(b, order) < config.point_clearance + FormationRadius() - 1e-9;
+}
+
+double GateImpl::TeammateDistance(const GateBot& b, const std::string& order) const {
+  double best = std::numeric_limits<double>::infinity();
+  if (!b.has_xy) return best;
   for (const auto& [id, o] : bots) {
-    if (&o == &b || !o.has_xy || (o.xy - b.xy).norm() >= envelope - 1e-9) continue;
+    if (&o == &b || !o.has_xy) continue;
     if (o.team == order || o.former_team == order || o.older_former == order || o.oldest_former == order ||
         o.approach == order) {
-      return true;
+      best = std::min(best, (o.xy - b.xy).norm());
     }
   }
-  return false;
+  return best;
 }
 
 bool GateImpl::DissolveTeam(GateTeam& team) {

@@ -58,6 +58,10 @@ struct GateBot {
   bool resume_pending = false;  // reconnected: resend Resume if it was held
   bool blocked = false;   // kBlocked reported for the current wait
   bool stepped_aside = false;
+  // Since when it has found the rendezvous point of formation `forming` occupied (JoinTeam),
+  // and when it last tried (a try after a pause starts the clock again).
+  std::string forming;
+  double forming_since = 0.0, forming_last = 0.0;
   PointId home = kNoPoint;  // the parking point it first connected at
   std::string team;       // the formation order whose team it has joined ("": none)
   // The team it left (at point former_at), until it has driven out of the team's envelope.
@@ -192,6 +196,10 @@ struct GateImpl {
   // Last index of the run of waypoints at point p starting at `from` (at most `limit`);
   // from - 1 when waypoint `from` is not at p.
   static long RunEnd(const GateBot& b, long from, PointId p, long limit);
+  // How far a solo robot granted `next` (from the point `at` it stands on) is released: the
+  // waypoints still ahead of it at `at` (a rewrite's anchor there, not yet reported), then the
+  // run at `next`.
+  static long GrantedRunEnd(const GateBot& b, PointId at, PointId next);
   double Departure(const GateBot& b, long i) const;
   static bool IsStop(const Waypoint& w);
   // The formation segment of `order` in b's plan (from b.spans for its formation orders).
@@ -210,6 +218,8 @@ struct GateImpl {
   // A kRelease of b's current horizon (a Resume when it was held).
   void SendRelease(GateBot& b, int intersection, std::vector<GateEffect>& out);
   void Hold(GateBot& b, const std::string& why, std::vector<GateEffect>& out);
+  // Reports b blocked (once per blocked spell) and holds it: `why` names what it waits for.
+  void Block(GateBot& b, const std::string& why, std::vector<GateEffect>& out);
 
   // Solo agents (traffic_gate_solo.cpp).
   bool OnFloor(const GateBot& b) const;
@@ -254,11 +264,14 @@ struct GateImpl {
   bool DissolveTeam(GateTeam& team);  // true: gone (BreakTeam); false: it leaves (kLeaving)
   // b leaves (or never joins) `order`'s team at `at` (kNoPoint: until its next point): exempt
   // from its members until it has driven off; of the former teams it still had, two stay
-  // (older_former, oldest_former): those with a member still beside b first, then the newer.
+  // (older_former, oldest_former): those with a member closer to b than eps1 first, then
+  // those with one beside it (TeammateBeside), then the newer.
   void BecomeFormer(GateBot& b, const std::string& order, PointId at);
   // A robot of team `order` (in it, approaching it or having left it) other than b stands
   // within the formation's envelope (eps1 + the formation's radius) of b.
   bool TeammateBeside(const GateBot& b, const std::string& order) const;
+  // The distance from b to the nearest other robot of team `order` (infinity: none known).
+  double TeammateDistance(const GateBot& b, const std::string& order) const;
   bool StepLeaving(GateTeam& team, double t, std::vector<GateEffect>& out);  // traffic_gate_leaving.cpp
 };
 

@@ -110,7 +110,7 @@ void GateImpl::StepSolo(GateBot& b, double t, std::vector<GateEffect>& out) {
       if (!b.former_team.empty() && !strays.empty()) PlaceStrays();  // a teammate's slot may be at the point it left
     }
     if (b.left && b.run_next == next && b.run_idx == b.idx && b.run_version == b.plan_version) return;
-    Release(b, RunEnd(b, b.idx + 1, next, n), map->IntersectionOf(next), out);
+    Release(b, GrantedRunEnd(b, ctl.At(r), next), map->IntersectionOf(next), out);
     if (b.left) {  // released up to the run at next: the same again would change nothing
       b.run_next = next;
       b.run_idx = b.idx;
@@ -227,8 +227,7 @@ void GateImpl::RequestSolo(GateBot& b, double t, std::vector<GateEffect>& out) {
       b.left = false;
       b.blocked = false;
       const PointId next = ctl.Next(r);
-      Release(b, RunEnd(b, b.idx + 1, next, static_cast<long>(b.plan.waypoints.size()) - 1),
-              map->IntersectionOf(next), out);
+      Release(b, GrantedRunEnd(b, ctl.At(r), next), map->IntersectionOf(next), out);
       return;
     }
     if (d == TrafficDecision::kWait) {
@@ -236,19 +235,23 @@ void GateImpl::RequestSolo(GateBot& b, double t, std::vector<GateEffect>& out) {
       return;
     }
     if (d == TrafficDecision::kBlocked) {
-      if (!b.blocked) {
-        b.blocked = true;
-        GateEffect e;
-        e.kind = GateEffect::Kind::kBlocked;
-        e.robot = b.id;
-        e.reason = ctl.why(r);
-        out.push_back(std::move(e));
-      }
-      Hold(b, "blocked: " + ctl.why(r), out);
+      Block(b, ctl.why(r), out);
       return;
     }
     AdoptRoute(b, t, out);  // kReplanned: the controller's detour becomes the leg
   }
+}
+
+void GateImpl::Block(GateBot& b, const std::string& why, std::vector<GateEffect>& out) {
+  if (!b.blocked) {
+    b.blocked = true;
+    GateEffect e;
+    e.kind = GateEffect::Kind::kBlocked;
+    e.robot = b.id;
+    e.reason = why;
+    out.push_back(std::move(e));
+  }
+  Hold(b, "blocked: " + why, out);
 }
 
 // The controller changed a standing solo robot's route (detour, back-off, nudge): rewrite

@@ -4,6 +4,7 @@
 // leaving the drop point one member at a time (traffic_gate_leaving.cpp); breaking up before
 // the drop is in traffic_gate_breakup.cpp.
 #include <algorithm>
+#include <cstdio>
 #include <cmath>
 #include <string>
 
@@ -84,11 +85,29 @@ void GateImpl::JoinTeam(GateBot& b, const std::string& order, double t, std::vec
       const int blocker = ctl.BlockerOf(p, r, FormationRadius());
       const std::string why = "formation " + order + ": rendezvous point '" + map->point(p).name + "' is occupied";
       ctl.WaitOn(r, blocker, t, blocker >= 0 ? why + " by " + ctl.robot_id(static_cast<std::size_t>(blocker)) : why);
+      // Never for ever: found on a dense grid, an idle robot boxed in next to the rendezvous
+      // point (by the team's own strays and a queue of waiting robots) kept a team forming
+      // until the run's end. Blocked, the member gives its orders back (re-allocated). Timed
+      // here: a member standing on the rendezvous point is taken off and put back each try,
+      // which restarts the controller's wait clock.
+      if (b.forming != order || t - b.forming_last > 1.0) {
+        b.forming = order;
+        b.forming_since = t;
+      }
+      b.forming_last = t;
+      if (blocker >= 0 && t - b.forming_since >= config.blocked_after) {
+        char buf[64];
+        std::snprintf(buf, sizeof buf, "blocked after waiting %.0f s: ", t - b.forming_since);
+        b.forming.clear();
+        Block(b, buf + ctl.why(r), out);
+        return;
+      }
       Hold(b, why, out);
       return;
     }
     ctl.WaitOn(r, -1, t, {});
   }
+  b.forming.clear();
   // Into its slot: the rendezvous run up to the formation's first pick. It keeps its point
   // until it is clear of it (StepTeams), then the team agent stands for it.
   Release(b, span->first_pick, map->IntersectionOf(p), out);
