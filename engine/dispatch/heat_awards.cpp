@@ -69,7 +69,7 @@ void RouteAwardsByHeat(const WarehouseMap& map, const AllocationConfig& config, 
     for (std::size_t k = fresh ? 1 : 0; k < old.size() && ok; ++k) {
       const Waypoint& stop = old[k];
       if (stop.action != WaypointAction::kPick && stop.action != WaypointAction::kDrop) continue;
-      auto route = HeatRoute(map, heat, from, stop.point, config.speed);
+      auto route = HeatRoute(map, heat, from, stop.point, config.speed, config.turn_time, last_arc);
       if (!route.ok()) {
         ok = false;
         notes.push_back("order " + a.order_id + ": heat routing: " + route.error().message + "; the table's route kept");

@@ -2,7 +2,8 @@
 // after the strategy's awards, the lanes every robot's plan uses in the next heat_period give
 // the heat (steps 1-4 of seed 004 §3.1; the new segments are the plain routes of step 1), and
 // each single-robot award's legs between its stops are routed again over the heat-weighted
-// lengths (step 5), timed at the allocation's speed with the stops' work times. Formation
+// lengths (step 5) and, with turn_time > 0, the turning time (the seed's improved Dijkstra,
+// §4.1), timed at the allocation's speed with the turns and the stops' work times. Formation
 // awards keep their routes (a member's next single-robot segment starts where its formation
 // segment ends). Pure; the awards are rewritten.
 #pragma once

@@ -5,9 +5,12 @@
 #include <cstdint>
 #include <functional>
 #include <limits>
+#include <numbers>
 #include <queue>
 #include <set>
 #include <utility>
+
+#include "engine/routing/cost_graph.h"
 
 namespace dispatch::engine {
 
@@ -41,45 +44,71 @@ double PathHeat::ArcWeight(const WarehouseMap& map, ArcId a) const {
   return lane >= 0 && static_cast<std::size_t>(lane) < weight_.size() ? weight_[static_cast<std::size_t>(lane)] : 1.0;
 }
 
-Result<Route> HeatRoute(const WarehouseMap& map, const PathHeat& heat, PointId from, PointId to, double speed) {
+Result<Route> HeatRoute(const WarehouseMap& map, const PathHeat& heat, PointId from, PointId to, double speed,
+                        double turn_s_per_90, ArcId arrived_by) {
   const std::size_t n = map.point_count();
   auto valid = [&](PointId p) { return p >= 0 && static_cast<std::size_t>(p) < n; };
   if (!valid(from) || !valid(to)) return NoRouteError(map, from, to);
+  if (arrived_by >= 0 && (static_cast<std::size_t>(arrived_by) >= map.arcs().size() || map.arc(arrived_by).to != from)) {
+    arrived_by = -1;  // not an arc into `from`: heading unknown
+  }
+  // Without turning time a state is a point; with it, the arc a robot arrived by (the start
+  // is one more state), so a turn's cost is known when the next arc is chosen.
+  const bool turns = turn_s_per_90 > 0.0;
+  const std::size_t states = turns ? map.arcs().size() + 1 : n;
+  const std::size_t start = turns ? map.arcs().size() : static_cast<std::size_t>(from);
+  auto state_of = [&](ArcId a) { return turns ? static_cast<std::size_t>(a) : static_cast<std::size_t>(map.arc(a).to); };
+  auto drive = [&](const Arc& arc) {
+    return arc.length / (arc.max_speed > 0.0 ? std::min(speed, arc.max_speed) : speed);
+  };
   constexpr double kInf = std::numeric_limits<double>::infinity();
-  std::vector<double> dist(n, kInf);
-  std::vector<ArcId> via(n, -1);
-  using Item = std::pair<double, PointId>;
+  std::vector<double> dist(states, kInf);
+  std::vector<ArcId> via(states, -1);          // the arc that reached the state
+  std::vector<std::size_t> parent(states, start);
+  using Item = std::pair<double, std::size_t>;
   std::priority_queue<Item, std::vector<Item>, std::greater<>> open;
-  dist[static_cast<std::size_t>(from)] = 0.0;
-  open.push({0.0, from});
+  dist[start] = 0.0;
+  open.push({0.0, start});
+  std::size_t goal = states;
   while (!open.empty()) {
-    const auto [d, u] = open.top();
+    const auto [d, s] = open.top();
     open.pop();
-    if (d > dist[static_cast<std::size_t>(u)]) continue;
-    if (u == to) break;
-    for (ArcId a : map.out_arcs(u)) {
-      const Arc& arc = map.arc(a);
-      const double nd = d + arc.length * heat.ArcWeight(map, a);
-      if (nd < dist[static_cast<std::size_t>(arc.to)]) {
-        dist[static_cast<std::size_t>(arc.to)] = nd;
-        via[static_cast<std::size_t>(arc.to)] = a;
-        open.push({nd, arc.to});
+    if (d > dist[s]) continue;
+    const ArcId in = s == start ? arrived_by : via[s];
+    const PointId at = s == start ? from : map.arc(via[s]).to;
+    if (at == to) {
+      goal = s;
+      break;
+    }
+    for (ArcId b : map.out_arcs(at)) {
+      const Arc& arc = map.arc(b);
+      double nd = d + drive(arc) * heat.ArcWeight(map, b);
+      if (turns && in >= 0) nd += turn_s_per_90 * TurnAngle(map, in, b) / (std::numbers::pi / 2.0);
+      const std::size_t next = state_of(b);
+      if (nd < dist[next]) {
+        dist[next] = nd;
+        via[next] = b;
+        parent[next] = s;
+        open.push({nd, next});
       }
     }
   }
-  if (std::isinf(dist[static_cast<std::size_t>(to)])) return NoRouteError(map, from, to);
+  if (goal == states) return NoRouteError(map, from, to);
   Route r;
-  for (PointId p = to; p != from; p = map.arc(via[static_cast<std::size_t>(p)]).from) {
-    r.points.push_back(p);
-    r.arcs.push_back(via[static_cast<std::size_t>(p)]);
+  for (std::size_t s = goal; s != start; s = parent[s]) {
+    r.points.push_back(map.arc(via[s]).to);
+    r.arcs.push_back(via[s]);
   }
   r.points.push_back(from);
   std::reverse(r.points.begin(), r.points.end());
   std::reverse(r.arcs.begin(), r.arcs.end());
+  ArcId last = arrived_by;
   for (ArcId a : r.arcs) {
     const Arc& arc = map.arc(a);
     r.length += arc.length;
-    r.cost += arc.length / (arc.max_speed > 0.0 ? std::min(speed, arc.max_speed) : speed);
+    r.cost += drive(arc);
+    if (turns && last >= 0) r.cost += turn_s_per_90 * TurnAngle(map, last, a) / (std::numbers::pi / 2.0);
+    last = a;
   }
   return r;
 }

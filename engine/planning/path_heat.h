@@ -46,9 +46,16 @@ class PathHeat {
   std::vector<double> weight_;
 };
 
-// The route from -> to minimising the weighted length Σ length · w (step 5), by Dijkstra;
-// Route::cost is the drive time at `speed` (arcs' own limits apply), Route::length the metres.
-// Errors: kNotFound (unknown point), kUnreachable.
-Result<Route> HeatRoute(const WarehouseMap& map, const PathHeat& heat, PointId from, PointId to, double speed);
+// The route from -> to minimising the weighted drive time Σ w · length / v (step 5: Dijkstra
+// over the heat-weighted lengths; v = `speed`, capped by an arc's own limit) plus, with
+// turn_s_per_90 > 0, the turning time (Wang2019 eq. (3), t_c: seconds per 90 degrees of
+// heading change between consecutive arcs, a U-turn twice; the seed's "improved Dijkstra" of
+// §4.1 weighs both). `arrived_by` is the arc the robot reached `from` by (its heading), or -1
+// (standing, heading unknown: the first arc turns nothing). With turning time the search runs
+// over the arcs (the state is the arc a robot arrived by), exactly as MapCostGraph's
+// arc-expanded graph. Route::cost is the unweighted drive time plus the turning time,
+// Route::length the metres. Errors: kNotFound (unknown point), kUnreachable.
+Result<Route> HeatRoute(const WarehouseMap& map, const PathHeat& heat, PointId from, PointId to, double speed,
+                        double turn_s_per_90 = 0.0, ArcId arrived_by = -1);
 
 }  // namespace dispatch::engine

@@ -2,6 +2,8 @@
 
 #include <gtest/gtest.h>
 
+#include "engine/routing/cost_graph.h"
+
 #include "grid_map.h"
 
 namespace dispatch::engine {
@@ -65,6 +67,48 @@ TEST(PathHeatTest, RoutesTakeTheColderOfEqualRoutes) {
   const auto split = GridMap({".@."});
   EXPECT_EQ(HeatRoute(*split, PathHeat::FromUses(*split, {}, 0, 1), At(*split, 0, 0), At(*split, 0, 2), 1.0).error().code,
             ErrorCode::kUnreachable);
+}
+
+// The seed's improved Dijkstra (§4.1) weighs turning time too (eq. (3), t_c per 90 degrees):
+// across an open 4 x 4 grid every shortest route is 6 m, and with 1 s per turn the route
+// turns once; a robot that arrived heading east goes on east before it turns.
+TEST(PathHeatTest, TurningTimeMakesRoutesTurnOnce) {
+  const auto map = GridMap({"....", "....", "....", "...."});
+  const PathHeat cold = PathHeat::FromUses(*map, {}, 0.0, 60.0);
+  auto turns = [&](const Route& r) {
+    int n = 0;
+    for (std::size_t k = 1; k < r.arcs.size(); ++k) n += TurnAngle(*map, r.arcs[k - 1], r.arcs[k]) > 0.1 ? 1 : 0;
+    return n;
+  };
+  auto r = HeatRoute(*map, cold, At(*map, 0, 0), At(*map, 3, 3), 1.0, 1.0);
+  ASSERT_TRUE(r.ok());
+  EXPECT_DOUBLE_EQ(r->length, 6.0);
+  EXPECT_EQ(turns(*r), 1);
+  EXPECT_DOUBLE_EQ(r->cost, 7.0);  // 6 s driving + one 90-degree turn
+  const ArcId east = *map->FindArc(At(*map, 0, 0), At(*map, 0, 1));
+  auto headed = HeatRoute(*map, cold, At(*map, 0, 1), At(*map, 3, 3), 1.0, 1.0, east);
+  ASSERT_TRUE(headed.ok());
+  EXPECT_EQ(headed->points[1], At(*map, 0, 2));  // on east first: turning at the start costs the same
+  EXPECT_EQ(turns(*headed), 1);
+  EXPECT_DOUBLE_EQ(headed->cost, 6.0);
+  // A U-turn counts twice: back to where it came from takes 2 s of turning and 1 s driving.
+  auto back = HeatRoute(*map, cold, At(*map, 0, 1), At(*map, 0, 0), 1.0, 1.0, east);
+  ASSERT_TRUE(back.ok());
+  EXPECT_DOUBLE_EQ(back->cost, 3.0);
+  // Heat against turning: the lane east of the start is hot (weight 1 + 4 * 3 / 10 = 2.2). To
+  // the cell south-east, a robot heading east goes south first (2 m, two turns) when turns
+  // are free, and through the hot lane (one turn) when a turn takes 5 s.
+  std::vector<LaneUse> uses;
+  for (int robot = 0; robot < 3; ++robot) uses.push_back({*map->FindArc(At(*map, 0, 1), At(*map, 0, 2)), robot, 1.0});
+  uses.push_back({*map->FindArc(At(*map, 2, 0), At(*map, 3, 0)), 9, 1.0});
+  const PathHeat hot = PathHeat::FromUses(*map, uses, 0.0, 60.0);
+  auto free_turns = HeatRoute(*map, hot, At(*map, 0, 1), At(*map, 1, 2), 1.0, 0.0, east);
+  ASSERT_TRUE(free_turns.ok());
+  EXPECT_EQ(free_turns->points[1], At(*map, 1, 1));
+  auto slow_turns = HeatRoute(*map, hot, At(*map, 0, 1), At(*map, 1, 2), 1.0, 5.0, east);
+  ASSERT_TRUE(slow_turns.ok());
+  EXPECT_EQ(slow_turns->points[1], At(*map, 0, 2));
+  EXPECT_DOUBLE_EQ(slow_turns->cost, 7.0);  // unweighted: 2 s driving + 5 s turning
 }
 
 }  // namespace
