@@ -143,7 +143,7 @@ engine::Result<std::unique_ptr<DispatchServer>> DispatchServer::Start(const Serv
   const std::string map_json = engine::WriteMapJson(*map);
   version.content_hash = MapContentHash(map_json);
   version.also_known_as = {LegacyMapContentHash(map_json)};  // stored by older servers
-  version.source = config.map == "chu2024" ? "builtin:chu2024" : config.map;
+  version.source = config.map == "chu2024" || config.map == "wang2019" ? "builtin:" + config.map : config.map;
   auto recorded = s->store_->RecordMapVersion(version);
   if (!recorded.ok()) return recorded.error();
   spdlog::info("map '{}' ({} points), version {} ({})", map->name(), map->point_count(),

@@ -3,6 +3,7 @@
 #include "engine/io/map_json.h"
 #include "engine/io/movingai_map.h"
 #include "engine/map/chu2024_floor.h"
+#include "engine/map/grid_floor.h"
 
 namespace dispatch::engine {
 
@@ -14,10 +15,11 @@ bool EndsWith(const std::string& s, const std::string& suffix) {
 
 Result<WarehouseMap> LoadMapSource(const std::string& source) {
   if (source == "chu2024") return BuildChu2024Floor();
+  if (source == "wang2019") return BuildWang2019Floor();
   if (EndsWith(source, ".json")) return LoadMapJsonFile(source);
   if (EndsWith(source, ".map")) return LoadMovingAiMapFile(source);
   return InvalidArgument("unknown map source '" + source +
-                         "': expected 'chu2024', a .json map file or a MovingAI .map file");
+                         "': expected 'chu2024', 'wang2019', a .json map file or a MovingAI .map file");
 }
 
 }  // namespace dispatch::engine

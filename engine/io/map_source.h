@@ -1,5 +1,6 @@
 // Resolves a map source given on a command line or in a config file:
 //   "chu2024"        the built-in Chu2024 floor (engine/map/chu2024_floor.h)
+//   "wang2019"       the built-in 40 x 30 grid of Wang2019 §4 (engine/map/grid_floor.h)
 //   "<file>.json"    a map file in the JSON format of engine/io/map_format.md
 //   "<file>.map"     a MovingAI grid (engine/io/movingai_map.h)
 // Anything else is an InvalidArgument error that lists the accepted forms.

@@ -24,6 +24,13 @@ TEST(MapSourceTest, BuiltInChu2024) {
   EXPECT_EQ(map->name(), "chu2024");
 }
 
+TEST(MapSourceTest, BuiltInWang2019) {
+  auto map = LoadMapSource("wang2019");
+  ASSERT_TRUE(map.ok()) << map.error().message;
+  EXPECT_EQ(map->name(), "wang2019");
+  EXPECT_EQ(map->point_count(), static_cast<std::size_t>(40 * 30 - 42 * 8));
+}
+
 TEST(MapSourceTest, Chu2024SurvivesAJsonRoundTrip) {
   auto floor = BuildChu2024Floor();
   ASSERT_TRUE(floor.ok());
@@ -50,7 +57,7 @@ TEST(MapSourceTest, MovingAiFile) {
 TEST(MapSourceTest, UnknownFormsAndMissingFilesAreClearErrors) {
   auto bad = LoadMapSource("warehouse.txt");
   ASSERT_FALSE(bad.ok());
-  EXPECT_NE(bad.error().message.find("expected 'chu2024', a .json map file or a MovingAI .map file"),
+  EXPECT_NE(bad.error().message.find("expected 'chu2024', 'wang2019', a .json map file or a MovingAI .map file"),
             std::string::npos);
   auto missing = LoadMapSource("/nonexistent/floor.json");
   ASSERT_FALSE(missing.ok());

@@ -34,9 +34,25 @@ TEST(GridFloorTest, SizesKindsAndLanes) {
   EXPECT_TRUE(map->intersections().empty());
 }
 
+// Wang2019 §4's 40 x 30 grid: 3 free columns left and right, 2 free rows above and below.
+TEST(GridFloorTest, Wang2019FloorIsFortyByThirty) {
+  auto map = BuildWang2019Floor();
+  ASSERT_TRUE(map.ok()) << map.error().message;
+  EXPECT_EQ(map->name(), "wang2019");
+  EXPECT_EQ(map->shelves().size(), 42u);
+  EXPECT_EQ(map->point_count(), static_cast<std::size_t>(40 * 30 - 42 * 8));
+  EXPECT_DOUBLE_EQ(map->floor_max().x(), 39.5);
+  EXPECT_DOUBLE_EQ(map->floor_max().y(), 29.5);
+  EXPECT_DOUBLE_EQ(map->shelves().front().min.y(), 1.5);  // rows 0 and 1 free
+  EXPECT_DOUBLE_EQ(map->shelves().front().min.x(), 2.5);  // columns 0-2 free
+}
+
 TEST(GridFloorTest, RejectsBadSizes) {
   GridFloorOptions o;
   o.aisle = 0;
+  EXPECT_FALSE(BuildGridFloor(o).ok());
+  o.aisle = 2;
+  o.border_y = -1;
   EXPECT_FALSE(BuildGridFloor(o).ok());
 }
 
