@@ -19,6 +19,8 @@
 //       the discrete-time planners on a floor (mapf_command.h).
 //   dispatch-sim headon
 //       seed 004 §4.3: a head-on conflict resolved by waiting vs. re-planning.
+//   dispatch-sim routing [--tasks 4,8,12,16,20] [--seeds 5] [--turn-time 1]
+//       seed 004 §4.1-4.2: traditional vs. improved Dijkstra (routing_command.h).
 //   dispatch-sim replay --db dispatch.db [--run N | --list] [--what-if [--strategy S] [--zeta Z]
 //       [--robots N]]
 //       a run dispatchd recorded, through a fresh dispatch core again (exit 0: it matched);
@@ -39,6 +41,7 @@
 #include "engine/allocation/auction_allocator.h"
 #include "engine/cli/journal_replay.h"
 #include "engine/cli/mapf_command.h"
+#include "engine/cli/routing_command.h"
 #include "engine/cli/stream_command.h"
 #include "engine/cli/scenario.h"
 #include "engine/dispatch/strategy.h"
@@ -196,7 +199,10 @@ int Main(int argc, char** argv) {
   r->add_option("--max-time", replay.max_time, "What-if simulated seconds before giving up")->capture_default_str();
   MapfArgs mapf;
   auto* m = AddMapfCommand(app, mapf);
+  RoutingArgs routing;
+  auto* rt = AddRoutingCommand(app, routing);
   CLI11_PARSE(app, argc, argv);
+  if (*rt) return RunRouting(routing);
   if (*m) return RunMapf(mapf);
   if (*r) return RunReplay(replay);
   if (*p) return RunPlan(plan);
