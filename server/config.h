@@ -50,6 +50,9 @@ struct ServerConfig {
   // Traffic priority within a class (working, loaded, the rest): index (the lower robot index)
   // or release (the earlier task release, Wang2019 §3.2).
   std::string priority = "index";
+  // Wang2019 §3.3 case ①: at a free single-lane corridor a robot gives way to one of higher
+  // priority about to enter it from the other end (TrafficControllerConfig::head_on_priority).
+  bool head_on_priority = false;
   // Bound of the lazy route table's per-destination cache (large grid floors, where a dense
   // all-pairs table does not fit), MiB. It should hold the destinations in use at once (every
   // robot's next stop): on a 38k-cell floor one destination takes 0.46 MB.

@@ -165,6 +165,7 @@ engine::Result<std::unique_ptr<DispatchServer>> DispatchServer::Start(const Serv
   options.traffic.t_w2 = config.t_w2;
   options.traffic.blocked_after = config.blocked_after;
   options.traffic.priority_by_release = config.priority == "release";
+  options.traffic.head_on_priority = config.head_on_priority;
   options.map_version = recorded->content_hash;
   options.metrics = s->metrics_.get();
   if (!store && config.journal_runs > 0) {

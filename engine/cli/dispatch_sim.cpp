@@ -167,6 +167,14 @@ int RunHeadOn() {
                   run->wait_estimate, run->replan_extra, run->replanned ? "re-plan" : "wait");
     }
   }
+  std::printf("\nSeed 004 §3.3 case 1: h1 (released first) and h2 drive at a corridor from its two ends, h2 first\n");
+  std::printf("%-22s %10s %10s %10s  %s\n", "corridor", "h1 time", "h2 time", "deadlocks", "gave way");
+  auto one = RunCaseOneComparison();
+  if (!one.ok()) return Fail(one.error().message);
+  for (auto [name, run] : {std::pair{"first come", &one->first_come}, std::pair{"higher priority first", &one->priority}}) {
+    std::printf("%-22s %9.1fs %9.1fs %10zu  %s%s\n", name, run->h1_time, run->h2_time, run->deadlocks,
+                run->h1_met_head_on ? "h1 " : "", run->h2_met_head_on ? "h2" : "");
+  }
   return 0;
 }
 

@@ -104,6 +104,7 @@ StreamConfig ConfigOf(const StreamArgs& a, const std::string& strategy, double z
   c.allocation.routing = ParseRouting(a.routing).value_or(RoutingKind::kFloyd);
   c.allocation.heat_period = a.heat_period;
   c.traffic.priority_by_release = a.priority == "release";
+  c.traffic.head_on_priority = a.head_on_priority;
   c.one_formation_per_pick = a.one_formation_per_pick;
   c.blocked_recovery = a.blocked_recovery;
   c.check_safety = a.check_safety;
@@ -294,6 +295,9 @@ StreamCommands AddStreamCommands(CLI::App& app, StreamArgs& stream_args, StreamA
         ->capture_default_str();
     c->add_option("--priority", a.priority, "Traffic priority within a class: index or release (Wang2019)")
         ->capture_default_str()->check(CLI::IsMember({"index", "release"}));
+    c->add_option("--head-on-priority", a.head_on_priority,
+                  "Wang2019 case 1: give way at a free corridor to a higher-priority robot about to enter it (true|false)")
+        ->capture_default_str();
     c->add_option("--heat-period", a.heat_period, "Path heat: the period δ the lanes' use is counted over, s")
         ->capture_default_str()->check(CLI::PositiveNumber);
     c->add_option("--max-queue", a.max_queue, "Orders a robot may hold and still bid (0: no limit)")

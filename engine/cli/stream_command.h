@@ -33,6 +33,7 @@ struct StreamArgs {
   double turn_s = 0.0;                     // turning time per 90 degrees (AllocationConfig::turn_time)
   double heat_period = 60.0;               // path heat: δ, s
   std::string priority = "index";          // TrafficControllerConfig::priority_by_release
+  bool head_on_priority = false;           // TrafficControllerConfig::head_on_priority
 };
 
 struct StreamCommands {

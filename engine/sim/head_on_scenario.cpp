@@ -1,6 +1,7 @@
 #include "engine/sim/head_on_scenario.h"
 
 #include <memory>
+#include <utility>
 
 #include "engine/map/map_builder.h"
 #include "engine/routing/route_table.h"
@@ -11,8 +12,9 @@ namespace {
 
 Result<WarehouseMap> HeadOnFloor() {
   MapBuilder b("wang2019-head-on");
-  b.SetFloor({0, -1}, {18, 12});
-  b.AddRectZone("z", {0, -1}, {18, 12});
+  b.SetFloor({0, -4}, {18, 12});
+  b.AddRectZone("z", {0, -4}, {18, 12});
+  b.AddPoint("S0", {14, -3}, PointKind::kPick);
   b.AddPoint("S1", {14, 0}, PointKind::kPark);
   b.AddPoint("B", {14, 2}, PointKind::kLane);
   for (int y = 3; y <= 7; ++y) {
@@ -28,6 +30,7 @@ Result<WarehouseMap> HeadOnFloor() {
   auto lane = [&](const char* f, const char* t, std::optional<double> len = std::nullopt) {
     b.AddPath(f, t, len, 0.0, true);
   };
+  lane("S0", "S1");
   lane("S1", "B");
   lane("B", "c3");
   lane("c3", "c4");
@@ -90,15 +93,71 @@ Result<HeadOnRun> RunOnce(std::shared_ptr<const WarehouseMap> map,
   return run;
 }
 
-}  // namespace
+Result<CaseOneRun> RunCaseOne(std::shared_ptr<const WarehouseMap> map, std::shared_ptr<const RouteTable> routes,
+                              bool head_on_priority) {
+  const WarehouseMap& m = *map;
+  std::vector<FleetRobot> robots{{"h1", *m.FindPoint("S0"), 0.0}, {"h2", *m.FindPoint("P"), 0.0}};
+  Order o1;
+  o1.id = "O1";
+  o1.picks = {*m.FindPoint("S0")};
+  o1.drop = *m.FindPoint("V");
+  o1.work_time = 1.0;
+  o1.release_time = 0.0;
+  Order o2;
+  o2.id = "O2";
+  o2.picks = {*m.FindPoint("U")};
+  o2.drop = *m.FindPoint("X");
+  o2.work_time = 1.0;
+  o2.release_time = 0.5;
+  o2.created_time = 0.5;
+  StreamConfig config;
+  config.traffic.priority_by_release = true;
+  config.traffic.head_on_priority = head_on_priority;
+  config.max_time = 600.0;
+  auto r = SimulateOnCore(map, routes, robots, {o1, o2}, config);
+  if (!r.ok()) return r.error();
+  if (!r->all_completed()) return InvalidArgument("case 1 scenario: an order did not complete");
+  if (r->orders[0].robot != "h1" || r->orders[1].robot != "h2") {
+    return InvalidArgument("case 1 scenario: O1, O2 went to " + r->orders[0].robot + ", " + r->orders[1].robot);
+  }
+  CaseOneRun run;
+  run.h1_time = r->orders[0].completion_time - r->orders[0].release_time;
+  run.h2_time = r->orders[1].completion_time - r->orders[1].release_time;
+  run.deadlocks = r->traffic.deadlocks_resolved;
+  for (const HeadOnRecord& rec : r->traffic.head_on) {
+    run.h1_met_head_on = run.h1_met_head_on || rec.robot == "h1";
+    run.h2_met_head_on = run.h2_met_head_on || rec.robot == "h2";
+  }
+  return run;
+}
 
-Result<HeadOnComparison> RunHeadOnComparison(double h1_work) {
+Result<std::pair<std::shared_ptr<const WarehouseMap>, std::shared_ptr<const RouteTable>>> HeadOnWorld() {
   auto built = HeadOnFloor();
   if (!built.ok()) return built.error();
   auto map = std::make_shared<const WarehouseMap>(std::move(built).value());
   auto table = MakeRouteTable(map, {});
   if (!table.ok()) return table.error();
-  std::shared_ptr<const RouteTable> routes = std::move(table).value();
+  return std::pair{map, std::shared_ptr<const RouteTable>(std::move(table).value())};
+}
+
+}  // namespace
+
+Result<CaseOneComparison> RunCaseOneComparison() {
+  auto world = HeadOnWorld();
+  if (!world.ok()) return world.error();
+  CaseOneComparison out;
+  for (auto [priority, slot] : {std::pair{false, &out.first_come}, std::pair{true, &out.priority}}) {
+    auto run = RunCaseOne(world->first, world->second, priority);
+    if (!run.ok()) return run.error();
+    *slot = *run;
+  }
+  return out;
+}
+
+Result<HeadOnComparison> RunHeadOnComparison(double h1_work) {
+  auto world = HeadOnWorld();
+  if (!world.ok()) return world.error();
+  const auto& [map, routes] = *world;
   HeadOnComparison out;
   out.h1_work = h1_work;
   for (auto [policy, slot] : {std::pair{HeadOnPolicy::kAlwaysWait, &out.wait},

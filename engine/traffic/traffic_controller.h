@@ -78,6 +78,10 @@ struct TrafficControllerConfig {
   // Wang2019 §3.2: between robots of one class (working, loaded, the rest) the one whose task
   // was released earlier has priority (SetRank); false: the lower index, as before.
   bool priority_by_release = false;
+  // Wang2019 §3.3 case ①: a robot about to enter a free single-lane corridor gives way (waits
+  // or detours, as on a head-on) to a robot of higher priority that would enter it from the
+  // other end before it is through; false: the corridor goes to whoever claims it first.
+  bool head_on_priority = false;
   Status Validate() const;
 };
 

@@ -236,7 +236,8 @@ struct TrafficController::Impl {
   double RouteCost(const RobotState& x) const;
   double ClearTime(std::size_t h, int c, double now) const;
   Status Assign(std::size_t r, std::vector<PointId> points);
-  TrafficDecision HeadOn(std::size_t r, int c, int oncoming, double t);
+  TrafficDecision HeadOn(std::size_t r, int c, int oncoming, double t);  // traffic_controller_head_on.cpp
+  int PriorityOncoming(std::size_t r, int c, int d, double t) const;
   TrafficDecision Request(std::size_t r, double t);
   TrafficDecision Check(std::size_t r, PointId q, double t);
   // The agent at work that r would stand behind with no way around it if it drove on: along

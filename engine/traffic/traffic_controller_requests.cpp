@@ -1,5 +1,6 @@
 // TrafficController's requests (what Request() decides): point reservations and clearance
-// (PointBlocker), single-lane corridors and head-on conflicts, intersection grants, waits and
+// (PointBlocker), single-lane corridors (head-on conflicts: traffic_controller_head_on.cpp),
+// intersection grants, waits and
 // their timeouts, route assignment, and arriving at / leaving the floor. Detours, back-off,
 // sidings and deadlocks are in traffic_controller_deadlocks.cpp, the public interface in
 // traffic_controller.cpp, the shared state in traffic_controller_impl.h.
@@ -148,20 +149,6 @@ double TrafficController::Impl::RouteCost(const RobotState& x) const {
   return c;
 }
 
-// Time until robot h has driven through corridor c (approach included) and one arc beyond.
-double TrafficController::Impl::ClearTime(std::size_t h, int c, double now) const {
-  const RobotState& x = robots[h];
-  double t = x.working ? std::max(0.0, x.work_end - now) : 0.0;
-  bool entered = lanes.interior_of[static_cast<std::size_t>(x.at)] == c;
-  for (std::size_t k = x.pos; k < x.arcs.size(); ++k) {
-    const bool in = CorridorOf(x.arcs[k]) == c;
-    t += ArcTime(x.arcs[k]);
-    if (in) entered = true;
-    if (!in && entered) break;
-  }
-  return t;
-}
-
 Status TrafficController::Impl::Assign(std::size_t r, std::vector<PointId> points) {
   RobotState& x = robots[r];
   if (x.removed) return Error{ErrorCode::kFailedPrecondition, "traffic: robot " + x.id + " is off the floor"};
@@ -189,43 +176,6 @@ Status TrafficController::Impl::Assign(std::size_t r, std::vector<PointId> point
   if (x.guard >= 0 && M().IntersectionOf(x.at) != x.guard) ReleaseGuard(r);
   ReconcileCorridors(r);
   return Ok{};
-}
-
-TrafficDecision TrafficController::Impl::HeadOn(std::size_t r, int c, int oncoming, double t) {
-  RobotState& x = robots[r];
-  if (x.head_on_decided != c) {
-    x.head_on_decided = c;
-    ++stats.head_on_conflicts;
-    HeadOnRecord rec;
-    rec.t = t;
-    rec.robot = x.id;
-    rec.oncoming = robots[static_cast<std::size_t>(oncoming)].id;
-    for (int h : cstate[static_cast<std::size_t>(c)].holders) {
-      if (static_cast<std::size_t>(h) == r) continue;
-      rec.wait_estimate = std::max(rec.wait_estimate, ClearTime(static_cast<std::size_t>(h), c, t));
-    }
-    // kChooseFaster only needs detours faster than waiting: bound the search there.
-    const double old_cost = RouteCost(x);
-    const double bound = config.head_on == HeadOnPolicy::kChooseFaster
-                             ? old_cost + rec.wait_estimate
-                             : kInf;
-    Detour d = Route(x.at, x.route.back(), kNoPoint, c, -1, bound);
-    if (!d.points.empty() && !StartAllowed(r, d.points)) d = Detour{};
-    rec.replan_extra = d.points.empty() ? kInf : d.cost - old_cost;
-    const bool replan =
-        !d.points.empty() && (config.head_on == HeadOnPolicy::kAlwaysReplan ||
-                              (config.head_on == HeadOnPolicy::kChooseFaster &&
-                               rec.replan_extra < rec.wait_estimate));
-    rec.replanned = replan;
-    if (stats.head_on.size() < 1000) stats.head_on.push_back(rec);
-    if (replan && Assign(r, std::move(d.points)).ok()) {
-      Replanned(x);
-      ClearWait(x);
-      return TrafficDecision::kReplanned;
-    }
-  }
-  return WaitFor(r, WaitKind::kCorridor, oncoming, t, WhyKey{1, oncoming},
-                 [&] { return "head-on: corridor held by " + robots[static_cast<std::size_t>(oncoming)].id; });
 }
 
 void TrafficController::Impl::NoteProgress(RobotState& x, double t) {
@@ -324,7 +274,9 @@ TrafficDecision TrafficController::Impl::Check(std::size_t r, PointId q, double 
   for (std::size_t k = x.pos; k < x.arcs.size() && k < x.pos + 2; ++k) {
     const int c = CorridorOf(x.arcs[k]);
     if (c < 0) continue;
-    const int on = CorridorBlocker(c, lanes.Direction(M(), x.arcs[k]), r);
+    const int d = lanes.Direction(M(), x.arcs[k]);
+    int on = CorridorBlocker(c, d, r);
+    if (on < 0 && config.head_on_priority) on = PriorityOncoming(r, c, d, t);
     if (on < 0) continue;
     x.wait_corridor = c;
     return HeadOn(r, c, on, t);

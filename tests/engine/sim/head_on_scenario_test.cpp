@@ -41,5 +41,23 @@ TEST(HeadOnScenarioTest, Wang2019HeadOnWaitVersusReplanOnTheCore) {
   EXPECT_LT(fast->wait.h2_time, fast->replan.h2_time);
 }
 
+// Seed 004 §3.3 case ①: two robots drive at one corridor from its two ends; h2 (released
+// later) reaches it first. First come, h2 enters and h1 (released first) waits at the other
+// end; with head_on_priority h2 gives way at its end (waiting: the detour is 14 s longer) and
+// h1 drives through as if alone: 1 s pick, 13 m, 1 s drop.
+TEST(HeadOnScenarioTest, Wang2019CaseOneTheHigherPriorityPassesFirst) {
+  auto c = RunCaseOneComparison();
+  ASSERT_TRUE(c.ok()) << c.error().message;
+  std::printf("first come: h1 %.1f s, h2 %.1f s; higher priority first: h1 %.1f s, h2 %.1f s\n", c->first_come.h1_time,
+              c->first_come.h2_time, c->priority.h1_time, c->priority.h2_time);
+  EXPECT_TRUE(c->first_come.h1_met_head_on);
+  EXPECT_GT(c->first_come.h1_time, c->priority.h1_time + 5.0);
+  EXPECT_NEAR(c->priority.h1_time, 1.0 + 13.0 + 1.0, 0.3);
+  EXPECT_FALSE(c->priority.h1_met_head_on);
+  EXPECT_TRUE(c->priority.h2_met_head_on);
+  EXPECT_GT(c->priority.h2_time, c->first_come.h2_time);
+  EXPECT_EQ(c->priority.deadlocks, 0u);
+}
+
 }  // namespace
 }  // namespace dispatch::engine
