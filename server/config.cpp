@@ -170,7 +170,9 @@ engine::Result<ParsedCommandLine> ParseCommandLine(int argc, char** argv) {
   app.add_option("--map", flags.map, "chu2024 | wang2019 | map.json | MovingAI .map")->capture_default_str();
   app.add_option("--strategy", flags.strategy, "auction | greedy")->capture_default_str();
   app.add_option("--zeta", flags.zeta, "Traffic weight (Chu2024 eq. 5)")->capture_default_str();
-  app.add_option("--planner", flags.planner, "rules | time-windows (Wang2019 time windows)")->capture_default_str();
+  app.add_option("--planner", flags.planner,
+                 "rules | time-windows (Wang2019) | conflict-elimination (BIT2024 step 7)")
+      ->capture_default_str();
   app.add_option("--turn-time", flags.turn_time, "Turning time per 90 degrees, s (plans, route costs)")
       ->capture_default_str();
   app.add_option("--priority", flags.priority, "Traffic priority within a class: index | release (Wang2019)")

@@ -26,7 +26,8 @@ struct ServerConfig {
   bool one_formation_per_pick = true;
   double zeta = 100.0;            // Chu2024 eq. (5) traffic weight
   // How awards get their routes (AllocationConfig::planner): rules | time-windows (Wang2019's
-  // time windows for single-robot orders). turn_time: seconds per 90 degrees of turning in plan
+  // time windows for single-robot orders) | conflict-elimination (BIT2024 step 7 in the same
+  // windows). turn_time: seconds per 90 degrees of turning in plan
   // ETAs, route costs and the time-window planner (AllocationConfig::turn_time).
   std::string planner = "rules";
   double turn_time = 0.0;

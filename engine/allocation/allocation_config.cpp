@@ -45,12 +45,13 @@ const char* PlannerName(PlannerKind planner) {
   switch (planner) {
     case PlannerKind::kRules: return "rules";
     case PlannerKind::kTimeWindows: return "time-windows";
+    case PlannerKind::kConflictElimination: return "conflict-elimination";
   }
   return "?";
 }
 
 std::optional<PlannerKind> ParsePlanner(std::string_view name) {
-  for (PlannerKind p : {PlannerKind::kRules, PlannerKind::kTimeWindows}) {
+  for (PlannerKind p : {PlannerKind::kRules, PlannerKind::kTimeWindows, PlannerKind::kConflictElimination}) {
     if (name == PlannerName(p)) return p;
   }
   return std::nullopt;
@@ -73,6 +74,9 @@ std::optional<RoutingKind> ParseRouting(std::string_view name) {
 
 std::vector<std::string> RoutingNames() { return {RoutingName(RoutingKind::kFloyd), RoutingName(RoutingKind::kHeat)}; }
 
-std::vector<std::string> PlannerNames() { return {PlannerName(PlannerKind::kRules), PlannerName(PlannerKind::kTimeWindows)}; }
+std::vector<std::string> PlannerNames() {
+  return {PlannerName(PlannerKind::kRules), PlannerName(PlannerKind::kTimeWindows),
+          PlannerName(PlannerKind::kConflictElimination)};
+}
 
 }  // namespace dispatch::engine

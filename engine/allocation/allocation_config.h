@@ -57,7 +57,7 @@
 namespace dispatch::engine {
 
 // How an award's robots get their routes (issue 16 §3).
-enum class PlannerKind { kRules, kTimeWindows };
+enum class PlannerKind { kRules, kTimeWindows, kConflictElimination };
 // Which routes the rules planner gives them: the route table's shortest (Floyd, or its lazy
 // equivalent on large floors) or Wang2019's heat-weighted ones (engine/planning/path_heat.h).
 enum class RoutingKind { kFloyd, kHeat };
@@ -90,13 +90,15 @@ struct AllocationConfig {
   // and the simulator's robots. 0 (default): Chu2024 has no turning time.
   double turn_time = 0.0;
   PlannerKind planner = PlannerKind::kRules;
-  // Planner kTimeWindows; its speed and turning time are replaced by `speed` and `turn_time`.
+  // Planners kTimeWindows and kConflictElimination; its speed and turning time are replaced by
+  // `speed` and `turn_time`.
   TimeWindowRules windows;
   RoutingKind routing = RoutingKind::kFloyd;
   double heat_period = 60.0;  // δ of Wang2019's path heat, seconds (> 0)
 };
 
-// "rules", "time-windows" (PlannerNames: in the order help texts list them).
+// "rules", "time-windows", "conflict-elimination" (PlannerNames: in the order help texts list
+// them).
 const char* PlannerName(PlannerKind planner);
 std::optional<PlannerKind> ParsePlanner(std::string_view name);
 std::vector<std::string> PlannerNames();

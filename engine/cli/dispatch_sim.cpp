@@ -6,13 +6,13 @@
 //       [--formations 0.2]) [--strategy auction|greedy] [--zeta 100]
 //       [--orders-csv out.csv] [--check-safety] [--journal run.db] [--max-queue N]
 //       [--formation-max-queue N] [--one-formation-per-pick true|false] [--trace R1,R2 [--trace-from T] [--trace-to T]]
-//       [--planner rules|time-windows] [--routing floyd|heat [--heat-period S]] [--turn-time S]
+//       [--planner rules|time-windows|conflict-elimination] [--routing floyd|heat [--heat-period S]] [--turn-time S]
 //       an order stream with release times (formation orders too) on the dispatch core (the
 //       service's allocation rounds and traffic gate, robots following its messages); with
 //       --planner time-windows single-robot awards are planned through the others' time
 //       windows (Wang2019, window_awards.h).
 //   dispatch-sim compare [--random 200 --seed 1 --robots 18 --map chu2024]
-//       [--planners rules,time-windows] [--routings floyd,heat] [--strategy S] [--zeta Z]
+//       [--planners rules,time-windows,conflict-elimination] [--routings floyd,heat] [--strategy S] [--zeta Z]
 //       auction zeta=100, auction zeta=0 and greedy on one random stream (issue 4 §4), or the
 //       planners side by side (both: stream_command.h).
 //   dispatch-sim mapf --map FILE.map --agents N [--planner conflict-elimination|cbs|both]

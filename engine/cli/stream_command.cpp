@@ -31,7 +31,7 @@ namespace {
 
 using cli_stream::Fail;
 
-// "rules, time-windows" for messages and help texts.
+// "rules, time-windows, conflict-elimination" for messages and help texts.
 std::string PlannerList() {
   std::string out;
   for (const std::string& name : PlannerNames()) out += (out.empty() ? "" : ", ") + name;
@@ -231,7 +231,7 @@ int RunCompare(StreamArgs a) {
               setup->robots.size(), a.map.c_str(), a.dt);
   // failed: blocked / still waiting at --max-time / other; violations: with --check-safety.
   // ms/order: wall time of the allocation rounds (auction and planner) per award.
-  std::printf("%-18s %9s %11s %10s %12s %10s %10s %6s %9s %8s %9s %8s %10s %9s\n",
+  std::printf("%-20s %9s %11s %10s %12s %10s %10s %6s %9s %8s %9s %8s %10s %9s\n",
               a.planners.empty() && a.routings.empty() ? "strategy" : "planner", "completed", "failed b/w/o",
               "makespan", "throughput/h", "mean compl", "waiting s", "stops", "distance", "replans", "deadlocks",
               "min dist", "violations", "ms/order");
@@ -264,7 +264,7 @@ int RunCompare(StreamArgs a) {
     const std::string violations = r->safety ? std::to_string(r->safety->violations.size()) : "-";
     const double per_order =
         r->planned_awards > 0 ? 1000.0 * r->planning_seconds / static_cast<double>(r->planned_awards) : 0.0;
-    std::printf("%-18s %5zu/%-3zu %11s %10.1f %12.1f %10.1f %10.1f %6zu %9.1f %8zu %9zu %8.3f %10s %9.3f\n",
+    std::printf("%-20s %5zu/%-3zu %11s %10.1f %12.1f %10.1f %10.1f %6zu %9.1f %8zu %9zu %8.3f %10s %9.3f\n",
                 name.c_str(), r->completed, r->orders.size(), failures, r->makespan, r->throughput_per_hour,
                 r->mean_completion, r->total_waiting_time, r->stops, r->total_distance, r->traffic.replans,
                 r->traffic.deadlocks_resolved, r->overall_min_distance, violations.c_str(), per_order);

@@ -106,6 +106,8 @@ RoundResult RoundRunner::Run(const RoundInput& input) {
   }
   if (config_.planner == PlannerKind::kTimeWindows && !out.awards.empty()) {
     PlanAwardsInWindows(map_, *routes_, config_, state, segments, input.now, out.awards, out.notes);
+  } else if (config_.planner == PlannerKind::kConflictElimination && !out.awards.empty()) {
+    PlanAwardsByConflictElimination(map_, *routes_, config_, state, segments, input.now, out.awards, out.notes);
   } else if (config_.routing == RoutingKind::kHeat && !out.awards.empty()) {
     RouteAwardsByHeat(*map_, config_, state, segments, input.now, out.awards, out.notes);
   }

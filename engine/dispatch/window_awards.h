@@ -13,7 +13,7 @@
 // finds no route (a stop held for ever, say by a robot parked on it), the segment stays as
 // the strategy planned it and a note says why; the traffic controller stays the safety net.
 //
-// Pure; the caller's FleetState is read, the awards rewritten.
+// Pure; the caller's FleetState is read, the awards rewritten. Both planners below.
 #pragma once
 
 #include <memory>
@@ -38,5 +38,20 @@ void PlanAwardsInWindows(const std::shared_ptr<const WarehouseMap>& map, const R
                          const AllocationConfig& config,
                          const FleetState& fleet, const RoundSegments& segments, double now,
                          std::vector<RoundAward>& awards, std::vector<std::string>& notes);
+
+// BIT2024 step 7 (seed 003 s71-s73) in the same time windows (AllocationConfig::planner =
+// conflict-elimination): every re-planned robot's new segments are first planned alone,
+// through the windows of the plans kept from before the round only (not through each
+// other's); then, at the first conflict among them (EarliestConflict: two windows at a point,
+// a lane both ways), one of the two robots keeps its route (a seeded random choice) and the
+// other is kept out of that robot's window there (a constraint: a pseudo reservation only its
+// own searches see) and planned again; until none is left. Deterministic (the seed comes from
+// the round's time) and bounded by 8 iterations per robot + 8 (a replay re-runs the same
+// round; a wall-clock deadline would not); conflicts left then, or between robots whose
+// constraints leave no route, are the traffic controller's, as with every planner.
+void PlanAwardsByConflictElimination(const std::shared_ptr<const WarehouseMap>& map, const RouteTable& routes,
+                                     const AllocationConfig& config, const FleetState& fleet,
+                                     const RoundSegments& segments, double now, std::vector<RoundAward>& awards,
+                                     std::vector<std::string>& notes);
 
 }  // namespace dispatch::engine

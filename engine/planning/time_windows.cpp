@@ -199,6 +199,44 @@ Status CheckTimeWindows(const WarehouseMap& map, const TimeWindowRules& rules, c
   return Ok{};
 }
 
+std::optional<WindowConflict> EarliestConflict(const ReservationTable& table) {
+  const WarehouseMap& map = table.map();
+  std::optional<WindowConflict> best;
+  auto offer = [&](WindowConflict c) {
+    if (!best || c.at < best->at) best = c;
+  };
+  for (std::size_t p = 0; p < map.point_count(); ++p) {
+    const auto& w = table.PointWindows(static_cast<PointId>(p));  // sorted by start
+    for (std::size_t i = 1; i < w.size(); ++i) {
+      for (std::size_t j = 0; j < i; ++j) {
+        if (w[j].robot == w[i].robot || !Overlap(w[j].from, w[j].to, w[i].from, w[i].to)) continue;
+        WindowConflict c;
+        c.point = static_cast<PointId>(p);
+        c.a = w[j].robot < w[i].robot ? w[j] : w[i];
+        c.b = w[j].robot < w[i].robot ? w[i] : w[j];
+        c.at = std::max(w[j].from, w[i].from);
+        offer(c);
+      }
+    }
+  }
+  for (std::size_t a = 0; a < map.arcs().size(); ++a) {
+    const Arc& arc = map.arcs()[a];
+    if (arc.reverse_arc < 0 || static_cast<std::size_t>(arc.reverse_arc) < a) continue;  // each lane once
+    for (const TimeWindow& x : table.ArcWindows(static_cast<ArcId>(a))) {
+      for (const TimeWindow& y : table.ArcWindows(arc.reverse_arc)) {
+        if (y.robot == x.robot || !Overlap(x.from, x.to, y.from, y.to)) continue;
+        WindowConflict c;
+        c.arc = static_cast<ArcId>(a);
+        c.a = x;
+        c.b = y;
+        c.at = std::max(x.from, y.from);
+        offer(c);
+      }
+    }
+  }
+  return best;
+}
+
 double RouteDuration(const TimedRoute& route) {
   return route.empty() ? 0.0 : route.back().arrive - route.front().arrive;
 }

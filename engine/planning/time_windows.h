@@ -16,6 +16,7 @@
 
 #include <limits>
 #include <memory>
+#include <optional>
 #include <unordered_map>
 #include <utility>
 #include <vector>
@@ -103,6 +104,19 @@ class ReservationTable {
 // windows overlapping at a point, opposite directions of a lane never at once, no lane over
 // its capacity. Errors name the first fault (robots by index).
 Status CheckTimeWindows(const WarehouseMap& map, const TimeWindowRules& rules, const std::vector<TimedRoute>& routes);
+
+// The earliest conflict between two robots in `table` (BIT2024 step 7's "first conflict", in
+// continuous time): two windows at one point that overlap, or one lane driven both ways at
+// once; by the time they begin to overlap, ties by point then arc order. Lane capacity
+// (eq. (10)) is not looked at. Each robot's window is given, so a planner can keep one robot's
+// and forbid it to the other.
+struct WindowConflict {
+  PointId point = kNoPoint;  // a point conflict, else kNoPoint
+  ArcId arc = -1;            // a lane conflict: robot a drives `arc`, robot b its reverse
+  TimeWindow a, b;           // the two robots' windows (a.robot < b.robot for points)
+  double at = 0.0;           // when they begin to overlap
+};
+std::optional<WindowConflict> EarliestConflict(const ReservationTable& table);
 
 // Seconds from the route's first arrival to its last arrival (its makespan), 0 for none.
 double RouteDuration(const TimedRoute& route);

@@ -13,8 +13,9 @@
 //                   until that model was deleted.)
 //   BM_SimulateFormationsOnCore/R   the same with 10% of the orders formation orders (3 robots
 //                   each, Chu2024 §3.2: gathering, one agent with the formation's envelope).
-//   BM_SimulatePlannerTimeWindows/R, BM_SimulatePlannerHeat/R   BM_SimulateOnCore's stream with
-//                   AllocationConfig::planner = time-windows / routing = heat (issue 16).
+//   BM_SimulatePlannerTimeWindows/R, BM_SimulatePlannerConflictElimination/R,
+//   BM_SimulatePlannerHeat/R   BM_SimulateOnCore's stream with AllocationConfig::planner =
+//                   time-windows / conflict-elimination / routing = heat (issue 16).
 // Counter `speedup` = simulated seconds per wall second (target: R = 500 at >= 100x).
 // The map, the route table (warmed on every pick and drop) and the orders are built once,
 // outside the timing. Run from a Release build:
@@ -112,12 +113,17 @@ void Simulate(benchmark::State& state, double formation_share, PlannerKind plann
 void BM_SimulateOnCore(benchmark::State& state) { Simulate(state, 0.0); }
 void BM_SimulateFormationsOnCore(benchmark::State& state) { Simulate(state, 0.1); }
 void BM_SimulatePlannerTimeWindows(benchmark::State& state) { Simulate(state, 0.0, PlannerKind::kTimeWindows); }
+void BM_SimulatePlannerConflictElimination(benchmark::State& state) {
+  Simulate(state, 0.0, PlannerKind::kConflictElimination);
+}
 void BM_SimulatePlannerHeat(benchmark::State& state) { Simulate(state, 0.0, PlannerKind::kRules, RoutingKind::kHeat); }
 BENCHMARK(BM_SimulateOnCore)->Arg(18)->Arg(100)->Arg(500)->Unit(benchmark::kMillisecond)
     ->UseRealTime()->Iterations(2);
 BENCHMARK(BM_SimulateFormationsOnCore)->Arg(100)->Arg(500)->Unit(benchmark::kMillisecond)
     ->UseRealTime()->Iterations(2);
 BENCHMARK(BM_SimulatePlannerTimeWindows)->Arg(100)->Arg(500)->Unit(benchmark::kMillisecond)
+    ->UseRealTime()->Iterations(2);
+BENCHMARK(BM_SimulatePlannerConflictElimination)->Arg(100)->Arg(500)->Unit(benchmark::kMillisecond)
     ->UseRealTime()->Iterations(2);
 BENCHMARK(BM_SimulatePlannerHeat)->Arg(100)->Arg(500)->Unit(benchmark::kMillisecond)
     ->UseRealTime()->Iterations(2);

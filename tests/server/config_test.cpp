@@ -74,7 +74,7 @@ TEST(ServerConfigTest, BadValuesAreNamed) {
   EXPECT_NE(strategy.error().message.find("random"), std::string::npos);
   auto planner = Parse({"--planner", "cbs"});
   ASSERT_FALSE(planner.ok());
-  EXPECT_NE(planner.error().message.find("planner must be one of rules, time-windows, got 'cbs'"), std::string::npos);
+  EXPECT_NE(planner.error().message.find("planner must be one of rules, time-windows, conflict-elimination, got 'cbs'"), std::string::npos);
   EXPECT_FALSE(Parse({"--turn-time", "-1"}).ok());
   auto routing = Parse({"--routing", "astar"});
   ASSERT_FALSE(routing.ok());

@@ -27,12 +27,12 @@ std::vector<std::string> Row(const std::string& output, const std::string& name)
 }
 
 TEST(DispatchSimCompareCliTest, PlannersSideBySideWithFailuresStopsAndViolations) {
-  const auto run = Compare("--random 30 --seed 1 --planners rules,time-windows --check-safety");
+  const auto run = Compare("--random 30 --seed 1 --planners rules,time-windows,conflict-elimination --check-safety");
   ASSERT_EQ(run.status, 0) << run.output;
   for (const char* column : {"completed", "failed b/w/o", "stops", "replans", "deadlocks", "min dist", "violations", "ms/order"}) {
     EXPECT_NE(run.output.find(column), std::string::npos) << column << "\n" << run.output;
   }
-  for (const char* planner : {"rules", "time-windows"}) {
+  for (const char* planner : {"rules", "time-windows", "conflict-elimination"}) {
     const std::vector<std::string> row = Row(run.output, planner);
     ASSERT_EQ(row.size(), 14u) << planner << "\n" << run.output;
     EXPECT_EQ(row[1], "30/30") << run.output;

@@ -66,6 +66,39 @@ TEST_F(TimeWindowsTest, TheCheckerFindsOppositeDirectionsOnOneLane) {
   EXPECT_NE(head_on.error().message.find("opposite directions"), std::string::npos) << head_on.error().message;
 }
 
+// BIT2024 step 7's "first conflict" in the windows: the earliest overlap, with each robot's
+// window (so one can be kept and forbidden to the other).
+TEST_F(TimeWindowsTest, EarliestConflictIsTheFirstOverlapInTime) {
+  TimeWindowRules rules;
+  rules.headway_s = 0.0;  // clear 0.5 s
+  ReservationTable table(map, rules);
+  ASSERT_TRUE(table.Reserve(1, {{p0, 0, 0}, {p1, 1, 1}, {p2, 2, 2}, {p3, 3, kForever}}).ok());
+  EXPECT_FALSE(EarliestConflict(table).has_value());
+  // Robot 2 drives r0c2 -> r0c1 over [0.2, 1.2]: the lane r0c1-r0c2 both ways from 1.0, and
+  // before that both at r0c1 from 1.0 as well; a later point conflict at r0c3 from 5.
+  ASSERT_TRUE(table.Reserve(2, {{p2, -1, 0.2}, {p1, 1.2, 1.2}, {p0, 2.2, 4}, {p1, 5, 5}, {p2, 6, 6}, {p3, 7, kForever}}).ok());
+  const auto c = EarliestConflict(table);
+  ASSERT_TRUE(c.has_value());
+  EXPECT_EQ(c->a.robot, 1);
+  EXPECT_EQ(c->b.robot, 2);
+  EXPECT_LT(c->at, 1.0 + 1e-9);
+  EXPECT_GE(c->at, 0.2 - 1e-9);
+  if (c->arc >= 0) {
+    EXPECT_EQ(map->arc(c->arc).reverse_arc >= 0, true);
+  } else {
+    EXPECT_NE(c->point, kNoPoint);
+  }
+  ReservationTable apart(map, rules);
+  ASSERT_TRUE(apart.Reserve(1, {{p0, 0, kForever}}).ok());
+  ASSERT_TRUE(apart.Reserve(2, {{p3, 0, 0}, {p2, 1, kForever}}).ok());
+  EXPECT_FALSE(EarliestConflict(apart).has_value());
+  ASSERT_TRUE(apart.Reserve(3, {{p1, 10, 11}, {p0, 12, kForever}}).ok());  // r0c0 held for ever by 1
+  const auto late = EarliestConflict(apart);
+  ASSERT_TRUE(late.has_value());
+  EXPECT_EQ(late->point, p0);
+  EXPECT_DOUBLE_EQ(late->at, 12.0);
+}
+
 TEST_F(TimeWindowsTest, TheCheckerFindsALaneOverItsCapacity) {
   TimeWindowRules rules;
   rules.headway_s = 0.0;
