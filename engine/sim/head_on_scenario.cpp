@@ -1,6 +1,7 @@
 #include "engine/sim/head_on_scenario.h"
 
 #include <memory>
+#include <string>
 #include <utility>
 
 #include "engine/map/map_builder.h"
@@ -50,39 +51,57 @@ Result<WarehouseMap> HeadOnFloor() {
   return b.Build(options);
 }
 
-Result<HeadOnRun> RunOnce(std::shared_ptr<const WarehouseMap> map,
-                          std::shared_ptr<const RouteTable> routes, double h1_work,
-                          HeadOnPolicy policy) {
+// The two orders of both scenarios: h1 starts at `h1_start`, picks at `h1_pick` for `h1_work`
+// seconds and drops at V; h2 waits at its park P, is released at `h2_release`, picks at U
+// (1 s) and drops at X. Checks that both complete and that the auction gave each order to the
+// robot the scenario means.
+struct TwoOrders {
+  const char* h1_start;
+  const char* h1_pick;
+  double h1_work;
+  double h2_release;
+};
+
+Result<StreamResult> RunTwo(std::shared_ptr<const WarehouseMap> map, std::shared_ptr<const RouteTable> routes,
+                            const TwoOrders& two, const StreamConfig& config, const std::string& scenario) {
   const WarehouseMap& m = *map;
-  std::vector<FleetRobot> robots{{"h1", *m.FindPoint("S1"), 0.0}, {"h2", *m.FindPoint("P"), 0.0}};
+  std::vector<FleetRobot> robots{{"h1", *m.FindPoint(two.h1_start), 0.0}, {"h2", *m.FindPoint("P"), 0.0}};
   Order o1;
   o1.id = "O1";
-  o1.picks = {*m.FindPoint("c5")};
+  o1.picks = {*m.FindPoint(two.h1_pick)};
   o1.drop = *m.FindPoint("V");
-  o1.work_time = h1_work;
+  o1.work_time = two.h1_work;
   o1.release_time = 0.0;
   Order o2;
   o2.id = "O2";
   o2.picks = {*m.FindPoint("U")};
   o2.drop = *m.FindPoint("X");
   o2.work_time = 1.0;
-  o2.release_time = 9.0;
-  o2.created_time = 9.0;
+  o2.release_time = two.h2_release;
+  o2.created_time = two.h2_release;
+  auto r = SimulateOnCore(map, routes, robots, {o1, o2}, config);
+  if (!r.ok()) return r.error();
+  if (!r->all_completed()) return InvalidArgument(scenario + ": an order did not complete");
+  if (r->orders[0].robot != "h1" || r->orders[1].robot != "h2") {
+    return InvalidArgument(scenario + ": O1, O2 went to " + r->orders[0].robot + ", " + r->orders[1].robot);
+  }
+  return r;
+}
+
+double TimeOf(const StreamOrderOutcome& o) { return o.completion_time - o.release_time; }
+
+Result<HeadOnRun> RunOnce(std::shared_ptr<const WarehouseMap> map, std::shared_ptr<const RouteTable> routes,
+                          double h1_work, HeadOnPolicy policy) {
   StreamConfig config;
   config.traffic.head_on = policy;
   config.traffic.t_w1 = 1000.0;  // the policies alone decide
   config.max_time = 600.0;
-  auto r = SimulateOnCore(map, routes, robots, {o1, o2}, config);
+  // h1 is nearer c5 than h2 at 0 s; h2 waits at P, next to O2's pick, when O2 is released.
+  auto r = RunTwo(std::move(map), std::move(routes), {"S1", "c5", h1_work, 9.0}, config, "head-on scenario");
   if (!r.ok()) return r.error();
-  if (!r->all_completed()) return InvalidArgument("head-on scenario: an order did not complete");
-  // The auction gives each order to the robot the scenario means (h1 is nearer c5 than h2 at
-  // 0 s; h2 waits at P, next to O2's pick, when O2 is released).
-  if (r->orders[0].robot != "h1" || r->orders[1].robot != "h2") {
-    return InvalidArgument("head-on scenario: O1, O2 went to " + r->orders[0].robot + ", " + r->orders[1].robot);
-  }
   HeadOnRun run;
-  run.h1_time = r->orders[0].completion_time - r->orders[0].release_time;
-  run.h2_time = r->orders[1].completion_time - r->orders[1].release_time;
+  run.h1_time = TimeOf(r->orders[0]);
+  run.h2_time = TimeOf(r->orders[1]);
   for (const HeadOnRecord& rec : r->traffic.head_on) {
     if (rec.robot != "h2") continue;
     run.replanned = rec.replanned;
@@ -95,34 +114,15 @@ Result<HeadOnRun> RunOnce(std::shared_ptr<const WarehouseMap> map,
 
 Result<CaseOneRun> RunCaseOne(std::shared_ptr<const WarehouseMap> map, std::shared_ptr<const RouteTable> routes,
                               bool head_on_priority) {
-  const WarehouseMap& m = *map;
-  std::vector<FleetRobot> robots{{"h1", *m.FindPoint("S0"), 0.0}, {"h2", *m.FindPoint("P"), 0.0}};
-  Order o1;
-  o1.id = "O1";
-  o1.picks = {*m.FindPoint("S0")};
-  o1.drop = *m.FindPoint("V");
-  o1.work_time = 1.0;
-  o1.release_time = 0.0;
-  Order o2;
-  o2.id = "O2";
-  o2.picks = {*m.FindPoint("U")};
-  o2.drop = *m.FindPoint("X");
-  o2.work_time = 1.0;
-  o2.release_time = 0.5;
-  o2.created_time = 0.5;
   StreamConfig config;
   config.traffic.priority_by_release = true;
   config.traffic.head_on_priority = head_on_priority;
   config.max_time = 600.0;
-  auto r = SimulateOnCore(map, routes, robots, {o1, o2}, config);
+  auto r = RunTwo(std::move(map), std::move(routes), {"S0", "S0", 1.0, 0.5}, config, "case 1 scenario");
   if (!r.ok()) return r.error();
-  if (!r->all_completed()) return InvalidArgument("case 1 scenario: an order did not complete");
-  if (r->orders[0].robot != "h1" || r->orders[1].robot != "h2") {
-    return InvalidArgument("case 1 scenario: O1, O2 went to " + r->orders[0].robot + ", " + r->orders[1].robot);
-  }
   CaseOneRun run;
-  run.h1_time = r->orders[0].completion_time - r->orders[0].release_time;
-  run.h2_time = r->orders[1].completion_time - r->orders[1].release_time;
+  run.h1_time = TimeOf(r->orders[0]);
+  run.h2_time = TimeOf(r->orders[1]);
   run.deadlocks = r->traffic.deadlocks_resolved;
   for (const HeadOnRecord& rec : r->traffic.head_on) {
     run.h1_met_head_on = run.h1_met_head_on || rec.robot == "h1";
