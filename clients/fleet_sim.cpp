@@ -22,6 +22,8 @@
 // (tests trigger faults at a chosen moment, not by the clock): "mute ID" (as --mute, now),
 // "drop ID" (as one --drop-every drop, for that robot). Unknown commands are reported on
 // stderr; EOF just ends the commands.
+// --turn-time S: robots turn in place S seconds per 90 degrees before a new heading (run
+// dispatchd with the same --turn-time so that its plans count the turns).
 // Runs until SIGINT/SIGTERM or --duration wall seconds. --ready-fd N: once every robot has
 // been welcomed, writes "connected N" to the inherited descriptor N and closes it (scripts
 // wait on it, no polling).
@@ -199,7 +201,7 @@ int Main(int argc, char** argv) {
   CLI::App app{"fleet-sim: simulated robots on real gRPC streams"};
   std::string server = "127.0.0.1:50051";
   std::size_t count = 18;
-  double speed = 1.0, report_hz = 10.0, tick_hz = 50.0, duration = 0.0, drop_every = 0.0;
+  double speed = 1.0, report_hz = 10.0, tick_hz = 50.0, duration = 0.0, drop_every = 0.0, turn_time = 0.0;
   int delay_ms = 0;
   int ready_fd = -1, control_fd = -1;
   std::size_t first = 1;
@@ -225,6 +227,8 @@ int Main(int argc, char** argv) {
       ->check(CLI::Range(3, 65535));
   app.add_option("--stall", stall, "Fault: these robots never move (ids, repeat)");
   app.add_option("--slow", slow, "Fault: ID:FACTOR drives at FACTOR x speed (repeat)");
+  app.add_option("--turn-time", turn_time, "Seconds per 90 degrees a robot turns in place before a new heading")
+      ->capture_default_str()->check(CLI::NonNegativeNumber);
   app.add_option("--mute", mute,
                  "Fault: ID:AFTER - after AFTER wall seconds robot ID stops moving and sending anything, "
                  "keeping its stream open (the server's heartbeat timeout must notice); it never "
@@ -270,6 +274,7 @@ int Main(int argc, char** argv) {
         id, Eigen::Vector2d(starts[i].position().x(), starts[i].position().y()), speed);
     by_id[id] = i;
   }
+  for (auto& slot : slots) slot.robot->set_turn_time(turn_time);
   for (const std::string& id : stall) {
     if (!by_id.count(id)) return std::fprintf(stderr, "fleet-sim: --stall: no robot %s\n", id.c_str()), 1;
     slots[by_id[id]].robot->set_stalled(true);

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numbers>
 
 namespace dispatch::clients {
 namespace {
@@ -210,7 +211,18 @@ void SimRobot::Step(double now, std::vector<v1::RobotMessage>& out) {
       continue;
     }
     if (v <= 0.0 || t >= now_) break;
-    heading_ = std::atan2(d.y(), d.x());
+    const double want = std::atan2(d.y(), d.x());
+    if (turning_to_ != front.wp.sequence()) {  // a new leg: turn to it first
+      turning_to_ = front.wp.sequence();
+      const double angle = has_heading_ ? std::abs(std::remainder(want - heading_, 2.0 * std::numbers::pi)) : 0.0;
+      turn_end_ = t + turn_time_ * angle / (std::numbers::pi / 2.0);
+    }
+    if (turn_end_ > t) {
+      if (turn_end_ >= now_) break;  // still turning, standing
+      t = turn_end_;
+    }
+    heading_ = want;
+    has_heading_ = true;
     current_speed_ = v;
     const double reach = v * (now_ - t);
     if (reach + kArriveEps >= dist) {

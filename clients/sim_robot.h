@@ -23,6 +23,11 @@
 // picked events need no repeat: state reports carry the last waypoint, and a drop starts an
 // order that missed its pick.
 //
+// Turning (set_turn_time, fleet-sim --turn-time): before each leg whose heading differs from
+// the one it drove last it turns in place, turn_time seconds per 90 degrees (Wang2019's t_c;
+// none before its first move), as the engine's simulated robot (engine/sim/waypoint_robot.h)
+// and the dispatcher's --turn-time plans it.
+//
 // Faults for tests of the server: a stalled robot does not move (it still talks); a slow
 // robot drives at speed * slow_factor; a muted robot is dead: it neither moves nor produces
 // events from then on (fleet-sim also stops sending anything for it, see fleet_sim.cpp).
@@ -66,6 +71,7 @@ class SimRobot {
 
   void set_stalled(bool stalled) { stalled_ = stalled; }
   void set_slow_factor(double factor) { slow_factor_ = factor; }
+  void set_turn_time(double seconds_per_90) { turn_time_ = seconds_per_90; }
   // Permanent: a muted robot stands still and Step produces nothing.
   void set_muted() { muted_ = true; }
   bool muted() const { return muted_; }
@@ -117,6 +123,10 @@ class SimRobot {
   v1::TimedWaypoint dwell_wp_;
   bool stalled_ = false;
   double slow_factor_ = 1.0;
+  double turn_time_ = 0.0;          // s per 90 degrees
+  bool has_heading_ = false;        // it has moved (before, its heading is not known)
+  std::uint64_t turning_to_ = 0;    // the waypoint (sequence) it turned, or turns, towards
+  double turn_end_ = 0.0;           // when that turn is done
   bool muted_ = false;
   // Drops finished (waypoint sequence -> order id), the most recent kMaxFinishedDrops.
   std::deque<std::pair<std::uint64_t, std::string>> finished_drops_;

@@ -78,6 +78,32 @@ TEST(SimRobotTest, FollowsTheTimedPlanAndReportsInOrder) {
   EXPECT_EQ(r.Report().state_report().last_waypoint_sequence(), 4u);
 }
 
+// With 1 s per 90 degrees the robot turns in place before the leg up to the drop (the first
+// leg, from standing, turns nothing): it reaches the drop 1 s later than without turning.
+TEST(SimRobotTest, TurnsInPlaceBeforeANewHeading) {
+  double reached_drop[2] = {0, 0};
+  for (int turning = 0; turning < 2; ++turning) {
+    SimRobot r("R1", {0, 0}, 1.0);
+    r.set_turn_time(turning);
+    ASSERT_TRUE(r.Apply(Plan(1)));
+    Events run;
+    for (double t = 0; t <= 20 + 1e-9; t += 0.05) {
+      const std::size_t before = run.events.size();
+      r.Step(t, run.events);
+      for (std::size_t k = before; k < run.events.size(); ++k) {
+        if (run.events[k].has_waypoint_reached() && run.events[k].waypoint_reached().sequence() == 4 &&
+            reached_drop[turning] == 0) {
+          reached_drop[turning] = t;
+        }
+      }
+    }
+    EXPECT_EQ(run.Names(), (std::vector<std::string>{"wp1", "wp2", "wp3", "picked", "wp4", "dropped"}));
+  }
+  // Without turning: 4 m, 3 s pick, 3 m -> at the drop by 10 s (its planned eta). With it,
+  // the 90-degree turn after the pick adds 1 s.
+  EXPECT_NEAR(reached_drop[1] - reached_drop[0], 1.0, 0.1);
+}
+
 TEST(SimRobotTest, WaitsForPlannedDepartureWhenAhead) {
   SimRobot r("R1", {0, 0}, 1.0);
   v1::ServerMessage m = Plan(1);
