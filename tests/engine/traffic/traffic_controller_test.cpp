@@ -225,6 +225,24 @@ TEST(TrafficControllerTest, IdleRobotInTheWayIsNudgedToASiding) {
   EXPECT_EQ(ctl.stats().deadlocks_resolved, 0u);
 }
 
+// An idle robot the waiter needs is boxed in by idle robots (found on the Wang2019 grid: two
+// robots had stepped aside next to a corner drop where a third stood done): they step aside
+// first (MakeRoom), then it can, and the waiter gets through.
+TEST(TrafficControllerTest, AnIdleRobotBoxedInByIdleRobotsIsMadeRoomFor) {
+  auto map = Grid({".....", "@@.@@", "@...@"});
+  TrafficController ctl = Make(map);
+  const std::size_t a = *ctl.AddRobot("A", P(*map, "c0"));
+  const std::size_t b = *ctl.AddRobot("B", P(*map, "c2"));  // idle where A is going
+  (void)*ctl.AddRobot("C", P(*map, "c7"));                   // idle below it
+  (void)*ctl.AddRobot("D", P(*map, "c3"));                   // idle beside it
+  ASSERT_TRUE(ctl.SetRoute(a, Route(*map, {"c0", "c1", "c2"})).ok());
+  double t = 0;
+  for (int i = 0; i < 60 && ctl.At(a) != P(*map, "c2"); ++i) Step(ctl, t += 1.0);
+  EXPECT_EQ(ctl.At(a), P(*map, "c2"));
+  EXPECT_NE(ctl.At(b), P(*map, "c2"));
+  EXPECT_GE(ctl.stats().nudges, 2u);
+}
+
 TEST(TrafficControllerTest, WorkingRobotIsNeverMovedAndAWaiterWithoutDetourIsBlocked) {
   auto map = Grid({"...."});
   TrafficControllerConfig config;
