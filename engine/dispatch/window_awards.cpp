@@ -192,8 +192,12 @@ void PlanAwardsByConflictElimination(const std::shared_ptr<const WarehouseMap>& 
   }
   std::vector<std::vector<TimedRoute>> constraints(n);
   std::vector<std::vector<Waypoint>> planned(n);  // the new waypoints of all its awards
-  std::vector<std::vector<std::vector<Waypoint>>> segment_of(n);
-  std::vector<std::vector<double>> ready_of(n);
+  struct Planned {  // one award's segment as planned, and how it follows the robot's queue
+    std::vector<Waypoint> segment;
+    double ready = 0.0;
+    bool fresh = false;
+  };
+  std::vector<std::vector<Planned>> planned_awards(n);
   std::vector<bool> frozen(n, false);  // no route under its constraints: keeps its last plan
   // Plans robot i's awards one after another, each alone: through the windows of the kept
   // plans and its own constraints only (BIT2024: each robot planned on its own, not through
@@ -208,20 +212,18 @@ void PlanAwardsByConflictElimination(const std::shared_ptr<const WarehouseMap>& 
       table = &*own;
     }
     std::vector<Waypoint> queue = round.kept[i];
-    std::vector<std::vector<Waypoint>> segs;
-    std::vector<double> readies;
+    std::vector<Planned> segs;
     for (std::size_t k : awards_of[i]) {
       const auto job = JobOf(awards[k], k, i, queue, now);
       if (!job) return false;
       auto plan = PlanInWindows(*table, routes, job->request);
       if (!plan.ok()) return false;
-      segs.push_back(SegmentOf(*map, plan.value(), job->stops, job->fresh, job->ready, awards[k].segments[0].front()));
-      readies.push_back(job->ready);
+      segs.push_back({SegmentOf(*map, plan.value(), job->stops, job->fresh, job->ready, awards[k].segments[0].front()),
+                      job->ready, job->fresh});
       if (job->fresh) queue.clear();
-      queue.insert(queue.end(), segs.back().begin(), segs.back().end());
+      queue.insert(queue.end(), segs.back().segment.begin(), segs.back().segment.end());
     }
-    segment_of[i] = std::move(segs);
-    ready_of[i] = std::move(readies);
+    planned_awards[i] = std::move(segs);
     // From where its queue ends (a fresh robot: its start), so the first arc is checked too.
     const std::size_t from = round.kept[i].empty() ? 0 : std::min(queue.size(), round.kept[i].size() - 1);
     planned[i].assign(queue.begin() + static_cast<std::ptrdiff_t>(from), queue.end());
@@ -280,12 +282,11 @@ void PlanAwardsByConflictElimination(const std::shared_ptr<const WarehouseMap>& 
                     " iterations; the traffic controller resolves them");
   }
   for (std::size_t i : robots) {
-    for (std::size_t j = 0; j < awards_of[i].size() && j < segment_of[i].size(); ++j) {
+    for (std::size_t j = 0; j < awards_of[i].size() && j < planned_awards[i].size(); ++j) {
       RoundAward& a = awards[awards_of[i][j]];
-      const bool fresh = round.kept[i].size() == 1 && j == 0 && a.segments[0].front().point == round.kept[i].front().point &&
-                         a.segments[0].front().seq == round.kept[i].front().seq;
-      a.segments[0] = segment_of[i][j];
-      if (!fresh) a.after_departure[0] = ready_of[i][j];
+      Planned& p = planned_awards[i][j];
+      a.segments[0] = std::move(p.segment);
+      if (!p.fresh) a.after_departure[0] = p.ready;
     }
   }
 }
