@@ -48,6 +48,9 @@
 #include <thread>
 #include <vector>
 
+#include <nlohmann/json.hpp>
+
+#include "clients/client_security.h"
 #include "clients/robot_stream.h"
 #include "clients/sim_robot.h"
 #include "warehouse/dispatch/v1/map.grpc.pb.h"
@@ -65,6 +68,7 @@ double Seconds(Clock::duration d) { return std::chrono::duration<double>(d).coun
 struct Slot {
   std::unique_ptr<SimRobot> robot;
   std::unique_ptr<RobotStream> stream;
+  std::unique_ptr<v1::FleetService::Stub> stub;  // its own channel (--robot-certs), else the shared one
   bool welcomed = false;
   double welcome_server_time = 0.0;
   double time_scale = 1.0;
@@ -206,9 +210,17 @@ int Main(int argc, char** argv) {
   int ready_fd = -1, control_fd = -1;
   std::size_t first = 1;
   std::vector<std::string> stall, slow, mute;
-  std::string stats_out;
+  std::string stats_out, robot_tokens_file;
   FleetStats stats;
+  ClientSecurity security;
   app.add_option("--server", server, "dispatchd gRPC address HOST:PORT")->capture_default_str();
+  AddSecurityOptions(app, security);
+  app.add_option("--robot-tokens", robot_tokens_file,
+                 "JSON object of robot id -> its own bearer token (robot role); others use --token-file");
+  std::string robot_certs;
+  app.add_option("--robot-certs", robot_certs,
+                 "Folder of robots' client certificates (mTLS): <id>.crt and <id>.key per robot, each robot "
+                 "on a channel of its own (needs --tls-ca)");
   app.add_option("--robots", count, "Number of robots")->capture_default_str()
       ->check(CLI::Range(std::size_t{1}, std::size_t{100000}));
   app.add_option("--first", first, "Number of the first robot: runs R<first>.. on start points <first>..")
@@ -245,10 +257,25 @@ int Main(int argc, char** argv) {
   std::signal(SIGTERM, OnSignal);
   grpc::ChannelArguments channel_args;
   channel_args.SetMaxReceiveMessageSize(512 << 20);  // GetMap of a large grid floor is many MB
-  auto channel = grpc::CreateCustomChannel(server, grpc::InsecureChannelCredentials(), channel_args);
+  std::string error;
+  if (!Resolve(security, error)) return std::fprintf(stderr, "fleet-sim: %s\n", error.c_str()), 2;
+  std::map<std::string, std::string> robot_tokens;
+  if (!robot_tokens_file.empty()) {
+    std::string text;
+    if (!ReadWholeFile(robot_tokens_file, text)) {
+      return std::fprintf(stderr, "fleet-sim: cannot read --robot-tokens '%s'\n", robot_tokens_file.c_str()), 2;
+    }
+    try {
+      robot_tokens = nlohmann::json::parse(text).get<std::map<std::string, std::string>>();
+    } catch (const nlohmann::json::exception& e) {
+      return std::fprintf(stderr, "fleet-sim: --robot-tokens: not a JSON object of strings: %s\n", e.what()), 2;
+    }
+  }
+  auto channel = grpc::CreateCustomChannel(server, Credentials(security), channel_args);
   v1::GetMapResponse map;
   {
     grpc::ClientContext ctx;
+    Authorize(ctx, robot_tokens.empty() ? security.token : robot_tokens.begin()->second);
     ctx.set_wait_for_ready(true);
     ctx.set_deadline(std::chrono::system_clock::now() + std::chrono::seconds(30));
     const grpc::Status s = v1::MapService::NewStub(channel)->GetMap(&ctx, {}, &map);
@@ -258,7 +285,6 @@ int Main(int argc, char** argv) {
       return 1;
     }
   }
-  std::string error;
   std::vector<v1::MapPoint> starts = StartPoints(map.map(), first - 1 + count, &error);
   if (!error.empty()) {
     std::fprintf(stderr, "fleet-sim: %s\n", error.c_str());
@@ -266,6 +292,9 @@ int Main(int argc, char** argv) {
   }
   starts.erase(starts.begin(), starts.begin() + static_cast<std::ptrdiff_t>(first - 1));
   auto fleet_stub = v1::FleetService::NewStub(channel);
+  if (!robot_certs.empty() && security.tls_ca.empty()) {
+    return std::fprintf(stderr, "fleet-sim: --robot-certs needs --tls-ca\n"), 2;
+  }
   std::vector<Slot> slots(count);
   std::map<std::string, std::size_t> by_id;
   for (std::size_t i = 0; i < count; ++i) {
@@ -275,6 +304,15 @@ int Main(int argc, char** argv) {
     by_id[id] = i;
   }
   for (auto& slot : slots) slot.robot->set_turn_time(turn_time);
+  if (!robot_certs.empty()) {  // each robot shows its own certificate: a channel each
+    for (auto& slot : slots) {
+      ClientSecurity own = security;
+      own.tls_cert = robot_certs + "/" + slot.robot->id() + ".crt";
+      own.tls_key = robot_certs + "/" + slot.robot->id() + ".key";
+      if (!Resolve(own, error)) return std::fprintf(stderr, "fleet-sim: --robot-certs: %s\n", error.c_str()), 2;
+      slot.stub = v1::FleetService::NewStub(grpc::CreateCustomChannel(server, Credentials(own), channel_args));
+    }
+  }
   for (const std::string& id : stall) {
     if (!by_id.count(id)) return std::fprintf(stderr, "fleet-sim: --stall: no robot %s\n", id.c_str()), 1;
     slots[by_id[id]].robot->set_stalled(true);
@@ -400,8 +438,9 @@ int Main(int argc, char** argv) {
       }
       if (!s.stream) {
         if (now < s.next_connect) continue;
-        s.stream = std::make_unique<RobotStream>(*fleet_stub, s.robot->Hello(),
-                                                 std::chrono::milliseconds(delay_ms));
+        const auto own = robot_tokens.find(s.robot->id());
+        s.stream = std::make_unique<RobotStream>(s.stub ? *s.stub : *fleet_stub, s.robot->Hello(), std::chrono::milliseconds(delay_ms),
+                                                 own != robot_tokens.end() ? own->second : security.token);
         s.last_sent = now;
         ++s.connects;
       }

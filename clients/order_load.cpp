@@ -21,6 +21,7 @@
 #include <thread>
 #include <vector>
 
+#include "clients/client_security.h"
 #include "warehouse/dispatch/v1/map.grpc.pb.h"
 #include "warehouse/dispatch/v1/orders.grpc.pb.h"
 
@@ -50,14 +51,21 @@ int Main(int argc, char** argv) {
       ->check(CLI::Range(std::size_t{1}, std::size_t{10}));
   app.add_option("--seed", seed, "Random seed for the stops")->capture_default_str();
   app.add_option("--json", json_out, "Write the figures as JSON here");
+  ClientSecurity security;
+  AddSecurityOptions(app, security);
   CLI11_PARSE(app, argc, argv);
+  if (std::string error; !Resolve(security, error)) {
+    std::fprintf(stderr, "order-load: %s\n", error.c_str());
+    return 2;
+  }
 
   grpc::ChannelArguments args;
   args.SetMaxReceiveMessageSize(512 << 20);  // GetMap of a large grid floor
-  auto channel = grpc::CreateCustomChannel(server, grpc::InsecureChannelCredentials(), args);
+  auto channel = grpc::CreateCustomChannel(server, Credentials(security), args);
   v1::GetMapResponse map;
   {
     grpc::ClientContext ctx;
+    Authorize(ctx, security.token);
     ctx.set_wait_for_ready(true);
     ctx.set_deadline(std::chrono::system_clock::now() + std::chrono::seconds(30));
     const grpc::Status s = v1::MapService::NewStub(channel)->GetMap(&ctx, {}, &map);
@@ -103,6 +111,7 @@ int Main(int argc, char** argv) {
       for (std::size_t i = next++; i < orders; i = next++) {
         grpc::ClientContext ctx;
         ctx.set_deadline(std::chrono::system_clock::now() + std::chrono::seconds(30));
+        Authorize(ctx, security.token);
         v1::SubmitOrderResponse response;
         const Clock::time_point sent = Clock::now();
         const grpc::Status s = stub->SubmitOrder(&ctx, requests[i], &response);

@@ -1,10 +1,13 @@
 #include "clients/robot_stream.h"
 
+#include "clients/client_security.h"
+
 namespace dispatch::clients {
 
 RobotStream::RobotStream(v1::FleetService::Stub& stub, const v1::RobotMessage& hello,
-                         std::chrono::milliseconds delay)
+                         std::chrono::milliseconds delay, const std::string& token)
     : delay_(delay) {
+  Authorize(context_, token);
   stub.async()->Connect(&context_, this);
   // Hello goes first, undelayed: the server expects it before anything else.
   outgoing_.push_back({hello, std::chrono::steady_clock::now()});

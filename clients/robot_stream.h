@@ -28,9 +28,10 @@ namespace v1 = ::warehouse::dispatch::v1;
 class RobotStream final : public grpc::ClientBidiReactor<v1::RobotMessage, v1::ServerMessage> {
  public:
   // Starts the call and sends `hello` first. `delay`: every outgoing message waits this long
-  // before it is sent (the "delayed messages" fault); zero sends at once.
+  // before it is sent (the "delayed messages" fault); zero sends at once. `token`: the
+  // bearer token the call carries ("" none).
   RobotStream(v1::FleetService::Stub& stub, const v1::RobotMessage& hello,
-              std::chrono::milliseconds delay = std::chrono::milliseconds(0));
+              std::chrono::milliseconds delay = std::chrono::milliseconds(0), const std::string& token = "");
   ~RobotStream() override;
 
   void Send(const v1::RobotMessage& message);

@@ -19,6 +19,7 @@
 #include <string>
 #include <vector>
 
+#include "clients/client_security.h"
 #include "clients/order_file.h"
 #include "clients/order_text.h"
 #include "warehouse/dispatch/v1/orders.grpc.pb.h"
@@ -29,6 +30,7 @@ namespace {
 struct Options {
   std::string server = "127.0.0.1:50051";
   double timeout = 10.0;  // seconds per unary call
+  ClientSecurity security;
 };
 
 class Client {
@@ -36,7 +38,7 @@ class Client {
   explicit Client(const Options& options)
       : options_(options),
         stub_(v1::OrderService::NewStub(
-            grpc::CreateChannel(options.server, grpc::InsecureChannelCredentials()))) {}
+            grpc::CreateChannel(options.server, Credentials(options.security)))) {}
 
   v1::OrderService::Stub& stub() { return *stub_; }
   std::unique_ptr<grpc::ClientContext> Context() const {
@@ -44,8 +46,10 @@ class Client {
     ctx->set_deadline(std::chrono::system_clock::now() +
                       std::chrono::milliseconds(static_cast<long>(options_.timeout * 1000)));
     ctx->set_wait_for_ready(true);  // a server still starting is waited for, up to the deadline
+    Authorize(*ctx, options_.security.token);
     return ctx;
   }
+  const std::string& token() const { return options_.security.token; }
 
  private:
   Options options_;
@@ -68,6 +72,7 @@ int Report(const std::string& what, const grpc::Status& status) {
 bool WaitTerminal(Client& client, const std::set<std::string>& ids, bool print,
                   std::map<std::string, v1::Order>* final_orders) {
   grpc::ClientContext ctx;
+  Authorize(ctx, client.token());
   v1::WatchOrdersRequest req;
   for (const auto& id : ids) req.add_order_ids(id);
   req.set_from_start(true);
@@ -131,6 +136,7 @@ int Main(int argc, char** argv) {
       ->capture_default_str();
   app.add_option("--timeout", options.timeout, "Seconds per request")->capture_default_str()
       ->check(CLI::PositiveNumber);
+  AddSecurityOptions(app, options.security);
 
   auto* submit = app.add_subcommand("submit", "Submit orders from a file or the command line");
   std::string file, prefix, drop;
@@ -168,6 +174,10 @@ int Main(int argc, char** argv) {
   watch->add_flag("--from-start", from_start, "Replay the whole journal first");
   watch->add_flag("--until-done", until_done, "Exit when every --order is finished");
   CLI11_PARSE(app, argc, argv);
+  if (std::string error; !Resolve(options.security, error)) {
+    std::fprintf(stderr, "wmsctl: %s\n", error.c_str());
+    return 2;
+  }
 
   Client client(options);
   if (submit->parsed()) {
@@ -257,6 +267,7 @@ int Main(int argc, char** argv) {
     return 0;
   }
   grpc::ClientContext ctx;
+  Authorize(ctx, client.token());
   v1::WatchOrdersRequest req;
   for (const auto& w : watch_ids) req.add_order_ids(w);
   req.set_after_event_id(after);

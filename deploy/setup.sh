@@ -14,7 +14,7 @@ PACKAGES=(
   libgtest-dev libgmock-dev libbenchmark-dev
   libgrpc++-dev protobuf-compiler-grpc libprotobuf-dev protobuf-compiler
   libsqlite3-dev
-  libspdlog-dev libcpp-httplib-dev prometheus-cpp-dev
+  libspdlog-dev libcpp-httplib-dev prometheus-cpp-dev libssl-dev openssl
   python3 python3-grpcio python3-protobuf
 )
 if [ "${DISPATCH_TEST_DEPS:-0}" = 1 ]; then

@@ -64,6 +64,11 @@ std::vector<Key> Keys() {
       MakeKey("journal_runs", &ServerConfig::journal_runs),
       MakeKey("journal_max_mb", &ServerConfig::journal_max_mb),
       MakeKey("web_root", &ServerConfig::web_root),
+      MakeKey("tls_cert", &ServerConfig::tls_cert),
+      MakeKey("tls_key", &ServerConfig::tls_key),
+      MakeKey("tls_client_ca", &ServerConfig::tls_client_ca),
+      MakeKey("auth_tokens", &ServerConfig::auth_tokens),
+      MakeKey("metrics_open", &ServerConfig::metrics_open),
       MakeKey("ports_file", &ServerConfig::ports_file),
       MakeKey("ready_fd", &ServerConfig::ready_fd),
       MakeKey("log_level", &ServerConfig::log_level),
@@ -106,6 +111,11 @@ engine::Status ApplyConfigFile(const std::string& path, ServerConfig& config) {
 
 }  // namespace
 
+std::string EffectiveBind(const ServerConfig& c) {
+  if (!c.bind.empty()) return c.bind;
+  return c.tls_cert.empty() ? "127.0.0.1" : "0.0.0.0";
+}
+
 engine::Status ValidateServerConfig(const ServerConfig& c) {
   auto port_ok = [](int p) { return p >= 0 && p <= 65535; };
   if (!port_ok(c.grpc_port)) return InvalidArgument("grpc_port must be in 0..65535");
@@ -113,7 +123,16 @@ engine::Status ValidateServerConfig(const ServerConfig& c) {
     return InvalidArgument("ready_fd must be -1 (none) or an inherited descriptor >= 3");
   }
   if (!port_ok(c.http_port)) return InvalidArgument("http_port must be in 0..65535");
-  if (c.bind.empty()) return InvalidArgument("bind must not be empty");
+  if (c.tls_cert.empty() != c.tls_key.empty()) return InvalidArgument("tls_cert and tls_key go together");
+  if (!c.tls_client_ca.empty() && c.tls_cert.empty()) {
+    return InvalidArgument("tls_client_ca needs tls_cert and tls_key (client certificates come with TLS)");
+  }
+  for (auto [name, path] : {std::pair{"tls_cert", &c.tls_cert}, {"tls_key", &c.tls_key},
+                            {"tls_client_ca", &c.tls_client_ca}, {"auth_tokens", &c.auth_tokens}}) {
+    if (!path->empty() && !std::filesystem::is_regular_file(*path)) {
+      return InvalidArgument(std::string(name) + " '" + *path + "' is not a readable file");
+    }
+  }
   if (c.db.empty()) return InvalidArgument("db must name a SQLite file");
   if (auto strategy = engine::MakeAllocator(c.strategy); !strategy.ok()) return strategy.error();
   if (!engine::ParsePlanner(c.planner)) {
@@ -163,7 +182,8 @@ engine::Result<ParsedCommandLine> ParseCommandLine(int argc, char** argv) {
   ServerConfig flags;
   std::string config_file;
   app.add_option("--config", config_file, "JSON config file with the same keys as the flags");
-  app.add_option("--bind", flags.bind, "Address to listen on")->capture_default_str();
+  app.add_option("--bind", flags.bind,
+                 "Address to listen on (default: 0.0.0.0 with TLS, else 127.0.0.1 only)");
   app.add_option("--grpc-port", flags.grpc_port, "gRPC port (0 = any free port)")->capture_default_str();
   app.add_option("--http-port", flags.http_port, "REST port (0 = any free port)")->capture_default_str();
   app.add_option("--db", flags.db, "SQLite database file")->capture_default_str();
@@ -228,6 +248,13 @@ engine::Result<ParsedCommandLine> ParseCommandLine(int argc, char** argv) {
   app.add_option("--ports-file", flags.ports_file, "Write the chosen ports as JSON here");
   app.add_option("--ready-fd", flags.ready_fd,
                  "Write the chosen ports as one JSON line to this inherited fd, then close it");
+  app.add_option("--tls-cert", flags.tls_cert, "TLS certificate chain (PEM): gRPC over TLS, REST over HTTPS");
+  app.add_option("--tls-key", flags.tls_key, "TLS private key (PEM)");
+  app.add_option("--tls-client-ca", flags.tls_client_ca,
+                 "CA (PEM) of robots' client certificates: a robot's certificate must name its robot id");
+  app.add_option("--auth-tokens", flags.auth_tokens,
+                 "Token file (JSON, SHA-256 of each secret, with roles): bearer tokens required");
+  app.add_option("--metrics-open", flags.metrics_open, "GET /metrics without a token")->capture_default_str();
   app.add_option("--log-level", flags.log_level, "trace|debug|info|warn|error")->capture_default_str();
   try {
     app.parse(argc, argv);

@@ -11,7 +11,9 @@
 namespace dispatch::server {
 
 struct ServerConfig {
-  std::string bind = "0.0.0.0";   // address both listeners bind; tests use 127.0.0.1
+  // Address both listeners bind. "" (the default): secure by default (issue 18 §1), 0.0.0.0
+  // with TLS, else 127.0.0.1 (loopback only; the log says so). EffectiveBind says which.
+  std::string bind;
   int grpc_port = 50051;          // 0 = pick a free port
   int http_port = 8080;           // 0 = pick a free port
   std::string db = "dispatch.db"; // SQLite file
@@ -76,7 +78,22 @@ struct ServerConfig {
   // line once listening, then is closed: readiness without polling. -1 = none.
   int ready_fd = -1;
   std::string log_level = "info";  // spdlog level name
+  // Transport security (issue 18 §1): gRPC over TLS and REST over HTTPS with this certificate
+  // chain and key (PEM files; both or neither). tls_client_ca: robots' streams must present a
+  // client certificate issued by this CA whose subject CN (or a SAN) is the robot id of
+  // their Hello (mTLS); other clients may connect without one.
+  std::string tls_cert;
+  std::string tls_key;
+  std::string tls_client_ca;
+  // Bearer tokens with roles (issue 18 §2, server/auth.h): the token file ("" = no
+  // authentication: every caller may do everything). Re-read on SIGHUP. metrics_open: GET
+  // /metrics without a token (for a scraper inside the cluster).
+  std::string auth_tokens;
+  bool metrics_open = false;
 };
+
+// The address the listeners bind (see ServerConfig::bind).
+std::string EffectiveBind(const ServerConfig& config);
 
 // kInvalidArgument naming the field.
 engine::Status ValidateServerConfig(const ServerConfig& config);

@@ -1,5 +1,8 @@
 #include "server/fleet_service.h"
 
+#include <algorithm>
+
+#include "server/grpc_auth.h"
 #include "server/grpc_status.h"
 #include "server/proto_convert.h"
 #include "server/queued_writer.h"
@@ -28,8 +31,10 @@ class StreamLink final : public RobotLink {
 class RobotStreamReactor final
     : public QueuedWriter<grpc::ServerBidiReactor<pb::RobotMessage, pb::ServerMessage>, pb::ServerMessage> {
  public:
-  explicit RobotStreamReactor(Dispatcher& dispatcher)
-      : dispatcher_(dispatcher), link_(std::make_shared<StreamLink>(this)) {
+  // `allowed`: the robot ids its Hello may name (empty: any); `who` says whose they are.
+  RobotStreamReactor(Dispatcher& dispatcher, std::vector<std::string> allowed, std::string who)
+      : dispatcher_(dispatcher), link_(std::make_shared<StreamLink>(this)), allowed_(std::move(allowed)),
+        who_(std::move(who)) {
     StartRead(&in_);
   }
 
@@ -45,6 +50,13 @@ class RobotStreamReactor final
       RequestFinish(Fitted(ToGrpcStatus(FromEngineError(message.error()))));
       return;
     }
+    if (message->kind == RobotInbound::Kind::kHello && !allowed_.empty() &&
+        std::find(allowed_.begin(), allowed_.end(), message->robot_id) == allowed_.end()) {
+      dispatcher_.OnRobotGone(link_);
+      RequestFinish(Fitted({grpc::StatusCode::PERMISSION_DENIED,
+                            who_ + " may not connect as robot '" + message->robot_id + "'"}));
+      return;
+    }
     dispatcher_.OnRobotMessage(link_, std::move(message).value());
     StartRead(&in_);
   }
@@ -58,7 +70,16 @@ class RobotStreamReactor final
  private:
   Dispatcher& dispatcher_;
   std::shared_ptr<StreamLink> link_;
+  const std::vector<std::string> allowed_;
+  const std::string who_;
   pb::RobotMessage in_;
+};
+
+// A stream refused before it starts (no token, the wrong role, no client certificate).
+class RefusedStream final : public grpc::ServerBidiReactor<pb::RobotMessage, pb::ServerMessage> {
+ public:
+  explicit RefusedStream(grpc::Status status) { Finish(Fitted(std::move(status))); }
+  void OnDone() override { delete this; }
 };
 
 void StreamLink::Send(RobotOutbound message) {
@@ -76,19 +97,46 @@ void StreamLink::Close(ServiceStatus status) {
 }  // namespace
 
 grpc::ServerBidiReactor<pb::RobotMessage, pb::ServerMessage>* FleetServiceImpl::Connect(
-    grpc::CallbackServerContext* /*context*/) {
-  return new RobotStreamReactor(dispatcher_);
+    grpc::CallbackServerContext* context) {
+  const Authenticator::Outcome auth = AuthorizeCall(auth_, *context, Access::kRobotStream);
+  if (!auth.status.ok()) return new RefusedStream(ToGrpcStatus(auth.status));
+  std::vector<std::string> allowed;
+  std::string who = "this stream";
+  if (auth.principal.role == Role::kRobot) {
+    allowed.push_back(auth.principal.robot_id);
+    who = "token '" + auth.principal.name + "' (robot " + auth.principal.robot_id + ")";
+  }
+  if (require_certificate_) {
+    const std::vector<std::string> names = CertificateNames(*context);
+    if (names.empty()) {
+      return new RefusedStream({grpc::StatusCode::UNAUTHENTICATED,
+                                "robot streams need a client certificate issued by the server's client CA"});
+    }
+    if (allowed.empty()) {
+      allowed = names;
+      who = "the client certificate (" + names.front() + ")";
+    } else if (std::find(names.begin(), names.end(), allowed.front()) == names.end()) {
+      return new RefusedStream({grpc::StatusCode::PERMISSION_DENIED,
+                                "the client certificate (" + names.front() + ") is not robot " + allowed.front() +
+                                    "'s, whose token this stream carries"});
+    }
+  }
+  return new RobotStreamReactor(dispatcher_, std::move(allowed), std::move(who));
 }
 
-MapServiceImpl::MapServiceImpl(const Dispatcher& dispatcher) {
+MapServiceImpl::MapServiceImpl(const Dispatcher& dispatcher, const Authenticator& auth) : auth_(auth) {
   MapToProto(dispatcher.map(), dispatcher.options().map_version, &map_);
 }
 
 grpc::ServerUnaryReactor* MapServiceImpl::GetMap(grpc::CallbackServerContext* context,
                                                  const pb::GetMapRequest* /*request*/,
                                                  pb::GetMapResponse* response) {
-  *response = map_;
   auto* reactor = context->DefaultReactor();
+  if (const auto auth = AuthorizeCall(auth_, *context, Access::kReadMap); !auth.status.ok()) {
+    reactor->Finish(Fitted(ToGrpcStatus(auth.status)));
+    return reactor;
+  }
+  *response = map_;
   reactor->Finish(grpc::Status::OK);
   return reactor;
 }

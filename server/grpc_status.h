@@ -19,6 +19,8 @@ inline grpc::Status ToGrpcStatus(const ServiceStatus& s) {
     case StatusCode::kFailedPrecondition: return {grpc::StatusCode::FAILED_PRECONDITION, s.message};
     case StatusCode::kUnavailable: return {grpc::StatusCode::UNAVAILABLE, s.message};
     case StatusCode::kInternal: return {grpc::StatusCode::INTERNAL, s.message};
+    case StatusCode::kUnauthenticated: return {grpc::StatusCode::UNAUTHENTICATED, s.message};
+    case StatusCode::kPermissionDenied: return {grpc::StatusCode::PERMISSION_DENIED, s.message};
   }
   return {grpc::StatusCode::INTERNAL, s.message};
 }

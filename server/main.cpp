@@ -24,6 +24,7 @@ int main(int argc, char** argv) {
   sigemptyset(&signals);
   sigaddset(&signals, SIGTERM);
   sigaddset(&signals, SIGINT);
+  sigaddset(&signals, SIGHUP);  // re-read the token file
   pthread_sigmask(SIG_BLOCK, &signals, nullptr);
 
   auto server = dispatch::server::DispatchServer::Start(config);
@@ -32,7 +33,11 @@ int main(int argc, char** argv) {
     return 1;
   }
   int signal = 0;
-  sigwait(&signals, &signal);
+  for (;;) {
+    sigwait(&signals, &signal);
+    if (signal != SIGHUP) break;
+    (void)(*server)->ReloadTokens();
+  }
   spdlog::info("signal {} received: shutting down", signal);
   (*server)->Shutdown();
   return 0;

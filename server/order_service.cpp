@@ -3,6 +3,7 @@
 #include <optional>
 #include <set>
 
+#include "server/grpc_auth.h"
 #include "server/grpc_status.h"
 #include "server/proto_convert.h"
 #include "server/queued_writer.h"
@@ -14,6 +15,14 @@ grpc::ServerUnaryReactor* Done(grpc::CallbackServerContext* context, grpc::Statu
   auto* reactor = context->DefaultReactor();
   reactor->Finish(Fitted(std::move(status)));
   return reactor;
+}
+
+// nullopt when the call may go on, else its refusal.
+std::optional<grpc::Status> Refused(const Authenticator& auth, const grpc::CallbackServerContext& context,
+                                    Access access) {
+  const Authenticator::Outcome outcome = AuthorizeCall(auth, context, access);
+  if (outcome.status.ok()) return std::nullopt;
+  return ToGrpcStatus(outcome.status);
 }
 
 // One WatchOrders stream: subscribed to the hub before the replay so nothing falls between.
@@ -125,6 +134,7 @@ constexpr int kDefaultPageSize = 100;
 grpc::ServerUnaryReactor* OrderServiceImpl::SubmitOrder(grpc::CallbackServerContext* context,
                                                         const grpc::ByteBuffer* request,
                                                         grpc::ByteBuffer* response) {
+  if (auto refused = Refused(auth_, *context, Access::kSubmitOrder)) return Done(context, std::move(*refused));
   pb::SubmitOrderRequest parsed;
   grpc::ByteBuffer bytes(*request);  // Deserialize consumes its buffer
   if (!grpc::SerializationTraits<pb::SubmitOrderRequest>::Deserialize(&bytes, &parsed).ok()) {
@@ -154,6 +164,7 @@ grpc::ServerUnaryReactor* OrderServiceImpl::SubmitOrder(grpc::CallbackServerCont
 grpc::ServerUnaryReactor* OrderServiceImpl::GetOrder(grpc::CallbackServerContext* context,
                                                      const pb::GetOrderRequest* request,
                                                      pb::Order* response) {
+  if (auto refused = Refused(auth_, *context, Access::kReadOrders)) return Done(context, std::move(*refused));
   engine::Result<std::shared_ptr<const OrderView>> order = std::shared_ptr<const OrderView>();
   std::string key;
   switch (request->key_case()) {
@@ -177,6 +188,7 @@ grpc::ServerUnaryReactor* OrderServiceImpl::GetOrder(grpc::CallbackServerContext
 grpc::ServerUnaryReactor* OrderServiceImpl::CancelOrder(grpc::CallbackServerContext* context,
                                                         const pb::CancelOrderRequest* request,
                                                         pb::Order* response) {
+  if (auto refused = Refused(auth_, *context, Access::kCancelOrder)) return Done(context, std::move(*refused));
   if (request->order_id().empty()) {
     return Done(context, {grpc::StatusCode::INVALID_ARGUMENT, "order_id is required"});
   }
@@ -192,6 +204,7 @@ grpc::ServerUnaryReactor* OrderServiceImpl::CancelOrder(grpc::CallbackServerCont
 grpc::ServerUnaryReactor* OrderServiceImpl::ListOrders(grpc::CallbackServerContext* context,
                                                        const pb::ListOrdersRequest* request,
                                                        pb::ListOrdersResponse* response) {
+  if (auto refused = Refused(auth_, *context, Access::kReadOrders)) return Done(context, std::move(*refused));
   // From the store: it holds every order (memory only the open ones and the newest
   // finished), and it is written before the snapshot changes, so it is never behind it.
   storage::OrderQuery query;
@@ -238,7 +251,8 @@ class RefusedWatch final : public grpc::ServerWriteReactor<pb::OrderEvent> {
 };
 
 grpc::ServerWriteReactor<pb::OrderEvent>* OrderServiceImpl::WatchOrders(
-    grpc::CallbackServerContext* /*context*/, const pb::WatchOrdersRequest* request) {
+    grpc::CallbackServerContext* context, const pb::WatchOrdersRequest* request) {
+  if (auto refused = Refused(auth_, *context, Access::kReadOrders)) return new RefusedWatch(Fitted(std::move(*refused)));
   // Named orders must exist (a submitted order is in the snapshot before SubmitOrder replies).
   for (const std::string& id : request->order_ids()) {
     auto order = dispatcher_.FindAnywhere(id, false, false);
@@ -251,6 +265,7 @@ grpc::ServerWriteReactor<pb::OrderEvent>* OrderServiceImpl::WatchOrders(
 grpc::ServerUnaryReactor* OrderServiceImpl::ExplainAllocation(
     grpc::CallbackServerContext* context, const pb::ExplainAllocationRequest* request,
     pb::AllocationExplanation* response) {
+  if (auto refused = Refused(auth_, *context, Access::kReadOrders)) return Done(context, std::move(*refused));
   auto found = dispatcher_.FindAnywhere(request->order_id(), false, true);
   if (!found.ok()) return Done(context, ToGrpcStatus(FromEngineError(found.error())));
   const std::shared_ptr<const OrderView> order = *found;

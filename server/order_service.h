@@ -4,6 +4,7 @@
 // events from the dispatcher's WatchHub. Thread-safe.
 #pragma once
 
+#include "server/auth.h"
 #include "server/dispatcher.h"
 #include "warehouse/dispatch/v1/orders.grpc.pb.h"
 
@@ -15,7 +16,8 @@ namespace dispatch::server {
 class OrderServiceImpl final : public ::warehouse::dispatch::v1::OrderService::WithRawCallbackMethod_SubmitOrder<
                                    ::warehouse::dispatch::v1::OrderService::CallbackService> {
  public:
-  explicit OrderServiceImpl(Dispatcher& dispatcher) : dispatcher_(dispatcher) {}
+  // Every call is authorized first (server/auth.h: submit, read, cancel orders).
+  OrderServiceImpl(Dispatcher& dispatcher, const Authenticator& auth) : dispatcher_(dispatcher), auth_(auth) {}
 
   grpc::ServerUnaryReactor* SubmitOrder(grpc::CallbackServerContext* context, const grpc::ByteBuffer* request,
                                         grpc::ByteBuffer* response) override;
@@ -38,6 +40,7 @@ class OrderServiceImpl final : public ::warehouse::dispatch::v1::OrderService::W
 
  private:
   Dispatcher& dispatcher_;
+  const Authenticator& auth_;
 };
 
 }  // namespace dispatch::server

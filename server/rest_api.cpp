@@ -3,6 +3,8 @@
 
 #include <httplib.h>
 
+#include "server/auth.h"
+#include "server/service_status.h"
 #include "server/web_assets.h"
 
 namespace dispatch::server {
@@ -39,44 +41,91 @@ void ServeWebMap(httplib::Server& s, const std::string& web_root) {
   }
 }
 
+std::unique_ptr<httplib::Server> MakeServer(const RestSecurity& security) {
+  if (security.tls_cert.empty()) return std::make_unique<httplib::Server>();
+  return std::make_unique<httplib::SSLServer>(security.tls_cert.c_str(), security.tls_key.c_str());
+}
+
+using Handler = std::function<void(const httplib::Request&, httplib::Response&)>;
+
+// `handler` behind the authorization of `access` (none when auth is null or off).
+Handler Guarded(const Authenticator* auth, Access access, Handler handler) {
+  if (!auth || !auth->enabled()) return handler;
+  return [auth, access, handler = std::move(handler)](const httplib::Request& req, httplib::Response& res) {
+    const bool given = req.has_header("Authorization");
+    const std::string value = given ? req.get_header_value("Authorization") : std::string();
+    const Authenticator::Outcome outcome =
+        auth->Authorize(given ? std::optional<std::string_view>(value) : std::nullopt, access);
+    if (!outcome.status.ok()) {
+      if (outcome.status.code == StatusCode::kUnauthenticated) res.set_header("WWW-Authenticate", "Bearer");
+      Reply(res, {HttpStatus(outcome.status.code), RestHandlers::ErrorBody(outcome.status.message)});
+      return;
+    }
+    handler(req, res);
+  };
+}
+
+// POST bodies are JSON: anything else (a form, text/plain, which browsers send cross-origin
+// without asking) is refused with 415.
+bool JsonBody(const httplib::Request& req, httplib::Response& res) {
+  const std::string type = req.get_header_value("Content-Type");
+  const std::string media = type.substr(0, type.find(';'));
+  if (media == "application/json") return true;
+  Reply(res, {415, RestHandlers::ErrorBody("the body must be JSON: send Content-Type: application/json (got '" +
+                                           type.substr(0, 100) + "')")});
+  return false;
+}
+
 }  // namespace
 
-RestServer::RestServer(RestHandlers handlers, const std::string& web_root)
-    : handlers_(handlers), http_(std::make_unique<httplib::Server>()) {
+RestServer::RestServer(RestHandlers handlers, const std::string& web_root, const RestSecurity& security)
+    : handlers_(handlers), http_(MakeServer(security)) {
   auto& h = handlers_;
   auto& s = *http_;
+  const Authenticator* auth = security.auth;
   ServeWebMap(s, web_root);
-  s.Get("/metrics", [&h](const httplib::Request&, httplib::Response& res) { Reply(res, h.Metrics()); });
-  s.Get("/api/v1/map", [&h](const httplib::Request&, httplib::Response& res) { Reply(res, h.Map()); });
-  s.Get("/api/v1/zones", [&h](const httplib::Request&, httplib::Response& res) { Reply(res, h.Zones()); });
-  s.Get("/api/v1/intersections", [&h](const httplib::Request& req, httplib::Response& res) {
-    std::optional<std::string> active;
-    if (req.has_param("active")) active = req.get_param_value("active");
-    Reply(res, h.Intersections(active));
-  });
+  s.Get("/metrics", security.metrics_open
+                        ? Handler([&h](const httplib::Request&, httplib::Response& res) { Reply(res, h.Metrics()); })
+                        : Guarded(auth, Access::kMetrics,
+                                  [&h](const httplib::Request&, httplib::Response& res) { Reply(res, h.Metrics()); }));
+  s.Get("/api/v1/map", Guarded(auth, Access::kReadMap,
+                               [&h](const httplib::Request&, httplib::Response& res) { Reply(res, h.Map()); }));
+  s.Get("/api/v1/zones", Guarded(auth, Access::kReadFleet,
+                                 [&h](const httplib::Request&, httplib::Response& res) { Reply(res, h.Zones()); }));
+  s.Get("/api/v1/intersections",
+        Guarded(auth, Access::kReadFleet, [&h](const httplib::Request& req, httplib::Response& res) {
+          std::optional<std::string> active;
+          if (req.has_param("active")) active = req.get_param_value("active");
+          Reply(res, h.Intersections(active));
+        }));
   s.Get("/healthz", [&h](const httplib::Request&, httplib::Response& res) { Reply(res, h.Health()); });
   s.Get("/readyz", [&h](const httplib::Request&, httplib::Response& res) { Reply(res, h.Ready()); });
-  s.Get("/api/v1/status", [&h](const httplib::Request&, httplib::Response& res) { Reply(res, h.Status()); });
-  s.Get("/api/v1/robots", [&h](const httplib::Request&, httplib::Response& res) { Reply(res, h.Robots()); });
-  s.Get("/api/v1/traffic", [&h](const httplib::Request&, httplib::Response& res) { Reply(res, h.Traffic()); });
-  s.Get(R"(/api/v1/robots/([^/]+))", [&h](const httplib::Request& req, httplib::Response& res) {
-    Reply(res, h.Robot(req.matches[1]));
-  });
-  s.Get("/api/v1/orders", [&h](const httplib::Request& req, httplib::Response& res) {
-    std::optional<std::string> state, finished;
-    if (req.has_param("state")) state = req.get_param_value("state");
-    if (req.has_param("finished")) finished = req.get_param_value("finished");
-    Reply(res, h.Orders(state, finished));
-  });
-  s.Get(R"(/api/v1/orders/([^/]+))", [&h](const httplib::Request& req, httplib::Response& res) {
-    Reply(res, h.Order(req.matches[1]));
-  });
-  s.Post("/api/v1/orders", [&h](const httplib::Request& req, httplib::Response& res) {
-    Reply(res, h.SubmitOrder(req.body));
-  });
-  s.Delete(R"(/api/v1/orders/([^/]+))", [&h](const httplib::Request& req, httplib::Response& res) {
-    Reply(res, h.CancelOrder(req.matches[1], req.has_param("reason") ? req.get_param_value("reason") : ""));
-  });
+  s.Get("/api/v1/status", Guarded(auth, Access::kReadFleet,
+                                  [&h](const httplib::Request&, httplib::Response& res) { Reply(res, h.Status()); }));
+  s.Get("/api/v1/robots", Guarded(auth, Access::kReadFleet,
+                                  [&h](const httplib::Request&, httplib::Response& res) { Reply(res, h.Robots()); }));
+  s.Get("/api/v1/traffic", Guarded(auth, Access::kReadFleet,
+                                   [&h](const httplib::Request&, httplib::Response& res) { Reply(res, h.Traffic()); }));
+  s.Get(R"(/api/v1/robots/([^/]+))",
+        Guarded(auth, Access::kReadFleet,
+                [&h](const httplib::Request& req, httplib::Response& res) { Reply(res, h.Robot(req.matches[1])); }));
+  s.Get("/api/v1/orders", Guarded(auth, Access::kReadOrders, [&h](const httplib::Request& req, httplib::Response& res) {
+          std::optional<std::string> state, finished;
+          if (req.has_param("state")) state = req.get_param_value("state");
+          if (req.has_param("finished")) finished = req.get_param_value("finished");
+          Reply(res, h.Orders(state, finished));
+        }));
+  s.Get(R"(/api/v1/orders/([^/]+))",
+        Guarded(auth, Access::kReadOrders,
+                [&h](const httplib::Request& req, httplib::Response& res) { Reply(res, h.Order(req.matches[1])); }));
+  s.Post("/api/v1/orders",
+         Guarded(auth, Access::kSubmitOrder, [&h](const httplib::Request& req, httplib::Response& res) {
+           if (JsonBody(req, res)) Reply(res, h.SubmitOrder(req.body));
+         }));
+  s.Delete(R"(/api/v1/orders/([^/]+))",
+           Guarded(auth, Access::kCancelOrder, [&h](const httplib::Request& req, httplib::Response& res) {
+             Reply(res, h.CancelOrder(req.matches[1], req.has_param("reason") ? req.get_param_value("reason") : ""));
+           }));
   s.set_payload_max_length(kMaxBodyBytes);
   s.new_task_queue = [] { return new httplib::ThreadPool(kHttpThreads); };
   s.set_read_timeout(kReadTimeoutSeconds);
@@ -110,6 +159,8 @@ RestServer::RestServer(RestHandlers handlers, const std::string& web_root)
 }
 
 RestServer::~RestServer() { Stop(); }
+
+bool RestServer::valid() const { return http_->is_valid(); }
 
 int RestServer::Start(const std::string& bind, int port) {
   int bound = port;

@@ -4,6 +4,13 @@
 // POST /api/v1/orders; DELETE /api/v1/orders/{id}[?reason=]) and serving the web map at `/`
 // (server/web/). Errors are 4xx/5xx with {"error": "..."}. Runs its own listener thread and
 // httplib's worker pool.
+//
+// Security (issue 18): HTTPS when given a certificate and key; with an Authenticator that is
+// enabled every /api/v1 endpoint needs `Authorization: Bearer <token>` of a role that may do
+// it (401 / 403 otherwise, server/auth.h), /metrics too unless metrics_open; /healthz,
+// /readyz and the web map's own files stay open. POST bodies must say Content-Type
+// application/json (415 otherwise: a cross-origin form or text/plain POST cannot create
+// orders).
 // Thread-safe: Start once, Stop from any thread.
 #pragma once
 
@@ -20,10 +27,21 @@ class Server;
 
 namespace dispatch::server {
 
+class Authenticator;
+
+struct RestSecurity {
+  std::string tls_cert;  // PEM files; both empty: plain HTTP
+  std::string tls_key;
+  const Authenticator* auth = nullptr;  // null: no authentication (must outlive the server)
+  bool metrics_open = false;
+};
+
 class RestServer {
  public:
   // web_root: serve the web map from this folder ("" = the built-in copy).
-  RestServer(RestHandlers handlers, const std::string& web_root);
+  RestServer(RestHandlers handlers, const std::string& web_root, const RestSecurity& security = {});
+  // False when the TLS certificate or key could not be loaded.
+  bool valid() const;
   ~RestServer();
   RestServer(const RestServer&) = delete;
   RestServer& operator=(const RestServer&) = delete;

@@ -15,7 +15,6 @@
 #include "server/rest_views.h"
 
 namespace dispatch::server {
-namespace {
 
 int HttpStatus(StatusCode code) {
   switch (code) {
@@ -26,9 +25,13 @@ int HttpStatus(StatusCode code) {
     case StatusCode::kFailedPrecondition: return 409;
     case StatusCode::kUnavailable: return 503;
     case StatusCode::kInternal: return 500;
+    case StatusCode::kUnauthenticated: return 401;
+    case StatusCode::kPermissionDenied: return 403;
   }
   return 500;
 }
+
+namespace {
 
 RestReply Json(int status, const google::protobuf::Message& body) { return {status, ToJson(body)}; }
 RestReply Error(int status, const std::string& message) { return {status, ErrorJson(message)}; }

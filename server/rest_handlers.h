@@ -16,6 +16,10 @@ namespace dispatch::server {
 
 class Dispatcher;
 class ServiceMetrics;
+enum class StatusCode;
+
+// The one mapping of service codes onto HTTP statuses (401, 403, 409, 503, ...).
+int HttpStatus(StatusCode code);
 
 // Finished orders GET /api/v1/orders lists by default and at most (the newest).
 inline constexpr std::size_t kListedFinished = 100;

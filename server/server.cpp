@@ -19,6 +19,7 @@
 #include "engine/routing/route_table.h"
 #include "storage/journal_json.h"
 #include "storage/journal_store.h"
+#include "server/auth.h"
 #include "server/dispatcher.h"
 #include "server/fleet_service.h"
 #include "server/metered_store.h"
@@ -90,6 +91,36 @@ engine::Result<StartedJournal> StartJournal(const ServerConfig& config, const Di
   spdlog::info("journal: run {} in {} (the newest {} runs kept; dispatch-sim replay --db {})", *run, config.db,
                config.journal_runs, config.db);
   return StartedJournal{std::move(opened).value(), *run};
+}
+
+engine::Result<std::string> ReadPem(const std::string& what, const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) return engine::IoError("cannot read " + what + " '" + path + "'");
+  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  if (text.find("-----BEGIN ") == std::string::npos) {
+    return engine::InvalidArgument(what + " '" + path + "' is not PEM");
+  }
+  return text;
+}
+
+// gRPC's credentials: TLS from config.tls_cert/key (client certificates requested, and
+// verified against tls_client_ca, when given), else plaintext.
+engine::Result<std::shared_ptr<grpc::ServerCredentials>> GrpcCredentials(const ServerConfig& config) {
+  if (config.tls_cert.empty()) return grpc::InsecureServerCredentials();
+  auto cert = ReadPem("tls_cert", config.tls_cert);
+  if (!cert.ok()) return cert.error();
+  auto key = ReadPem("tls_key", config.tls_key);
+  if (!key.ok()) return key.error();
+  grpc::SslServerCredentialsOptions options(config.tls_client_ca.empty()
+                                                ? GRPC_SSL_DONT_REQUEST_CLIENT_CERTIFICATE
+                                                : GRPC_SSL_REQUEST_CLIENT_CERTIFICATE_AND_VERIFY);
+  if (!config.tls_client_ca.empty()) {
+    auto ca = ReadPem("tls_client_ca", config.tls_client_ca);
+    if (!ca.ok()) return ca.error();
+    options.pem_root_certs = *ca;
+  }
+  options.pem_key_cert_pairs.push_back({*key, *cert});
+  return grpc::SslServerCredentials(options);
 }
 
 }  // namespace
@@ -181,29 +212,61 @@ engine::Result<std::unique_ptr<DispatchServer>> DispatchServer::Start(const Serv
   s->dispatcher_ = std::move(dispatcher).value();
   s->dispatcher_->Start();
 
-  s->order_service_ = std::make_unique<OrderServiceImpl>(*s->dispatcher_);
-  s->fleet_service_ = std::make_unique<FleetServiceImpl>(*s->dispatcher_);
-  s->map_service_ = std::make_unique<MapServiceImpl>(*s->dispatcher_);
+  if (config.auth_tokens.empty()) {
+    s->auth_ = std::make_unique<Authenticator>();
+  } else {
+    auto auth = Authenticator::FromFile(config.auth_tokens);
+    if (!auth.ok()) return auth.error();
+    s->auth_ = std::move(auth).value();
+    spdlog::info("authentication: {} tokens from {} (SIGHUP re-reads it)", s->auth_->token_count(),
+                 config.auth_tokens);
+  }
+  const std::string bind = EffectiveBind(config);
+  if (config.tls_cert.empty()) {
+    spdlog::warn("no TLS: gRPC and HTTP are plaintext{}", config.bind.empty()
+                                                              ? "; listening on loopback only (give --tls-cert and "
+                                                                "--tls-key, or --bind, to listen elsewhere)"
+                                                              : "");
+  }
+  if (!s->auth_->enabled()) spdlog::warn("no --auth-tokens: every caller may do everything");
+  auto credentials = GrpcCredentials(config);
+  if (!credentials.ok()) return credentials.error();
+
+  s->order_service_ = std::make_unique<OrderServiceImpl>(*s->dispatcher_, *s->auth_);
+  s->fleet_service_ = std::make_unique<FleetServiceImpl>(*s->dispatcher_, *s->auth_, !config.tls_client_ca.empty());
+  s->map_service_ = std::make_unique<MapServiceImpl>(*s->dispatcher_, *s->auth_);
   grpc::ServerBuilder builder;
+  // One listener per port: a second dispatchd on the same port must fail, not share it.
+  builder.AddChannelArgument(GRPC_ARG_ALLOW_REUSEPORT, 0);
   int grpc_port = 0;
-  builder.AddListeningPort(config.bind + ":" + std::to_string(config.grpc_port),
-                           grpc::InsecureServerCredentials(), &grpc_port);
+  builder.AddListeningPort(bind + ":" + std::to_string(config.grpc_port), *credentials, &grpc_port);
   builder.RegisterService(s->order_service_.get());
   builder.RegisterService(s->fleet_service_.get());
   builder.RegisterService(s->map_service_.get());
   s->grpc_ = builder.BuildAndStart();
   if (!s->grpc_ || grpc_port == 0) {
-    return engine::IoError("cannot listen for gRPC on " + config.bind + ":" + std::to_string(config.grpc_port));
+    return engine::IoError("cannot listen for gRPC on " + bind + ":" + std::to_string(config.grpc_port));
   }
   s->ports_.grpc = grpc_port;
 
-  s->rest_ = std::make_unique<RestServer>(RestHandlers(*s->dispatcher_, s->metrics_.get()), config.web_root);
-  const int http_port = s->rest_->Start(config.bind, config.http_port);
+  RestSecurity security;
+  security.tls_cert = config.tls_cert;
+  security.tls_key = config.tls_key;
+  security.auth = s->auth_.get();
+  security.metrics_open = config.metrics_open;
+  s->rest_ = std::make_unique<RestServer>(RestHandlers(*s->dispatcher_, s->metrics_.get()), config.web_root, security);
+  if (!s->rest_->valid()) {
+    return engine::InvalidArgument("HTTPS: cannot load the certificate '" + config.tls_cert + "' with the key '" +
+                                   config.tls_key + "' (do they match?)");
+  }
+  const int http_port = s->rest_->Start(bind, config.http_port);
   if (http_port <= 0) {
-    return engine::IoError("cannot listen for HTTP on " + config.bind + ":" + std::to_string(config.http_port));
+    return engine::IoError("cannot listen for HTTP on " + bind + ":" + std::to_string(config.http_port));
   }
   s->ports_.http = http_port;
-  spdlog::info("listening: gRPC {}:{}, HTTP {}:{}", config.bind, grpc_port, config.bind, http_port);
+  const char* scheme = config.tls_cert.empty() ? "" : " (TLS)";
+  spdlog::info("listening: gRPC{} {}:{}, HTTP{} {}:{}", scheme, bind, grpc_port, config.tls_cert.empty() ? "" : "S",
+               bind, http_port);
   if (!config.ports_file.empty()) {
     if (auto written = WritePortsFile(config.ports_file, s->ports_); !written.ok()) return written.error();
     spdlog::info("ports written to {}", config.ports_file);
@@ -215,6 +278,16 @@ engine::Result<std::unique_ptr<DispatchServer>> DispatchServer::Start(const Serv
 }
 
 DispatchServer::~DispatchServer() { Shutdown(); }
+
+engine::Status DispatchServer::ReloadTokens() {
+  if (!auth_ || !auth_->enabled()) return engine::Ok{};
+  if (auto reloaded = auth_->Reload(); !reloaded.ok()) {
+    spdlog::error("tokens not reloaded (the previous ones stay in force): {}", reloaded.error().message);
+    return reloaded;
+  }
+  spdlog::info("authentication: {} tokens reloaded", auth_->token_count());
+  return engine::Ok{};
+}
 
 void DispatchServer::Shutdown() {
   std::lock_guard<std::mutex> lock(shutdown_mu_);

@@ -32,6 +32,7 @@ class FleetServiceImpl;
 class MapServiceImpl;
 class ServiceMetrics;
 class MeteredStore;
+class Authenticator;
 
 struct ServerPorts {
   int grpc = 0;
@@ -51,6 +52,8 @@ class DispatchServer {
   ServerPorts ports() const { return ports_; }
   Dispatcher& dispatcher() { return *dispatcher_; }
   void Shutdown();
+  // Re-reads the token file (SIGHUP); on an error the tokens in force stay (and it is logged).
+  engine::Status ReloadTokens();
 
  private:
   DispatchServer() = default;
@@ -61,6 +64,7 @@ class DispatchServer {
   storage::Store* store_ = nullptr;
   std::unique_ptr<storage::JournalStore> journal_;  // the core's journal (config.db), if kept
   std::unique_ptr<Dispatcher> dispatcher_;
+  std::unique_ptr<Authenticator> auth_;  // before the services, which hold a reference
   std::unique_ptr<OrderServiceImpl> order_service_;
   std::unique_ptr<FleetServiceImpl> fleet_service_;
   std::unique_ptr<MapServiceImpl> map_service_;

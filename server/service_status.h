@@ -18,6 +18,8 @@ enum class StatusCode {
   kFailedPrecondition,  // not allowed in the current state (e.g. cancel a completed order)
   kUnavailable,         // storage failed (nothing was accepted) or shutting down
   kInternal,            // a broken invariant
+  kUnauthenticated,     // no token, or one the server does not know (server/auth.h)
+  kPermissionDenied,    // a known token whose role may not do this
 };
 
 struct ServiceStatus {

@@ -72,6 +72,11 @@ def not_json(server):
         post_fails(server, 400, body, "not JSON")
     for body in ["[1, 2]", "null", "\"an order\"", "42"]:
         post_fails(server, 400, body, "JSON object")
+    # Issue 18: a body that does not say it is JSON (a browser's cross-origin text/plain or
+    # form POST, or none at all) creates nothing.
+    for headers in [{"Content-Type": "text/plain"}, {"Content-Type": "application/x-www-form-urlencoded"}, {}]:
+        expect_http_error(server, "POST", ORDERS, 415, "Content-Type: application/json", body=order("csrf-1"),
+                          headers=headers)
 
 
 def wrong_types(server):
@@ -114,7 +119,7 @@ def bad_orders(server, book):
     post_fails(server, 400, order("c" * 129), "longer than 128")
     first = next(iter(book.orders))  # <tag>-good-1: picks K1-1-1N, drop D-B1
     post_fails(server, 409, order(first, drop="D-B2"), first, book.orders[first]["id"])
-    status, ctype, data = http_call(server, "POST", ORDERS, order(first))
+    status, ctype, data = http_call(server, "POST", ORDERS, order(first), headers={"Content-Type": "application/json"})
     j = json_body(status, ctype, data, "the same submission again")
     check(status == 200 and j["created"] is False and j["order"]["id"] == book.orders[first]["id"],
           f"the same submission again: HTTP {status} {j}")

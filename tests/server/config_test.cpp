@@ -90,6 +90,26 @@ TEST(ServerConfigTest, BadValuesAreNamed) {
   auto scale = Parse({"--time-scale", "0"});
   ASSERT_FALSE(scale.ok());
   EXPECT_NE(scale.error().message.find("time_scale"), std::string::npos);
+  auto half_tls = Parse({"--tls-cert", file});
+  ASSERT_FALSE(half_tls.ok());
+  EXPECT_NE(half_tls.error().message.find("tls_cert and tls_key go together"), std::string::npos);
+  auto missing = Parse({"--auth-tokens", dir.File("none.json")});
+  ASSERT_FALSE(missing.ok());
+  EXPECT_NE(missing.error().message.find("auth_tokens"), std::string::npos);
+  auto client_ca = Parse({"--tls-client-ca", file});
+  ASSERT_FALSE(client_ca.ok());
+  EXPECT_NE(client_ca.error().message.find("tls_client_ca needs tls_cert"), std::string::npos);
+}
+
+// Issue 18 §1: with no TLS and no --bind, dispatchd listens on loopback only.
+TEST(ServerConfigTest, SecureByDefaultBindsLoopbackWithoutTls) {
+  ServerConfig c;
+  EXPECT_EQ(EffectiveBind(c), "127.0.0.1");
+  c.tls_cert = "server.crt";
+  c.tls_key = "server.key";
+  EXPECT_EQ(EffectiveBind(c), "0.0.0.0");
+  c.bind = "10.0.0.5";
+  EXPECT_EQ(EffectiveBind(c), "10.0.0.5");
 }
 
 }  // namespace

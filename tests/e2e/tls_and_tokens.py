@@ -1,0 +1,236 @@
+#!/usr/bin/env python3
+"""Issue 18 §1-3: dispatchd with TLS, robots' client certificates (mTLS) and bearer tokens with
+roles, as deploy/dev_certs.sh makes them, against real clients:
+  - a plaintext gRPC client and a plaintext HTTP client are refused (the TLS handshake fails);
+  - over TLS without a token: UNAUTHENTICATED / HTTP 401 (with WWW-Authenticate: Bearer), an
+    unknown token too; /healthz stays open;
+  - a wms token submits orders and reads them, but may not read the fleet (403), connect as a
+    robot (PERMISSION_DENIED) or POST a body that is not JSON (415);
+  - an operator token reads the fleet but may not submit (PERMISSION_DENIED);
+  - robot streams: without a client certificate UNAUTHENTICATED; R1's certificate and token
+    saying Hello as R2 PERMISSION_DENIED; R3's credentials saying Hello as R1 while R1 works
+    (a hijack) PERMISSION_DENIED, and R1's order completes untouched;
+  - fleet-sim with per-robot tokens and certificates and wmsctl with a wms token run an order
+    to completion;
+  - SIGHUP re-reads the token file: a revoked token is refused from then on.
+
+    tls_and_tokens.py --stubs DIR --dispatchd BIN --fleet-sim BIN --wmsctl BIN --scenarios DIR ...
+"""
+import http.client
+import json
+import os
+import queue
+import signal
+import ssl
+import subprocess
+import sys
+import threading
+
+sys.dont_write_bytecode = True  # no __pycache__ in the source tree
+sys.path.insert(0, sys.argv[sys.argv.index("--stubs") + 1])
+import grpc  # noqa: E402
+from e2e_harness import COMPLETED, Harness, TestFailure, check, common_arguments  # noqa: E402
+from warehouse.dispatch.v1 import common_pb2, fleet_pb2, fleet_pb2_grpc, orders_pb2, orders_pb2_grpc  # noqa: E402
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+DEV_CERTS = os.path.join(HERE, "..", "..", "deploy", "dev_certs.sh")
+Code = grpc.StatusCode
+PARK = (30.625, 24.75)  # park-P10, away from fleet-sim's robots
+
+
+def read(path):
+    with open(path, "rb") as f:
+        return f.read()
+
+
+class Credentials:
+    def __init__(self, folder):
+        self.folder = folder
+        self.ca = read(os.path.join(folder, "ca.crt"))
+        self.secrets = {role: read(os.path.join(folder, "secrets", f"{role}.token")).decode().strip()
+                        for role in ("wms", "operator", "admin")}
+        with open(os.path.join(folder, "secrets", "robot-tokens.json")) as f:
+            self.robot_secrets = json.load(f)
+
+    def channel(self, server, robot=None):
+        """A TLS channel to the server (with robot's client certificate when given)."""
+        key = cert = None
+        if robot:
+            key = read(os.path.join(self.folder, "robots", f"{robot}.key"))
+            cert = read(os.path.join(self.folder, "robots", f"{robot}.crt"))
+        creds = grpc.ssl_channel_credentials(root_certificates=self.ca, private_key=key, certificate_chain=cert)
+        return grpc.secure_channel(f"localhost:{server.grpc_port}", creds)
+
+
+def bearer(secret):
+    return [("authorization", f"Bearer {secret}")] if secret else []
+
+
+def expect_rpc_error(what, code, call, *words):
+    try:
+        call()
+    except grpc.RpcError as err:
+        check(err.code() == code, f"{what}: {err.code().name} '{err.details()}', want {code.name}")
+        missing = [w for w in words if w.lower() not in (err.details() or "").lower()]
+        check(not missing, f"{what}: '{err.details()}' does not name {missing}")
+        print(f"[e2e] {what}: {code.name} '{err.details()}'", flush=True)
+        return
+    raise TestFailure(f"{what}: succeeded, want {code.name}")
+
+
+def https(server, creds, method, path, secret=None, body=None, content_type="application/json"):
+    context = ssl.create_default_context(cadata=creds.ca.decode())
+    conn = http.client.HTTPSConnection("localhost", server.http_port, context=context, timeout=10)
+    headers = {}
+    if secret:
+        headers["Authorization"] = f"Bearer {secret}"
+    if body is not None:
+        headers["Content-Type"] = content_type
+    try:
+        conn.request(method, path, body=body, headers=headers)
+        resp = conn.getresponse()
+        return resp.status, resp.getheader("WWW-Authenticate") or "", resp.read()
+    finally:
+        conn.close()
+
+
+class RobotStream:
+    """One Connect call driven by the test (see bad_input_fleet.py)."""
+
+    def __init__(self, channel, secret, robot_id):
+        self._out = queue.Queue()
+        pose = common_pb2.Pose(x=PARK[0], y=PARK[1], theta=0.0)
+        self._out.put(fleet_pb2.RobotMessage(hello=fleet_pb2.Hello(robot_id=robot_id, pose=pose)))
+        self._in = queue.Queue()
+        stub = fleet_pb2_grpc.FleetServiceStub(channel)
+        self.call = stub.Connect(iter(self._out.get, None), timeout=30, metadata=bearer(secret))
+        threading.Thread(target=self._read, daemon=True).start()
+
+    def _read(self):
+        try:
+            for m in self.call:
+                self._in.put(m)
+            self._in.put(("end", self.call.code(), self.call.details() or ""))
+        except grpc.RpcError as err:
+            self._in.put(("end", err.code(), err.details() or ""))
+
+    def expect_end(self, what, code, *words):
+        while True:
+            try:
+                m = self._in.get(timeout=15)  # the server's answer, not a sleep
+            except queue.Empty:
+                raise TestFailure(f"{what}: the stream neither answered nor ended")
+            if isinstance(m, tuple):
+                break
+            check(m.WhichOneof("body") != "welcome", f"{what}: the server welcomed the stream")
+        _, got, details = m
+        self._out.put(None)
+        check(got == code, f"{what}: stream ended with {got.name} '{details}', want {code.name}")
+        missing = [w for w in words if w.lower() not in details.lower()]
+        check(not missing, f"{what}: '{details}' does not name {missing}")
+        print(f"[e2e] {what}: {code.name} '{details}'", flush=True)
+
+
+def order_request(client_id, pick="K3-2-3N", drop="D-B2"):
+    r = orders_pb2.SubmitOrderRequest(client_order_id=client_id)
+    r.picks.add().point_name = pick
+    r.drop.point_name = drop
+    return r
+
+
+def main():
+    args = common_arguments(__doc__).parse_args()
+    with Harness(args, "tls-tokens") as h:
+        folder = os.path.join(h.work, "pki")
+        subprocess.run(["bash", DEV_CERTS, folder, "3"], check=True, timeout=60)
+        creds = Credentials(folder)
+        tokens = os.path.join(folder, "tokens.json")
+        server = h.start_server(["--time-scale", "10", "--tls-cert", os.path.join(folder, "server.crt"),
+                                 "--tls-key", os.path.join(folder, "server.key"),
+                                 "--tls-client-ca", os.path.join(folder, "ca.crt"), "--auth-tokens", tokens])
+        wms, operator = creds.secrets["wms"], creds.secrets["operator"]
+
+        # Plaintext is refused.
+        plain = orders_pb2_grpc.OrderServiceStub(grpc.insecure_channel(server.grpc))
+        expect_rpc_error("plaintext gRPC", Code.UNAVAILABLE,
+                         lambda: plain.ListOrders(orders_pb2.ListOrdersRequest(), timeout=5, metadata=bearer(wms)))
+        try:
+            conn = http.client.HTTPConnection("127.0.0.1", server.http_port, timeout=5)
+            conn.request("GET", "/healthz")
+            status = conn.getresponse().status
+            raise TestFailure(f"plaintext HTTP answered {status}")
+        except (OSError, http.client.HTTPException) as err:
+            print(f"[e2e] plaintext HTTP refused: {type(err).__name__}", flush=True)
+
+        # TLS: who may do what.
+        orders = orders_pb2_grpc.OrderServiceStub(creds.channel(server))
+        expect_rpc_error("no token", Code.UNAUTHENTICATED,
+                         lambda: orders.ListOrders(orders_pb2.ListOrdersRequest(), timeout=10), "Bearer")
+        expect_rpc_error("unknown token", Code.UNAUTHENTICATED,
+                         lambda: orders.ListOrders(orders_pb2.ListOrdersRequest(), timeout=10,
+                                                   metadata=bearer("not-a-token")), "unknown")
+        expect_rpc_error("operator submits", Code.PERMISSION_DENIED,
+                         lambda: orders.SubmitOrder(order_request("op-1"), timeout=10, metadata=bearer(operator)),
+                         "operator", "submit")
+        status, challenge, _ = https(server, creds, "GET", "/api/v1/orders")
+        check(status == 401 and challenge == "Bearer", f"REST without a token: {status} '{challenge}'")
+        status, _, _ = https(server, creds, "GET", "/healthz")
+        check(status == 200, f"/healthz over HTTPS without a token: {status}")
+        status, _, body = https(server, creds, "GET", "/api/v1/robots", wms)
+        check(status == 403, f"wms reads the fleet: HTTP {status} {body[:200]!r}")
+        status, _, body = https(server, creds, "GET", "/api/v1/robots", operator)
+        check(status == 200, f"operator reads the fleet: HTTP {status} {body[:200]!r}")
+        status, _, body = https(server, creds, "POST", "/api/v1/orders", wms,
+                                body=json.dumps({"client_order_id": "text-1", "picks": [{"point_name": "K3-2-3N"}],
+                                                 "drop": {"point_name": "D-B2"}}), content_type="text/plain")
+        check(status == 415, f"text/plain POST: HTTP {status} {body[:200]!r}")
+
+        # Robot identity.
+        RobotStream(creds.channel(server), creds.robot_secrets["R1"], "R1").expect_end(
+            "robot stream without a client certificate", Code.UNAUTHENTICATED, "certificate")
+        RobotStream(creds.channel(server, "R1"), wms, "R1").expect_end(
+            "wms token connects as a robot", Code.PERMISSION_DENIED, "wms")
+        RobotStream(creds.channel(server, "R1"), creds.robot_secrets["R1"], "R2").expect_end(
+            "R1 says Hello as R2", Code.PERMISSION_DENIED, "R2")
+        RobotStream(creds.channel(server, "R1"), creds.robot_secrets["R2"], "R2").expect_end(
+            "R1's certificate with R2's token", Code.PERMISSION_DENIED, "R1")
+
+        # The fleet and a WMS, each with its own credentials, run an order to the end; a
+        # hijack of R1 meanwhile is refused.
+        h.start_fleet(server, 3, ["--tls-ca", os.path.join(folder, "ca.crt"),
+                                  "--robot-tokens", os.path.join(folder, "secrets", "robot-tokens.json"),
+                                  "--robot-certs", os.path.join(folder, "robots")])
+        submitted = orders.SubmitOrder(order_request("tls-1"), timeout=10, metadata=bearer(wms))
+        RobotStream(creds.channel(server, "R3"), creds.robot_secrets["R3"], "R1").expect_end(
+            "hijack of R1 with R3's credentials", Code.PERMISSION_DENIED, "R1")
+        wmsctl = [args.wmsctl, "--server", f"localhost:{server.grpc_port}", "--tls-ca", os.path.join(folder, "ca.crt"),
+                  "--token-file", os.path.join(folder, "secrets", "wms.token")]
+        r = subprocess.run(wmsctl + ["submit", "--pick", "K3-3-1N", "--drop", "D-B2", "--id", "tls-2", "--wait"],
+                           capture_output=True, text=True, timeout=120)
+        sys.stdout.write(r.stdout + r.stderr)
+        check(r.returncode == 0, f"wmsctl with TLS and a wms token exited {r.returncode}")
+        h.wait_for(lambda: orders.GetOrder(orders_pb2.GetOrderRequest(order_id=submitted.order.id), timeout=10,
+                                           metadata=bearer(wms)).state == COMPLETED, 120,
+                   f"{submitted.order.id} (R1's order during the hijack) completed")
+
+        # SIGHUP: the wms token revoked.
+        with open(tokens) as f:
+            table = json.load(f)
+        table["tokens"] = [t for t in table["tokens"] if t["role"] != "wms"]
+        with open(tokens, "w") as f:
+            json.dump(table, f)
+        server.popen.send_signal(signal.SIGHUP)
+
+        def revoked():
+            try:
+                orders.ListOrders(orders_pb2.ListOrdersRequest(), timeout=10, metadata=bearer(wms))
+                return False
+            except grpc.RpcError as err:
+                return err.code() == Code.UNAUTHENTICATED
+        h.wait_for(revoked, 10, "the wms token refused after SIGHUP")
+        orders.ListOrders(orders_pb2.ListOrdersRequest(), timeout=10, metadata=bearer(operator))
+        h.log("TLS, mTLS and tokens hold")
+
+
+if __name__ == "__main__":
+    main()
