@@ -1,9 +1,11 @@
 #!/usr/bin/env bash
 # The container end to end (SPEC §1 "it ships as a container"; ../shared/CONTAINERS.md):
 #  1. builds deploy/Dockerfile with podman (no Docker engine here; the Dockerfile is standard);
-#  2. runs dispatchd from the image (database in a host folder mounted as its volume) and
-#     fleet-sim (3 robots) from the same image in a second container;
-#  3. submits an order with the image's wmsctl and waits until it is done;
+#  2. runs dispatchd from the image with its default flags (TLS, robots' client certificates
+#     and tokens from deploy/dev_certs.sh mounted at /etc/dispatch; database in a host folder
+#     mounted as its volume) and fleet-sim (3 robots, each with its certificate and token)
+#     from the same image in a second container;
+#  3. submits an order with the image's wmsctl and the WMS token and waits until it is done;
 #  4. stops dispatchd with SIGTERM (it must exit 0), starts it again on the same volume and
 #     checks that the completed order is still there.
 # Installs podman, runc and debootstrap (apt-get, idempotent). With no registry reachable it
@@ -67,9 +69,13 @@ podman build --pull=never --network host -f deploy/Dockerfile -t "$IMAGE" . >"$w
   { tail -40 "$work/build.log" >&2; fail "podman build"; }
 log "built in $(( $(date +%s) - start )) s, $(podman image inspect --format '{{.Size}}' "$IMAGE") bytes"
 
-# The image runs as uid 10001; the volume is a host folder it owns.
+# The image runs as uid 10001; the volume is a host folder it owns, and so is the PKI.
 mkdir -p "$work/data"
 chown 10001:10001 "$work/data"
+bash deploy/dev_certs.sh "$work/pki" 3 >/dev/null
+chown -R 10001:10001 "$work/pki"
+pki=(-v "$work/pki:/etc/dispatch:ro")
+tls=(--tls-ca /etc/dispatch/ca.crt)
 
 # Waits for the ports file dispatchd writes once it listens, then for /readyz.
 ready() {
@@ -82,12 +88,13 @@ ready() {
   [ -n "$ports" ] || fail "dispatchd wrote no ports file"
   grpc=$(python3 -c 'import json,sys; print(json.loads(sys.argv[1])["grpc_port"])' "$ports")
   http=$(python3 -c 'import json,sys; print(json.loads(sys.argv[1])["http_port"])' "$ports")
-  python3 - "$http" <<'PY' || fail "/readyz"
-import sys, time, urllib.request
+  python3 - "$http" "$work/pki/ca.crt" <<'PY' || fail "/readyz"
+import ssl, sys, time, urllib.request
+context = ssl.create_default_context(cafile=sys.argv[2])
 deadline = time.time() + 30
 while True:
     try:
-        with urllib.request.urlopen(f"http://127.0.0.1:{sys.argv[1]}/readyz", timeout=2) as r:
+        with urllib.request.urlopen(f"https://localhost:{sys.argv[1]}/readyz", timeout=2, context=context) as r:
             if r.status == 200:
                 break
     except OSError:
@@ -106,24 +113,32 @@ start_server() {
 }
 
 # Loopback ports chosen by dispatchd (port 0): no clash with anything else on this machine.
-podman create --name "$server" --ulimit host --network host -v "$work/data:/var/lib/dispatch" "$IMAGE" \
+# The image's TLS and token flags, as its default command has them.
+podman create --name "$server" --ulimit host --network host -v "$work/data:/var/lib/dispatch" "${pki[@]}" "$IMAGE" \
   --bind 127.0.0.1 --grpc-port 0 --http-port 0 --ports-file /var/lib/dispatch/ports.json \
-  --db /var/lib/dispatch/dispatch.db --map chu2024 --time-scale 10 >/dev/null
+  --db /var/lib/dispatch/dispatch.db --map chu2024 --time-scale 10 \
+  --tls-cert /etc/dispatch/server.crt --tls-key /etc/dispatch/server.key \
+  --tls-client-ca /etc/dispatch/ca.crt --auth-tokens /etc/dispatch/tokens.json >/dev/null
 start_server
 
-podman run -d --name "$fleet" --ulimit host --network host --entrypoint fleet-sim "$IMAGE" \
-  --server "127.0.0.1:$grpc" --robots 3 >/dev/null
+podman run -d --name "$fleet" --ulimit host --network host "${pki[@]}" --entrypoint fleet-sim "$IMAGE" \
+  --server "localhost:$grpc" --robots 3 "${tls[@]}" --robot-tokens /etc/dispatch/secrets/robot-tokens.json \
+  --robot-certs /etc/dispatch/robots >/dev/null
 log "fleet-sim: 3 robots"
 
 log "submitting an order with wmsctl and waiting for it"
-timeout 300 podman run --rm --ulimit host --network host --entrypoint wmsctl "$IMAGE" \
-  --server "127.0.0.1:$grpc" submit --id container-test-1 --pick "19 17" --drop "6.5 2.75" --wait ||
+timeout 300 podman run --rm --ulimit host --network host "${pki[@]}" --entrypoint wmsctl "$IMAGE" \
+  --server "localhost:$grpc" "${tls[@]}" --token-file /etc/dispatch/secrets/wms.token \
+  submit --id container-test-1 --pick "19 17" --drop "6.5 2.75" --wait ||
   fail "the order did not complete"
 
 completed() {
-  python3 - "$http" <<'PY'
-import json, sys, urllib.request
-with urllib.request.urlopen(f"http://127.0.0.1:{sys.argv[1]}/api/v1/orders?state=completed", timeout=5) as r:
+  python3 - "$http" "$work/pki" <<'PY'
+import json, ssl, sys, urllib.request
+context = ssl.create_default_context(cafile=sys.argv[2] + "/ca.crt")
+request = urllib.request.Request(f"https://localhost:{sys.argv[1]}/api/v1/orders?state=completed")
+request.add_header("Authorization", "Bearer " + open(sys.argv[2] + "/secrets/operator.token").read().strip())
+with urllib.request.urlopen(request, timeout=5, context=context) as r:
     orders = json.load(r)["orders"]
 print(len(orders))
 PY
@@ -139,4 +154,4 @@ code=$(podman inspect --format '{{.State.ExitCode}}' "$server")
 log "starting dispatchd again on the same volume"
 start_server
 [ "$(completed)" = 1 ] || fail "the completed order is gone after the restart"
-log "passed: image $IMAGE built, order completed, SIGTERM exit 0, order kept across a restart"
+log "passed: image $IMAGE built, TLS and tokens, order completed, SIGTERM exit 0, order kept across a restart"

@@ -7,7 +7,7 @@ namespace dispatch::server {
 
 engine::Result<std::vector<storage::OrderEvent>> StoreChange(
     storage::Store& store, const engine::Change& change, const std::vector<std::string>* award_details,
-    const std::function<storage::RobotRecord(const std::string&)>& record_of) {
+    const std::function<storage::RobotRecord(const std::string&)>& record_of, const std::string& actor) {
   const double now = change.time;
   const std::map<std::string, std::uint64_t> messages = change.MessageCounts();
   std::set<std::string> robots;  // records to store: new plans (their queue), reserved sequences
@@ -18,7 +18,7 @@ engine::Result<std::vector<storage::OrderEvent>> StoreChange(
     events.clear();
     for (const engine::OrderChange& line : change.orders) {
       if (line.to) {
-        const storage::OrderTransition t{line.order_id, *line.to, now, line.robots, line.detail, line.distance};
+        const storage::OrderTransition t{line.order_id, *line.to, now, line.robots, line.detail, line.distance, actor};
         auto e = s.TransitionOrder(t);
         if (!e.ok()) return e.error();
         events.push_back(*e);

@@ -17,9 +17,10 @@ namespace dispatch::server {
 
 // `award_details`: per award of the change's round, its explanation as journaled (null: not
 // a round). `record_of`: a robot's record as it stands before the change. Returns the journal
-// events written, in order.
+// events written, in order. `actor`: who made the change (its state changes' actor: the token
+// name of a cancel, "" for the dispatcher's own changes).
 engine::Result<std::vector<storage::OrderEvent>> StoreChange(
     storage::Store& store, const engine::Change& change, const std::vector<std::string>* award_details,
-    const std::function<storage::RobotRecord(const std::string&)>& record_of);
+    const std::function<storage::RobotRecord(const std::string&)>& record_of, const std::string& actor = "");
 
 }  // namespace dispatch::server

@@ -138,8 +138,17 @@ class Dispatcher {
   const DispatcherOptions& options() const { return options_; }
 
   // --- Orders (callbacks run on the loop thread; they must not block) ------------------
-  void SubmitOrder(engine::OrderRequest request, std::function<void(SubmitReply)> done);
-  void CancelOrder(std::string order_id, std::string reason, std::function<void(OrderReply)> done);
+  // `actor`: who asks (the token's name, server/auth.h; "" without tokens), journaled with the
+  // events the call makes.
+  void SubmitOrder(engine::OrderRequest request, std::string actor, std::function<void(SubmitReply)> done);
+  void CancelOrder(std::string order_id, std::string reason, std::string actor,
+                   std::function<void(OrderReply)> done);
+
+  // --- Operator commands (issue 18 §4) --------------------------------------------------
+  // Pauses (paused) or resumes robot `robot_id` for `actor` (the token's name): journaled with
+  // who, and the robot held at its next point (engine DispatchCore::Pause). `done` runs once
+  // the snapshot shows it (RobotView::paused_by).
+  void PauseRobot(std::string robot_id, bool paused, std::string actor, std::function<void(ServiceStatus)> done);
 
   // --- Robot streams -----------------------------------------------------------------
   // Every message of a stream, Hello first. Replies go to `link`.
@@ -182,8 +191,9 @@ class Dispatcher {
   double Now() const { return clock_.Now(); }
 
   // Orders (dispatcher_orders.cpp).
-  void DoSubmit(const engine::OrderRequest& request, const std::function<void(SubmitReply)>& done);
-  void DoCancel(const std::string& order_id, const std::string& reason,
+  void DoSubmit(const engine::OrderRequest& request, const std::string& actor,
+                const std::function<void(SubmitReply)>& done);
+  void DoCancel(const std::string& order_id, const std::string& reason, const std::string& actor,
                 const std::function<void(OrderReply)>& done);
   std::string NextOrderId();
 
@@ -191,7 +201,9 @@ class Dispatcher {
   // transaction (journal, plans, the robots' reserved message sequences; with `round` the
   // awards' explanations), then applies it to the core and the order views and sends its
   // messages. False (and *status) when the store failed: nothing changed.
-  bool Commit(const engine::Change& change, const ServerRound* round, ServiceStatus* status = nullptr);
+  // `actor`: who made it (the token name of an operator's or WMS's call; "" the dispatcher).
+  bool Commit(const engine::Change& change, const ServerRound* round, ServiceStatus* status = nullptr,
+              const std::string& actor = "");
   // The robot as stored: the core's robot and the session.
   storage::RobotRecord RecordOf(const std::string& robot_id) const;
   // Stamps the robot's next message sequence and the time, and sends if connected.

@@ -11,10 +11,11 @@ storage::RobotRecord Dispatcher::RecordOf(const std::string& id) const {
   return server::RecordOf(core_->robot(id), sessions_.Find(id));
 }
 
-bool Dispatcher::Commit(const engine::Change& change, const ServerRound* round, ServiceStatus* status) {
+bool Dispatcher::Commit(const engine::Change& change, const ServerRound* round, ServiceStatus* status,
+                        const std::string& actor) {
   if (change.empty()) return true;
   auto events = StoreChange(store_, change, round ? &round->details : nullptr,
-                            [this](const std::string& id) { return RecordOf(id); });
+                            [this](const std::string& id) { return RecordOf(id); }, actor);
   if (!events.ok()) {
     if (status) *status = FromEngineError(events.error());
     spdlog::error("{} order changes not stored, nothing changed: {}", change.orders.size(), events.error().message);

@@ -24,32 +24,33 @@ std::string Dispatcher::NextOrderId() {
 
 // --- Orders --------------------------------------------------------------------------------
 
-void Dispatcher::SubmitOrder(engine::OrderRequest request, std::function<void(SubmitReply)> done) {
+void Dispatcher::SubmitOrder(engine::OrderRequest request, std::string actor, std::function<void(SubmitReply)> done) {
   // The route searches towards the order's stops run first, on the route worker: the loop's
   // reachability check and the auction then find them cached.
   auto shared = std::make_shared<const engine::OrderRequest>(std::move(request));
-  route_worker_->Run([this, shared, done = std::move(done)](bool cancelled) {
+  route_worker_->Run([this, shared, actor = std::move(actor), done = std::move(done)](bool cancelled) {
     if (!cancelled) {
       for (const engine::PointId p : engine::StopsOf(*map_, *shared, options_.snap)) routes_->Prepare(p);
     }
-    Post([this, shared, done] {
-      DoSubmit(*shared, [this, done](SubmitReply reply) {
+    Post([this, shared, actor, done] {
+      DoSubmit(*shared, actor, [this, done](SubmitReply reply) {
         Defer([done, reply = std::move(reply)]() mutable { done(std::move(reply)); });
       });
     });
   });
 }
 
-void Dispatcher::CancelOrder(std::string order_id, std::string reason,
+void Dispatcher::CancelOrder(std::string order_id, std::string reason, std::string actor,
                              std::function<void(OrderReply)> done) {
-  Post([this, order_id = std::move(order_id), reason = std::move(reason), done = std::move(done)] {
-    DoCancel(order_id, reason, [this, done](OrderReply reply) {
+  Post([this, order_id = std::move(order_id), reason = std::move(reason), actor = std::move(actor),
+        done = std::move(done)] {
+    DoCancel(order_id, reason, actor, [this, done](OrderReply reply) {
       Defer([done, reply = std::move(reply)]() mutable { done(std::move(reply)); });
     });
   });
 }
 
-void Dispatcher::DoSubmit(const engine::OrderRequest& request,
+void Dispatcher::DoSubmit(const engine::OrderRequest& request, const std::string& actor,
                           const std::function<void(SubmitReply)>& done) {
   SubmitReply reply;
   engine::OrderRequest req = request;
@@ -62,7 +63,7 @@ void Dispatcher::DoSubmit(const engine::OrderRequest& request,
   engine::Order order = std::move(admitted).value();
   if (auto existing = book_.FindClient(order.client_id)) return done(AnswerRepeat(std::move(existing), order));
   // Not in memory: new, or finished long ago (retired). The store decides which.
-  auto inserted = store_.InsertOrder(order);
+  auto inserted = store_.InsertOrder(order, actor);
   if (!inserted.ok()) {
     reply.status = NotInserted(inserted.error(), order.client_id);
     spdlog::warn("submit {}: {}", order.client_id, reply.status.message);
@@ -84,10 +85,11 @@ void Dispatcher::DoSubmit(const engine::OrderRequest& request,
   if (auto events = store_.ListEvents(first); events.ok() && !events->empty()) {
     Journal(events->front());
   }
-  spdlog::info("order {} ({}) accepted", view->record.order.id, view->record.order.client_id);
+  spdlog::info("order {} ({}) accepted{}", view->record.order.id, view->record.order.client_id,
+               actor.empty() ? "" : " from " + actor);
 }
 
-void Dispatcher::DoCancel(const std::string& order_id, const std::string& reason,
+void Dispatcher::DoCancel(const std::string& order_id, const std::string& reason, const std::string& actor,
                           const std::function<void(OrderReply)>& done) {
   OrderReply reply;
   auto view = book_.Find(order_id);
@@ -106,7 +108,7 @@ void Dispatcher::DoCancel(const std::string& order_id, const std::string& reason
     reply.status = FromEngineError(change.error());
     return done(std::move(reply));
   }
-  if (!Commit(*change, nullptr, &reply.status)) return done(std::move(reply));
+  if (!Commit(*change, nullptr, &reply.status, actor)) return done(std::move(reply));
   reply.order = book_.Find(order_id);
   done(std::move(reply));
 }

@@ -16,6 +16,23 @@ void Dispatcher::OnRobotMessage(std::shared_ptr<RobotLink> link, RobotInbound me
   Post([this, link = std::move(link), message = std::move(message)] { DoRobotMessage(link, message); });
 }
 
+void Dispatcher::PauseRobot(std::string robot_id, bool paused, std::string actor,
+                            std::function<void(ServiceStatus)> done) {
+  Post([this, id = std::move(robot_id), paused, actor = std::move(actor), done = std::move(done)] {
+    const engine::Status status = core_->Pause(id, paused, actor);
+    ServiceStatus reply;
+    if (!status.ok()) {
+      reply = status.error().code == engine::ErrorCode::kNotFound
+                  ? MakeStatus(StatusCode::kNotFound, status.error().message)
+                  : FromEngineError(status.error());
+    } else {
+      spdlog::info("robot {} {} by {}", id, paused ? "paused" : "resumed", actor.empty() ? "an operator" : actor);
+    }
+    effects_.MarkChanged();
+    Defer([done, reply = std::move(reply)] { done(reply); });
+  });
+}
+
 void Dispatcher::OnRobotGone(std::shared_ptr<RobotLink> link) {
   Post([this, link = std::move(link)] { DoRobotGone(link); });
 }

@@ -12,8 +12,9 @@ auto MeteredStore::Timed(const char* op, Fn&& fn) {
   return result;
 }
 
-engine::Result<storage::InsertOrderResult> MeteredStore::InsertOrder(const engine::Order& order) {
-  return Timed("insert_order", [&] { return inner_.InsertOrder(order); });
+engine::Result<storage::InsertOrderResult> MeteredStore::InsertOrder(const engine::Order& order,
+                                                                     const std::string& actor) {
+  return Timed("insert_order", [&] { return inner_.InsertOrder(order, actor); });
 }
 
 engine::Result<storage::OrderEvent> MeteredStore::TransitionOrder(const storage::OrderTransition& transition) {

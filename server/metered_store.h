@@ -15,7 +15,7 @@ class MeteredStore final : public storage::Store {
   // `inner` and `metrics` must outlive this decorator.
   MeteredStore(storage::Store& inner, ServiceMetrics& metrics) : inner_(inner), metrics_(metrics) {}
 
-  engine::Result<storage::InsertOrderResult> InsertOrder(const engine::Order& order) override;
+  engine::Result<storage::InsertOrderResult> InsertOrder(const engine::Order& order, const std::string& actor) override;
   engine::Result<storage::OrderRecord> GetOrder(const std::string& order_id) override {
     return inner_.GetOrder(order_id);
   }

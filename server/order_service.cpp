@@ -134,7 +134,8 @@ constexpr int kDefaultPageSize = 100;
 grpc::ServerUnaryReactor* OrderServiceImpl::SubmitOrder(grpc::CallbackServerContext* context,
                                                         const grpc::ByteBuffer* request,
                                                         grpc::ByteBuffer* response) {
-  if (auto refused = Refused(auth_, *context, Access::kSubmitOrder)) return Done(context, std::move(*refused));
+  const Authenticator::Outcome auth = AuthorizeCall(auth_, *context, Access::kSubmitOrder);
+  if (!auth.status.ok()) return Done(context, ToGrpcStatus(auth.status));
   pb::SubmitOrderRequest parsed;
   grpc::ByteBuffer bytes(*request);  // Deserialize consumes its buffer
   if (!grpc::SerializationTraits<pb::SubmitOrderRequest>::Deserialize(&bytes, &parsed).ok()) {
@@ -145,7 +146,8 @@ grpc::ServerUnaryReactor* OrderServiceImpl::SubmitOrder(grpc::CallbackServerCont
   auto converted = OrderRequestFromProto(parsed);
   if (!converted.ok()) return Done(context, ToGrpcStatus(FromEngineError(converted.error())));
   auto* reactor = context->DefaultReactor();
-  dispatcher_.SubmitOrder(std::move(converted).value(), [this, reactor, response](SubmitReply reply) {
+  dispatcher_.SubmitOrder(std::move(converted).value(), auth.principal.name,
+                          [this, reactor, response](SubmitReply reply) {
     if (reply.status.ok()) {
       pb::SubmitOrderResponse out;
       OrderToProto(*reply.order, dispatcher_.map(), out.mutable_order());
@@ -188,12 +190,13 @@ grpc::ServerUnaryReactor* OrderServiceImpl::GetOrder(grpc::CallbackServerContext
 grpc::ServerUnaryReactor* OrderServiceImpl::CancelOrder(grpc::CallbackServerContext* context,
                                                         const pb::CancelOrderRequest* request,
                                                         pb::Order* response) {
-  if (auto refused = Refused(auth_, *context, Access::kCancelOrder)) return Done(context, std::move(*refused));
+  const Authenticator::Outcome auth = AuthorizeCall(auth_, *context, Access::kCancelOrder);
+  if (!auth.status.ok()) return Done(context, ToGrpcStatus(auth.status));
   if (request->order_id().empty()) {
     return Done(context, {grpc::StatusCode::INVALID_ARGUMENT, "order_id is required"});
   }
   auto* reactor = context->DefaultReactor();
-  dispatcher_.CancelOrder(request->order_id(), request->reason(),
+  dispatcher_.CancelOrder(request->order_id(), request->reason(), auth.principal.name,
                           [this, reactor, response](OrderReply reply) {
                             if (reply.status.ok()) OrderToProto(*reply.order, dispatcher_.map(), response);
                             reactor->Finish(Fitted(ToGrpcStatus(reply.status)));

@@ -252,6 +252,7 @@ void EventToProto(const storage::OrderEvent& e, pb::OrderEvent* out) {
   out->set_time(e.time);
   for (const auto& r : e.robots) out->add_robot_ids(r);
   out->set_detail(e.detail);
+  out->set_actor(e.actor);
 }
 
 void AllocationToProto(const AllocationRecord& a, const engine::WarehouseMap& map,

@@ -47,10 +47,16 @@ std::unique_ptr<httplib::Server> MakeServer(const RestSecurity& security) {
 }
 
 using Handler = std::function<void(const httplib::Request&, httplib::Response&)>;
+// A handler that is told who calls (the token's name; "" without tokens).
+using ActorHandler = std::function<void(const httplib::Request&, httplib::Response&, const std::string&)>;
 
 // `handler` behind the authorization of `access` (none when auth is null or off).
-Handler Guarded(const Authenticator* auth, Access access, Handler handler) {
-  if (!auth || !auth->enabled()) return handler;
+Handler Guarded(const Authenticator* auth, Access access, ActorHandler handler) {
+  if (!auth || !auth->enabled()) {
+    return [handler = std::move(handler)](const httplib::Request& req, httplib::Response& res) {
+      handler(req, res, "");
+    };
+  }
   return [auth, access, handler = std::move(handler)](const httplib::Request& req, httplib::Response& res) {
     const bool given = req.has_header("Authorization");
     const std::string value = given ? req.get_header_value("Authorization") : std::string();
@@ -61,8 +67,14 @@ Handler Guarded(const Authenticator* auth, Access access, Handler handler) {
       Reply(res, {HttpStatus(outcome.status.code), RestHandlers::ErrorBody(outcome.status.message)});
       return;
     }
-    handler(req, res);
+    handler(req, res, outcome.principal.name);
   };
+}
+
+Handler Guarded(const Authenticator* auth, Access access, Handler handler) {
+  return Guarded(auth, access, ActorHandler([handler = std::move(handler)](const httplib::Request& req,
+                                                                           httplib::Response& res,
+                                                                           const std::string&) { handler(req, res); }));
 }
 
 // POST bodies are JSON: anything else (a form, text/plain, which browsers send cross-origin
@@ -109,6 +121,14 @@ RestServer::RestServer(RestHandlers handlers, const std::string& web_root, const
   s.Get(R"(/api/v1/robots/([^/]+))",
         Guarded(auth, Access::kReadFleet,
                 [&h](const httplib::Request& req, httplib::Response& res) { Reply(res, h.Robot(req.matches[1])); }));
+  for (const bool paused : {true, false}) {
+    s.Post(paused ? R"(/api/v1/robots/([^/]+)/pause)" : R"(/api/v1/robots/([^/]+)/resume)",
+           Guarded(auth, Access::kRobotCommand,
+                   ActorHandler([&h, paused](const httplib::Request& req, httplib::Response& res,
+                                             const std::string& actor) {
+                     Reply(res, h.PauseRobot(req.matches[1], paused, actor));
+                   })));
+  }
   s.Get("/api/v1/orders", Guarded(auth, Access::kReadOrders, [&h](const httplib::Request& req, httplib::Response& res) {
           std::optional<std::string> state, finished;
           if (req.has_param("state")) state = req.get_param_value("state");
@@ -119,13 +139,16 @@ RestServer::RestServer(RestHandlers handlers, const std::string& web_root, const
         Guarded(auth, Access::kReadOrders,
                 [&h](const httplib::Request& req, httplib::Response& res) { Reply(res, h.Order(req.matches[1])); }));
   s.Post("/api/v1/orders",
-         Guarded(auth, Access::kSubmitOrder, [&h](const httplib::Request& req, httplib::Response& res) {
-           if (JsonBody(req, res)) Reply(res, h.SubmitOrder(req.body));
-         }));
+         Guarded(auth, Access::kSubmitOrder,
+                 ActorHandler([&h](const httplib::Request& req, httplib::Response& res, const std::string& actor) {
+                   if (JsonBody(req, res)) Reply(res, h.SubmitOrder(req.body, actor));
+                 })));
   s.Delete(R"(/api/v1/orders/([^/]+))",
-           Guarded(auth, Access::kCancelOrder, [&h](const httplib::Request& req, httplib::Response& res) {
-             Reply(res, h.CancelOrder(req.matches[1], req.has_param("reason") ? req.get_param_value("reason") : ""));
-           }));
+           Guarded(auth, Access::kCancelOrder,
+                   ActorHandler([&h](const httplib::Request& req, httplib::Response& res, const std::string& actor) {
+                     Reply(res, h.CancelOrder(req.matches[1],
+                                              req.has_param("reason") ? req.get_param_value("reason") : "", actor));
+                   })));
   s.set_payload_max_length(kMaxBodyBytes);
   s.new_task_queue = [] { return new httplib::ThreadPool(kHttpThreads); };
   s.set_read_timeout(kReadTimeoutSeconds);

@@ -1,7 +1,8 @@
 // RestServer: cpp-httplib HTTP server routing to RestHandlers (GET /healthz, /readyz,
 // /api/v1/status, /api/v1/robots[/{id}], /api/v1/orders[?state=], /api/v1/orders/{id},
 // /api/v1/map, /api/v1/zones, /api/v1/intersections, /api/v1/traffic, /metrics;
-// POST /api/v1/orders; DELETE /api/v1/orders/{id}[?reason=]) and serving the web map at `/`
+// POST /api/v1/orders, /api/v1/robots/{id}/pause, /api/v1/robots/{id}/resume; DELETE
+// /api/v1/orders/{id}[?reason=]) and serving the web map at `/`
 // (server/web/). Errors are 4xx/5xx with {"error": "..."}. Runs its own listener thread and
 // httplib's worker pool.
 //

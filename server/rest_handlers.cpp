@@ -128,6 +128,15 @@ RestReply RestHandlers::Robot(const std::string& id) const {
   return Json(200, out);
 }
 
+RestReply RestHandlers::PauseRobot(const std::string& id, bool paused, const std::string& actor) {
+  const ServiceStatus status = dispatcher_.Call<ServiceStatus>([this, id, paused, actor](
+                                                                   std::function<void(ServiceStatus)> done) {
+    dispatcher_.PauseRobot(id, paused, actor, std::move(done));
+  });
+  if (!status.ok()) return Error(status);
+  return Robot(id);
+}
+
 RestReply RestHandlers::Orders(const std::optional<std::string>& state,
                                const std::optional<std::string>& finished) const {
   std::optional<engine::OrderState> filter;
@@ -193,14 +202,14 @@ RestReply RestHandlers::Order(const std::string& id) {
   return Json(200, out);
 }
 
-RestReply RestHandlers::SubmitOrder(const std::string& body) {
+RestReply RestHandlers::SubmitOrder(const std::string& body, const std::string& actor) {
   pb::SubmitOrderRequest parsed;
   if (auto read = FromJson(body, &parsed); !read.ok()) return Error(FromEngineError(read.error()));
   auto request = OrderRequestFromProto(parsed);
   if (!request.ok()) return Error(FromEngineError(request.error()));
   SubmitReply reply = dispatcher_.Call<SubmitReply>(
-      [this, r = std::move(request).value()](std::function<void(SubmitReply)> done) mutable {
-        dispatcher_.SubmitOrder(std::move(r), std::move(done));
+      [this, r = std::move(request).value(), actor](std::function<void(SubmitReply)> done) mutable {
+        dispatcher_.SubmitOrder(std::move(r), actor, std::move(done));
       });
   if (!reply.status.ok()) return Error(reply.status);
   pb::SubmitOrderResponse out;
@@ -209,10 +218,11 @@ RestReply RestHandlers::SubmitOrder(const std::string& body) {
   return Json(reply.created ? 201 : 200, out);
 }
 
-RestReply RestHandlers::CancelOrder(const std::string& id, const std::string& reason) {
+RestReply RestHandlers::CancelOrder(const std::string& id, const std::string& reason, const std::string& actor) {
   // The reason is stored and sent back in Order.reason: a proto string, so UTF-8.
-  OrderReply reply = dispatcher_.Call<OrderReply>([this, id, why = ValidUtf8(reason)](std::function<void(OrderReply)> done) {
-    dispatcher_.CancelOrder(id, why, std::move(done));
+  OrderReply reply = dispatcher_.Call<OrderReply>([this, id, why = ValidUtf8(reason), actor](
+                                                      std::function<void(OrderReply)> done) {
+    dispatcher_.CancelOrder(id, why, actor, std::move(done));
   });
   if (!reply.status.ok()) return Error(reply.status);
   pb::Order out;

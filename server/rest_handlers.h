@@ -43,6 +43,8 @@ class RestHandlers {
   RestReply Status() const;
   RestReply Robots() const;
   RestReply Robot(const std::string& id) const;
+  // POST /api/v1/robots/{id}/pause | /resume (issue 18 §4): the robot's RobotInfo afterwards.
+  RestReply PauseRobot(const std::string& id, bool paused, const std::string& actor);
   // state: an order state, lower case (in_progress) or as the enum (ORDER_STATE_IN_PROGRESS);
   // nullopt for all.
   // Every open order and the newest `finished` (default kListedFinished, at most
@@ -66,8 +68,9 @@ class RestHandlers {
   // body: a SubmitOrderRequest, e.g. {"client_order_id": "...", "picks": [{"point_name":
   // "P1-1-1"} | {"position": {"x": .., "y": ..}}, ...], "drop": {...}, "priority": 0,
   // "formation": false, "work_time": 5.0, "release_time": 0.0}; answers a SubmitOrderResponse.
-  RestReply SubmitOrder(const std::string& body);
-  RestReply CancelOrder(const std::string& id, const std::string& reason);
+  // `actor`: who asks (the token's name; "" without tokens), journaled with the order's events.
+  RestReply SubmitOrder(const std::string& body, const std::string& actor = "");
+  RestReply CancelOrder(const std::string& id, const std::string& reason, const std::string& actor = "");
 
   // An ErrorReply body (also for httplib's own errors: 404, 413, ...).
   static std::string ErrorBody(const std::string& message);

@@ -93,6 +93,7 @@ void RobotToProto(const RobotView& view, const engine::WarehouseMap& map, pb::Ro
   out->set_formation_order_id(view.formation);
   out->set_held(view.held);
   out->set_hold_reason(view.hold_reason);
+  out->set_paused_by(view.paused_by);
   if (r.current_point != engine::kNoPoint) StopToProto(r.current_point, map, out->mutable_point());
 }
 

@@ -24,6 +24,7 @@
 #include "server/fleet_service.h"
 #include "server/metered_store.h"
 #include "server/metrics.h"
+#include "server/operator_service.h"
 #include "server/order_service.h"
 #include "server/rest_api.h"
 #include "storage/sqlite_store.h"
@@ -235,6 +236,7 @@ engine::Result<std::unique_ptr<DispatchServer>> DispatchServer::Start(const Serv
   s->order_service_ = std::make_unique<OrderServiceImpl>(*s->dispatcher_, *s->auth_);
   s->fleet_service_ = std::make_unique<FleetServiceImpl>(*s->dispatcher_, *s->auth_, !config.tls_client_ca.empty());
   s->map_service_ = std::make_unique<MapServiceImpl>(*s->dispatcher_, *s->auth_);
+  s->operator_service_ = std::make_unique<OperatorServiceImpl>(*s->dispatcher_, *s->auth_);
   grpc::ServerBuilder builder;
   // One listener per port: a second dispatchd on the same port must fail, not share it.
   builder.AddChannelArgument(GRPC_ARG_ALLOW_REUSEPORT, 0);
@@ -243,6 +245,7 @@ engine::Result<std::unique_ptr<DispatchServer>> DispatchServer::Start(const Serv
   builder.RegisterService(s->order_service_.get());
   builder.RegisterService(s->fleet_service_.get());
   builder.RegisterService(s->map_service_.get());
+  builder.RegisterService(s->operator_service_.get());
   s->grpc_ = builder.BuildAndStart();
   if (!s->grpc_ || grpc_port == 0) {
     return engine::IoError("cannot listen for gRPC on " + bind + ":" + std::to_string(config.grpc_port));

@@ -30,6 +30,7 @@ class RestServer;
 class OrderServiceImpl;
 class FleetServiceImpl;
 class MapServiceImpl;
+class OperatorServiceImpl;
 class ServiceMetrics;
 class MeteredStore;
 class Authenticator;
@@ -68,6 +69,7 @@ class DispatchServer {
   std::unique_ptr<OrderServiceImpl> order_service_;
   std::unique_ptr<FleetServiceImpl> fleet_service_;
   std::unique_ptr<MapServiceImpl> map_service_;
+  std::unique_ptr<OperatorServiceImpl> operator_service_;
   std::unique_ptr<grpc::Server> grpc_;
   std::unique_ptr<RestServer> rest_;
   ServerPorts ports_;

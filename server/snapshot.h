@@ -46,6 +46,7 @@ struct RobotView {
   std::size_t waypoints = 0;  // in its current plan
   bool held = false;          // a traffic Hold is in force
   std::string hold_reason;
+  std::string paused_by;  // who paused it ("": not paused)
   std::string formation;      // the formation order whose team it is in ("": none)
 };
 

@@ -61,6 +61,7 @@ std::shared_ptr<Snapshot> BuildSnapshot(const engine::WarehouseMap& map, const e
       engine::GateRobotState traffic = gate->RobotState(id);
       view.held = traffic.held;
       view.hold_reason = std::move(traffic.reason);
+      view.paused_by = std::move(traffic.paused_by);
       view.formation = std::move(traffic.formation);
     }
     snap->robots.emplace(id, std::move(view));

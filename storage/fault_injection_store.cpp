@@ -14,9 +14,9 @@ Status FaultInjectionStore::Admit(const char* method) {
   return engine::Ok{};
 }
 
-Result<InsertOrderResult> FaultInjectionStore::InsertOrder(const engine::Order& order) {
+Result<InsertOrderResult> FaultInjectionStore::InsertOrder(const engine::Order& order, const std::string& actor) {
   if (Status s = Admit("InsertOrder"); !s.ok()) return s.error();
-  return inner_.InsertOrder(order);
+  return inner_.InsertOrder(order, actor);
 }
 
 Result<OrderEvent> FaultInjectionStore::TransitionOrder(const OrderTransition& transition) {

@@ -32,7 +32,7 @@ class FaultInjectionStore final : public Store {
   // Writes that were made to fail.
   std::uint64_t failures() const { return failures_.load(); }
 
-  Result<InsertOrderResult> InsertOrder(const engine::Order& order) override;
+  Result<InsertOrderResult> InsertOrder(const engine::Order& order, const std::string& actor) override;
   Result<OrderRecord> GetOrder(const std::string& order_id) override {
     return inner_.GetOrder(order_id);
   }

@@ -266,6 +266,7 @@ Result<std::string> EncodeCoreInput(const CoreInput& in) {
     if (in.change) j["change"] = in.change;
     if (in.max) j["max"] = in.max;
     if (in.cancelled) j["cancelled"] = true;
+    if (in.paused) j["paused"] = true;
     return j.dump();
   });
 }
@@ -323,6 +324,7 @@ Result<CoreInput> DecodeCoreInput(CoreInput::Kind kind, double time, const std::
     in.change = j.value("change", std::uint64_t{0});
     in.max = j.value("max", std::size_t{0});
     in.cancelled = j.value("cancelled", false);
+    in.paused = j.value("paused", false);
     return in;
   });
 }

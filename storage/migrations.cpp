@@ -69,6 +69,9 @@ CREATE TABLE map_versions (
     {4, "metres driven for each order", R"sql(
 ALTER TABLE orders ADD COLUMN distance REAL NOT NULL DEFAULT 0;
 )sql"},
+    {5, "who made each order event (the token's name)", R"sql(
+ALTER TABLE order_events ADD COLUMN actor TEXT NOT NULL DEFAULT '';
+)sql"},
 };
 
 }  // namespace

@@ -25,7 +25,7 @@ constexpr const char* kOrderColumns =
     "id, client_id, state, priority, formation, created_time, updated_time, content_hash, "
     "robots, reason, body, seq, distance";
 constexpr const char* kEventColumns =
-    "id, order_id, type, state, previous_state, time, robots, detail";
+    "id, order_id, type, state, previous_state, time, robots, detail, actor";
 
 }  // namespace
 
@@ -232,6 +232,7 @@ Result<OrderEvent> SqliteStore::ReadEvent(Statement& stmt) {
   if (!robots.ok()) return WithContext("order event " + std::to_string(e.id), robots.error());
   e.robots = std::move(robots).value();
   e.detail = stmt.ColText(7);
+  e.actor = stmt.ColText(8);
   return e;
 }
 
@@ -239,8 +240,8 @@ Result<OrderEvent> SqliteStore::InsertEvent(const OrderEvent& event) {
   Result<std::string> robots = EncodeStrings(event.robots);
   if (!robots.ok()) return robots.error();
   Result<Statement> stmt = Prepare(
-      "INSERT INTO order_events (order_id, type, state, previous_state, time, robots, detail) "
-      "VALUES (?, ?, ?, ?, ?, ?, ?)");
+      "INSERT INTO order_events (order_id, type, state, previous_state, time, robots, detail, actor) "
+      "VALUES (?, ?, ?, ?, ?, ?, ?, ?)");
   if (!stmt.ok()) return stmt.error();
   Statement& s = stmt.value();
   s.Text(1, event.order_id).Text(2, OrderEventTypeName(event.type));
@@ -250,7 +251,7 @@ Result<OrderEvent> SqliteStore::InsertEvent(const OrderEvent& event) {
   } else {
     s.Null(4);
   }
-  s.Real(5, event.time).Text(6, robots.value()).Text(7, event.detail);
+  s.Real(5, event.time).Text(6, robots.value()).Text(7, event.detail).Text(8, event.actor);
   if (Status run = s.Run(); !run.ok()) return run.error();
   OrderEvent stored = event;
   stored.id = sqlite3_last_insert_rowid(db_);
@@ -273,7 +274,7 @@ Result<OrderRecord> SqliteStore::FindOrder(const char* column, const std::string
 
 // --- Orders ---------------------------------------------------------------------------
 
-Result<InsertOrderResult> SqliteStore::InsertOrder(const engine::Order& order) {
+Result<InsertOrderResult> SqliteStore::InsertOrder(const engine::Order& order, const std::string& actor) {
   if (order.id.empty() || order.client_id.empty()) {
     return engine::InvalidArgument("an order needs an id and a client id");
   }
@@ -333,6 +334,7 @@ Result<InsertOrderResult> SqliteStore::InsertOrder(const engine::Order& order) {
     created.state = OrderState::kAccepted;
     created.time = order.created_time;
     created.detail = "accepted";
+    created.actor = actor;
     Result<OrderEvent> event = InsertEvent(created);
     if (!event.ok()) return event.error();
     OrderRecord record;
@@ -442,6 +444,7 @@ Result<OrderEvent> SqliteStore::TransitionOrder(const OrderTransition& t) {
     event.time = t.time;
     event.robots = robots;
     event.detail = t.detail;
+    event.actor = t.actor;
     Result<OrderEvent> stored = InsertEvent(event);
     if (!stored.ok()) return stored.error();
     out = std::move(stored).value();

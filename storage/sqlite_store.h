@@ -57,7 +57,7 @@ class SqliteStore final : public Store {
   // The schema version after Open (the highest applied migration).
   int schema_version() const { return schema_version_; }
 
-  Result<InsertOrderResult> InsertOrder(const engine::Order& order) override;
+  Result<InsertOrderResult> InsertOrder(const engine::Order& order, const std::string& actor) override;
   Result<OrderRecord> GetOrder(const std::string& order_id) override;
   Result<OrderRecord> GetOrderByClientId(const std::string& client_id) override;
   Result<OrderPage> ListOrders(const OrderQuery& query) override;

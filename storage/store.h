@@ -69,6 +69,9 @@ struct OrderEvent {
   double time = 0.0;                                         // seconds
   std::vector<std::string> robots;  // robots serving the order after the event
   std::string detail;               // human-readable
+  // Who made the change: the name of the token of the call that made it (issue 18 §2); ""
+  // for the dispatcher's own changes (allocation, robots' progress) and without tokens.
+  std::string actor;
 };
 
 struct InsertOrderResult {
@@ -85,6 +88,7 @@ struct OrderTransition {
   std::optional<std::vector<std::string>> robots;
   std::string detail;  // journaled; for cancelled/failed also stored as the order's reason
   std::optional<double> distance;  // metres driven for it; nullopt keeps the stored value
+  std::string actor;               // OrderEvent::actor
 };
 
 struct OrderQuery {
@@ -139,7 +143,8 @@ class Store {
   // already stored with the same OrderContentHash, returns the stored order with
   // created = false and writes nothing; with different content (or when order.id already
   // belongs to another client_id) the error is kFailedPrecondition naming both orders.
-  virtual Result<InsertOrderResult> InsertOrder(const engine::Order& order) = 0;
+  // `actor`: who submitted it (its kCreated event's actor).
+  virtual Result<InsertOrderResult> InsertOrder(const engine::Order& order, const std::string& actor) = 0;
   virtual Result<OrderRecord> GetOrder(const std::string& order_id) = 0;
   virtual Result<OrderRecord> GetOrderByClientId(const std::string& client_id) = 0;
   // Orders in insertion order, filtered by state, one page at a time. Pages are stable under

@@ -10,7 +10,7 @@
 namespace dispatch::engine {
 namespace {
 
-constexpr std::array<std::pair<CoreInput::Kind, const char*>, 17> kKinds{{
+constexpr std::array<std::pair<CoreInput::Kind, const char*>, 18> kKinds{{
     {CoreInput::Kind::kAddOrder, "add_order"},
     {CoreInput::Kind::kRestoreRobot, "restore_robot"},
     {CoreInput::Kind::kPlace, "place"},
@@ -28,6 +28,7 @@ constexpr std::array<std::pair<CoreInput::Kind, const char*>, 17> kKinds{{
     {CoreInput::Kind::kCommitted, "committed"},
     {CoreInput::Kind::kStep, "step"},
     {CoreInput::Kind::kSampleDistances, "sample_distances"},
+    {CoreInput::Kind::kPause, "pause"},
 }};
 
 std::string Join(const std::vector<std::string>& items, const char* sep) {

@@ -105,6 +105,10 @@ Result<std::string> CoreReplay::Feed(const JournalEntry& e) {
     case K::kDisconnect:
       core_->Disconnect(in.robot_id);
       return std::string();
+    case K::kPause: {
+      const Status paused = core_->Pause(in.robot_id, in.paused, in.reason);
+      return paused.ok() ? std::string() : "refused: " + paused.error().message;
+    }
     case K::kReport:
     case K::kReached: {
       if (in.kind == K::kReport && !in.pose) return Malformed(e, "no pose");

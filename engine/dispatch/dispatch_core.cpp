@@ -167,7 +167,7 @@ std::optional<OrderChange> DispatchCore::StartLine(const std::string& order_id, 
 
 bool DispatchCore::Eligible(const BookRobot& r) const {
   return r.connected && r.robot.current_point != kNoPoint && r.robot.state != RobotState::kFault &&
-         (!gate_ || gate_->Available(r.robot.id));
+         (!gate_ || (gate_->Available(r.robot.id) && !gate_->Paused(r.robot.id)));
 }
 
 PointId DispatchCore::StartOf(const BookRobot& r) const {

@@ -256,6 +256,10 @@ class DispatchCore {
                         double now);
   // "Picked" / "dropped": a pick starts the order, every member's drop completes it.
   TaskOutcome PlanTask(const std::string& robot, const TaskReport& report, double now);
+  // An operator (`by`: who) pauses or resumes the robot: TrafficGate::SetPaused; a paused
+  // robot bids for nothing (Eligible), a resumed one makes a round due. Errors:
+  // unknown robot (kNotFound), no traffic control (kFailedPrecondition: nothing to hold with).
+  Status Pause(const std::string& robot, bool paused, const std::string& by);
 
   // --- Applying and traffic --------------------------------------------------------------
   // Applies a stored Change: order states, plans, the gate; returns the plan messages.

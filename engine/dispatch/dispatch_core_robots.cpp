@@ -52,6 +52,14 @@ std::vector<RobotCommand> DispatchCore::Connect(Robot robot, double now) {
   return {{id, PlanMessage(r, true, 0)}};
 }
 
+Status DispatchCore::Pause(const std::string& id, bool paused, const std::string& by) {
+  if (!FindRobot(id)) return NotFound("no robot '" + id + "'");
+  if (!gate_) return Error{ErrorCode::kFailedPrecondition, "pausing robots needs traffic control (it holds them)"};
+  if (!gate_->SetPaused(id, paused ? (by.empty() ? "an operator" : by) : "")) return NotFound("robot '" + id + "' is not on the floor");
+  if (!paused) allocation_due_ = true;  // it may bid again
+  return Ok{};
+}
+
 void DispatchCore::Disconnect(const std::string& id) {
   BookRobot* r = FindRobot(id);
   if (!r) return;

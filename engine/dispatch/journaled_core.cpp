@@ -134,6 +134,18 @@ std::vector<RobotCommand> JournaledCore::Connect(Robot robot, double now) {
   return out;
 }
 
+Status JournaledCore::Pause(const std::string& robot, bool paused, const std::string& by) {
+  const std::uint64_t seq = Begin();
+  Status out = core_->Pause(robot, paused, by);
+  CoreInput in;
+  in.kind = CoreInput::Kind::kPause;
+  in.robot_id = robot;
+  in.reason = by;
+  in.paused = paused;
+  Record(seq, std::move(in), out.ok() ? "" : "refused: " + out.error().message);
+  return out;
+}
+
 void JournaledCore::Disconnect(const std::string& robot) {
   const std::uint64_t seq = Begin();
   core_->Disconnect(robot);

@@ -61,6 +61,7 @@ class JournaledCore {
                        double now);
   ReportOutcome Reached(const std::string& robot, std::uint64_t seq, const std::optional<Pose>& pose, double now);
   TaskOutcome PlanTask(const std::string& robot, const TaskReport& report, double now);
+  Status Pause(const std::string& robot, bool paused, const std::string& by);
   std::vector<RobotCommand> Apply(const Change& change);
   StepOutcome Step(double now);
   void SampleDistances(double now);

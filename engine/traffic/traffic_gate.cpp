@@ -125,6 +125,12 @@ void GateImpl::Hold(GateBot& b, const std::string& why, std::vector<GateEffect>&
   out.push_back(std::move(e));
 }
 
+void GateImpl::HoldPaused(GateBot& b, std::vector<GateEffect>& out) {
+  const std::string why = "paused by " + b.paused_by;
+  if (b.held && b.hold_reason != why) b.held = false;  // the Hold again, with the pause as reason
+  Hold(b, why, out);
+}
+
 std::optional<GateImpl::TeamSpan> GateImpl::SpanOf(const GateBot& b, const std::string& o) {
   auto cached = b.spans.find(o);
   return cached != b.spans.end() ? cached->second : FindSpan(b, o);
@@ -232,6 +238,13 @@ void TrafficGate::SetPlan(const std::string& robot, GatePlan plan) {
   s.SyncTeams(b);
 }
 
+bool TrafficGate::SetPaused(const std::string& robot, const std::string& by) {
+  GateBot* b = impl_->Find(robot);
+  if (!b) return false;
+  b->paused_by = by;
+  return true;
+}
+
 void TrafficGate::Unblock(const std::string& robot, double t) {
   GateBot* b = impl_->Find(robot);
   if (!b) return;
@@ -300,6 +313,11 @@ void TrafficGate::SampleDistances(double t) { impl_->SampleDistances(t); }
 double TrafficGate::NextWake() const { return impl_->next_wake; }
 
 std::uint64_t TrafficGate::LeavingEnded() const { return impl_->leaving_ended; }
+
+bool TrafficGate::Paused(const std::string& robot) const {
+  const GateBot* bot = impl_->Find(robot);
+  return bot && !bot->paused_by.empty();
+}
 
 bool TrafficGate::Available(const std::string& robot) const {
   const GateBot* bot = impl_->Find(robot);
@@ -380,6 +398,7 @@ GateRobotState TrafficGate::RobotState(const std::string& robot) const {
   if (!bot) return state;
   state.held = bot->held;
   if (state.held) state.reason = bot->hold_reason;
+  state.paused_by = bot->paused_by;
   state.formation = bot->team;
   state.moved_by_team = !bot->team.empty() && !impl_->OnFloor(*bot);
   state.teams = impl_->TeamKeys(*bot);

@@ -109,6 +109,7 @@ struct GateRobotState {
   // the set ones first: the team it is in or drives to join, and the teams it left (at a drop,
   // or broken up; the last two) until it has driven off ("": none).
   std::array<std::string, 3> teams;
+  std::string paused_by;  // who paused it ("": not paused)
 };
 
 struct GateBot;  // the gate's entry of one robot (traffic_gate_impl.h)
@@ -168,6 +169,12 @@ class TrafficGate {
   std::vector<GateIntersection> Intersections() const;
   GateRobotState RobotState(const std::string& robot) const;
   const MinDistance& min_distance() const;
+  // Pauses the robot for `by` (an operator's name; "": resumes it), issue 18 §4: nothing more
+  // is released to it, or to the team it drives in; it stops at the last waypoint released
+  // and is held there ("paused by <by>") until resumed, when the next Step releases it as
+  // usual. Its place, plan and orders stay. False for a robot the gate does not know.
+  bool SetPaused(const std::string& robot, const std::string& by);
+  bool Paused(const std::string& robot) const;
   // What happened to formations since the last call (formed again, broken up, members
   // leaving the drop), one line each, for the owner's log.
   std::vector<std::string> TakeNotes();

@@ -58,6 +58,9 @@ struct GateBot {
   bool resume_pending = false;  // reconnected: resend Resume if it was held
   bool blocked = false;   // kBlocked reported for the current wait
   bool stepped_aside = false;
+  // Paused by an operator (issue 18 §4; "": not paused): nothing more is released to it (or to
+  // its team); it stops at the last waypoint released and is held there until resumed.
+  std::string paused_by;
   // Since when it has found the rendezvous point of formation `forming` occupied (JoinTeam),
   // and when it last tried (a try after a pause starts the clock again).
   std::string forming;
@@ -218,6 +221,8 @@ struct GateImpl {
   // A kRelease of b's current horizon (a Resume when it was held).
   void SendRelease(GateBot& b, int intersection, std::vector<GateEffect>& out);
   void Hold(GateBot& b, const std::string& why, std::vector<GateEffect>& out);
+  // Held because paused (its Hold says so, also when it was held for something else before).
+  void HoldPaused(GateBot& b, std::vector<GateEffect>& out);
   // Reports b blocked (once per blocked spell) and holds it: `why` names what it waits for.
   void Block(GateBot& b, const std::string& why, std::vector<GateEffect>& out);
 

@@ -154,10 +154,11 @@ void GateImpl::StepSolo(GateBot& b, double t, std::vector<GateEffect>& out) {
     JoinTeam(b, join_order, t, out);
     return;
   }
+  if (!b.paused_by.empty() && ctl.Next(r) == kNoPoint) HoldPaused(b, out);  // also idle: it says so
   if (here + 1 >= n) {  // nothing ahead: idle
     ctl.SetIdle(r, true);
     bool aside = false;
-    if (!ctl.HasRoute(r) && !b.stepped_aside &&
+    if (!ctl.HasRoute(r) && !b.stepped_aside && b.paused_by.empty() &&
         (blocks_service[static_cast<std::size_t>(at)] || ctl.InExclusiveCorridor(at))) {
       // Out of the way of the next robot to serve here (or to pass through the one-robot
       // corridor it stands in): a siding nearby, else home.
@@ -220,6 +221,7 @@ void GateImpl::StepSolo(GateBot& b, double t, std::vector<GateEffect>& out) {
 }
 
 void GateImpl::RequestSolo(GateBot& b, double t, std::vector<GateEffect>& out) {
+  if (!b.paused_by.empty()) return HoldPaused(b, out);
   const auto r = static_cast<std::size_t>(b.ctl);
   for (int attempt = 0; attempt < 3; ++attempt) {
     const TrafficDecision d = ctl.Request(r, t);

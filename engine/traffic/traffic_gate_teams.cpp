@@ -287,6 +287,21 @@ void GateImpl::StepTeams(double t, std::vector<GateEffect>& out) {
                 team.leg_stop = s;
                 team.leg_stale = false;
               }
+              const MemberView* paused = nullptr;
+              for (const MemberView& v : m) {
+                if (!v.bot->paused_by.empty()) paused = &v;
+              }
+              if (paused) {  // the team waits for its paused member
+                for (const MemberView& v : m) {
+                  if (v.bot->paused_by.empty()) {
+                    Hold(*v.bot, "formation " + team.order + ": " + paused->bot->id + " paused", out);
+                  } else {
+                    HoldPaused(*v.bot, out);
+                  }
+                }
+                ++it;
+                continue;
+              }
               const TrafficDecision d = ctl.Request(tr, t);
               if (d == TrafficDecision::kGo) {
                 team.left = false;

@@ -20,13 +20,18 @@
     problems: new Map(),
   };
   const live = new WM.Live.LiveLayer($("live"));
+  // The bearer token typed into the header (dispatchd --auth-tokens): in this page's memory
+  // only, never stored, sent with every API request.
+  let token = "";
+  $("token").addEventListener("change", e => { token = e.target.value.trim(); });
   const EMPTY_FLOOR = { intersections: new Map(), ref: () => null };
 
   // ---- fetching ---------------------------------------------------------------------------
   async function getJson(path, timeoutMs = REQUEST_TIMEOUT_MS) {
     let res;
     try {
-      res = await fetch(API + path, { cache: "no-store", signal: AbortSignal.timeout(timeoutMs) });
+      const headers = token ? { Authorization: "Bearer " + token } : {};
+      res = await fetch(API + path, { cache: "no-store", headers, signal: AbortSignal.timeout(timeoutMs) });
     } catch (err) {
       const e = new Error(err.name === "TimeoutError" ? `no answer within ${timeoutMs / 1000} s` : "server unreachable");
       e.network = true;

@@ -12,6 +12,11 @@ roles, as deploy/dev_certs.sh makes them, against real clients:
     (a hijack) PERMISSION_DENIED, and R1's order completes untouched;
   - fleet-sim with per-robot tokens and certificates and wmsctl with a wms token run an order
     to completion;
+  - order events name who made them (the wms token's name on the created event, the
+    operator's on a cancel);
+  - an operator pauses R1 over REST and resumes it over gRPC: R1 stands held "paused by
+    operator-dev" meanwhile, the core's journal names the operator for both, and an order
+    then completes; a wms token may not pause (403 / PERMISSION_DENIED);
   - SIGHUP re-reads the token file: a revoked token is refused from then on.
 
     tls_and_tokens.py --stubs DIR --dispatchd BIN --fleet-sim BIN --wmsctl BIN --scenarios DIR ...
@@ -21,6 +26,7 @@ import json
 import os
 import queue
 import signal
+import sqlite3
 import ssl
 import subprocess
 import sys
@@ -30,7 +36,8 @@ sys.dont_write_bytecode = True  # no __pycache__ in the source tree
 sys.path.insert(0, sys.argv[sys.argv.index("--stubs") + 1])
 import grpc  # noqa: E402
 from e2e_harness import COMPLETED, Harness, TestFailure, check, common_arguments  # noqa: E402
-from warehouse.dispatch.v1 import common_pb2, fleet_pb2, fleet_pb2_grpc, orders_pb2, orders_pb2_grpc  # noqa: E402
+from warehouse.dispatch.v1 import (common_pb2, fleet_pb2, fleet_pb2_grpc, operator_pb2,  # noqa: E402
+                                   operator_pb2_grpc, orders_pb2, orders_pb2_grpc)
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 DEV_CERTS = os.path.join(HERE, "..", "..", "deploy", "dev_certs.sh")
@@ -212,6 +219,64 @@ def main():
         h.wait_for(lambda: orders.GetOrder(orders_pb2.GetOrderRequest(order_id=submitted.order.id), timeout=10,
                                            metadata=bearer(wms)).state == COMPLETED, 120,
                    f"{submitted.order.id} (R1's order during the hijack) completed")
+
+        # Who made each change.
+        def events_of(order_id):
+            call = orders.WatchOrders(orders_pb2.WatchOrdersRequest(order_ids=[order_id], from_start=True),
+                                      timeout=10, metadata=bearer(wms))
+            seen = []
+            try:
+                for e in call:
+                    seen.append(e)
+                    if e.state in (common_pb2.ORDER_STATE_COMPLETED, common_pb2.ORDER_STATE_CANCELLED):
+                        call.cancel()
+            except grpc.RpcError as err:
+                check(err.code() == Code.CANCELLED, f"WatchOrders: {err.code().name} {err.details()}")
+            return seen
+        created = events_of(submitted.order.id)[0]
+        check(created.actor == "wms-dev", f"created event's actor '{created.actor}', want wms-dev")
+        cancel_me = orders.SubmitOrder(order_request("tls-3", "K1-1-1N", "D-B1"), timeout=10, metadata=bearer(wms))
+        orders.CancelOrder(orders_pb2.CancelOrderRequest(order_id=cancel_me.order.id, reason="test"), timeout=10,
+                           metadata=bearer(operator))
+        cancelled = events_of(cancel_me.order.id)[-1]
+        check(cancelled.state == common_pb2.ORDER_STATE_CANCELLED and cancelled.actor == "operator-dev",
+              f"cancel event: state {cancelled.state} actor '{cancelled.actor}', want operator-dev")
+
+        # Operator commands: pause R1 (REST), resume it (gRPC); a wms token may not.
+        status, _, body = https(server, creds, "POST", "/api/v1/robots/R1/pause", wms, body="")
+        check(status == 403, f"wms pauses R1: HTTP {status} {body[:200]!r}")
+        operators = operator_pb2_grpc.OperatorServiceStub(creds.channel(server))
+        expect_rpc_error("wms pauses over gRPC", Code.PERMISSION_DENIED,
+                         lambda: operators.PauseRobot(operator_pb2.RobotCommandRequest(robot_id="R1"), timeout=10,
+                                                      metadata=bearer(wms)), "robot commands")
+        status, _, body = https(server, creds, "POST", "/api/v1/robots/R1/pause", operator, body="")
+        check(status == 200 and json.loads(body)["paused_by"] == "operator-dev", f"pause R1: HTTP {status} {body!r}")
+        status, _, body = https(server, creds, "POST", "/api/v1/robots/R9/pause", operator, body="")
+        check(status == 404, f"pause an unknown robot: HTTP {status} {body!r}")
+
+        def held_paused():
+            _, _, b = https(server, creds, "GET", "/api/v1/robots/R1", operator)
+            r = json.loads(b)
+            return r.get("held") and r.get("hold_reason") == "paused by operator-dev"
+        h.wait_for(held_paused, 30, "R1 held, paused by operator-dev")
+        resumed = operators.ResumeRobot(operator_pb2.RobotCommandRequest(robot_id="R1"), timeout=10,
+                                        metadata=bearer(operator))
+        check(resumed.paused_by == "", f"resumed R1 still paused by '{resumed.paused_by}'")
+        r = subprocess.run(wmsctl + ["submit", "--pick", "K3-2-1N", "--drop", "D-B2", "--id", "tls-4", "--wait"],
+                           capture_output=True, text=True, timeout=120)
+        sys.stdout.write(r.stdout + r.stderr)
+        check(r.returncode == 0, f"an order after the resume: wmsctl exited {r.returncode}")
+
+        def journaled():
+            db = sqlite3.connect(f"file:{os.path.join(h.work, 'dispatch.db')}?mode=ro", uri=True, timeout=5)
+            try:
+                rows = db.execute("SELECT input FROM core_journal WHERE kind = 'pause' ORDER BY seq").fetchall()
+            finally:
+                db.close()
+            inputs = [json.loads(r[0]) for r in rows]
+            return len(inputs) >= 2 and inputs[0].get("paused") and inputs[0].get("why") == "operator-dev" and \
+                not inputs[-1].get("paused") and inputs[-1].get("why") == "operator-dev"
+        h.wait_for(journaled, 30, "the journal's pause and resume naming operator-dev")
 
         # SIGHUP: the wms token revoked.
         with open(tokens) as f:

@@ -189,7 +189,7 @@ TEST(ChangeStoreTest, AChangeIsStoredWholeOrNotAtAll) {
   auto store = storage::SqliteStore::Open(dir.File("store.db"));
   ASSERT_TRUE(store.ok()) << store.error().message;
   engine::Order order = Order("ord-000001");
-  auto inserted = (*store)->InsertOrder(order);
+  auto inserted = (*store)->InsertOrder(order, "");
   ASSERT_TRUE(inserted.ok()) << inserted.error().message;
   auto record_of = [](const std::string& id) {
     storage::RobotRecord r;
@@ -494,8 +494,8 @@ TEST(StateRecoveryTest, RobotsComeBackOfflineWithTheirPlansAndThoseThatWereOnLin
   TempDir dir;
   auto store = storage::SqliteStore::Open(dir.File("store.db"));
   ASSERT_TRUE(store.ok()) << store.error().message;
-  ASSERT_TRUE((*store)->InsertOrder(Order("ord-000003")).ok());
-  ASSERT_TRUE((*store)->InsertOrder(Order("ord-000007")).ok());
+  ASSERT_TRUE((*store)->InsertOrder(Order("ord-000003"), "").ok());
+  ASSERT_TRUE((*store)->InsertOrder(Order("ord-000007"), "").ok());
   storage::OrderTransition cancel;
   cancel.order_id = "ord-000003";
   cancel.to = engine::OrderState::kCancelled;

@@ -44,10 +44,10 @@ engine::Order NumberedOrder(std::int32_t i) {
   }
   for (;; ++i) {
     Status s = store.value()->RunInTransaction([&](Store& tx) -> Status {
-      auto inserted = tx.InsertOrder(NumberedOrder(i));
+      auto inserted = tx.InsertOrder(NumberedOrder(i), "");
       if (!inserted.ok()) return inserted.error();
       auto assigned = tx.TransitionOrder({"o" + std::to_string(i), OrderState::kAssigned,
-                                          i + 0.5, std::vector<std::string>{"R1"}, "won", {}});
+                                          i + 0.5, std::vector<std::string>{"R1"}, "won", {}, ""});
       if (!assigned.ok()) return assigned.error();
       return engine::Ok{};
     });

@@ -38,15 +38,15 @@ class FaultInjectionStoreTest : public ::testing::Test {
 
 TEST_F(FaultInjectionStoreTest, TheNthWriteFailsAndChangesNothing) {
   store_->FailWrite(2);
-  ASSERT_TRUE(store_->InsertOrder(MakeOrder("o1")).ok());
-  auto failed = store_->InsertOrder(MakeOrder("o2"));
+  ASSERT_TRUE(store_->InsertOrder(MakeOrder("o1"), "").ok());
+  auto failed = store_->InsertOrder(MakeOrder("o2"), "");
   ASSERT_FALSE(failed.ok());
   EXPECT_EQ(failed.error().code, ErrorCode::kIoError);
   EXPECT_EQ(failed.error().message, "injected failure of write 2 (InsertOrder)");
   EXPECT_EQ(store_->GetOrder("o2").error().code, ErrorCode::kNotFound);  // reads pass through
   EXPECT_TRUE(store_->GetOrder("o1").ok());
   // Only write 2 fails: the retry (write 3) succeeds.
-  ASSERT_TRUE(store_->InsertOrder(MakeOrder("o2")).ok());
+  ASSERT_TRUE(store_->InsertOrder(MakeOrder("o2"), "").ok());
   EXPECT_EQ(store_->writes(), 3u);
   EXPECT_EQ(store_->failures(), 1u);
   EXPECT_EQ(sqlite_->ListOrders({}).value().orders.size(), 2u);
@@ -54,9 +54,9 @@ TEST_F(FaultInjectionStoreTest, TheNthWriteFailsAndChangesNothing) {
 }
 
 TEST_F(FaultInjectionStoreTest, EveryKindOfWriteCanFail) {
-  ASSERT_TRUE(store_->InsertOrder(MakeOrder("o1")).ok());  // write 1
+  ASSERT_TRUE(store_->InsertOrder(MakeOrder("o1"), "").ok());  // write 1
   store_->FailWritesFrom(2);
-  EXPECT_FALSE(store_->TransitionOrder({"o1", OrderState::kAssigned, 1, {}, "", {}}).ok());
+  EXPECT_FALSE(store_->TransitionOrder({"o1", OrderState::kAssigned, 1, {}, "", {}, ""}).ok());
   EXPECT_FALSE(store_->AppendProgress("o1", 1, "x").ok());
   RobotRecord robot;
   robot.robot.id = "R1";
@@ -74,15 +74,15 @@ TEST_F(FaultInjectionStoreTest, EveryKindOfWriteCanFail) {
   EXPECT_TRUE(sqlite_->ListAssignments().value().empty());
   EXPECT_EQ(sqlite_->LatestMapVersion().error().code, ErrorCode::kNotFound);
   store_->FailWritesFrom(0);
-  EXPECT_TRUE(store_->TransitionOrder({"o1", OrderState::kAssigned, 1, {}, "", {}}).ok());
+  EXPECT_TRUE(store_->TransitionOrder({"o1", OrderState::kAssigned, 1, {}, "", {}, ""}).ok());
 }
 
 TEST_F(FaultInjectionStoreTest, AFailureInsideATransactionUndoesItsEarlierWrites) {
   store_->FailWrite(2);
   Status status = store_->RunInTransaction([](Store& tx) -> Status {
-    auto order = tx.InsertOrder(MakeOrder("o1"));  // write 1: succeeds inside the transaction
+    auto order = tx.InsertOrder(MakeOrder("o1"), "");  // write 1: succeeds inside the transaction
     if (!order.ok()) return order.error();
-    auto assigned = tx.TransitionOrder({"o1", OrderState::kAssigned, 1, std::vector<std::string>{"R1"}, "", {}});  // fails
+    auto assigned = tx.TransitionOrder({"o1", OrderState::kAssigned, 1, std::vector<std::string>{"R1"}, "", {}, ""});  // fails
     if (!assigned.ok()) return assigned.error();
     return engine::Ok{};
   });

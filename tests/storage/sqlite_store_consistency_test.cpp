@@ -26,9 +26,9 @@ TEST_F(SqliteStoreTest, ReadersOnAnotherConnectionAreNotBlockedByAnOpenWrite) {
   auto reader = OpenOrDie(db_path());
   ASSERT_NE(writer, nullptr);
   ASSERT_NE(reader, nullptr);
-  ASSERT_TRUE(writer->InsertOrder(MakeOrder("before", "c0")).ok());
+  ASSERT_TRUE(writer->InsertOrder(MakeOrder("before", "c0"), "").ok());
   Status inside = writer->RunInTransaction([&](Store& tx) -> Status {
-    auto inserted = tx.InsertOrder(MakeOrder("pending", "c1"));
+    auto inserted = tx.InsertOrder(MakeOrder("pending", "c1"), "");
     if (!inserted.ok()) return inserted.error();
     // The write lock is held and the insert is uncommitted: the reader neither waits nor
     // sees it (WAL snapshot isolation).
@@ -58,7 +58,7 @@ TEST_F(SqliteStoreTest, AConcurrentReaderSeesAGrowingPrefixWhileAThreadWrites) {
   std::thread write_thread([&] {
     for (int i = 0; i < kOrders; ++i) {
       const std::string n = std::to_string(i);
-      EXPECT_TRUE(writer->InsertOrder(MakeOrder("o" + n, "c" + n)).ok());
+      EXPECT_TRUE(writer->InsertOrder(MakeOrder("o" + n, "c" + n), "").ok());
     }
     done = true;
   });
@@ -97,7 +97,7 @@ TEST_F(SqliteStoreTest, AFailedStatementLeavesNoPartialOrder) {
 
   // The order row is written, then its first event fails: both must be gone.
   fail_on = "INSERT INTO order_events";
-  auto failed = store->InsertOrder(MakeOrder("o1", "c1"));
+  auto failed = store->InsertOrder(MakeOrder("o1", "c1"), "");
   ASSERT_FALSE(failed.ok());
   EXPECT_EQ(failed.error().code, ErrorCode::kIoError);
   EXPECT_NE(failed.error().message.find("injected: disk full"), std::string::npos);
@@ -108,13 +108,13 @@ TEST_F(SqliteStoreTest, AFailedStatementLeavesNoPartialOrder) {
 
   // The store is still usable; the retry succeeds as a new order.
   fail_on.clear();
-  auto retry = store->InsertOrder(MakeOrder("o1", "c1"));
+  auto retry = store->InsertOrder(MakeOrder("o1", "c1"), "");
   ASSERT_TRUE(retry.ok()) << retry.error().message;
   EXPECT_TRUE(retry->created);
 
   // A transition whose journal entry fails does not change the state.
   fail_on = "INSERT INTO order_events";
-  EXPECT_FALSE(store->TransitionOrder({"o1", OrderState::kAssigned, 2, std::vector<std::string>{"R1"}, "", {}}).ok());
+  EXPECT_FALSE(store->TransitionOrder({"o1", OrderState::kAssigned, 2, std::vector<std::string>{"R1"}, "", {}, ""}).ok());
   EXPECT_EQ(store->GetOrder("o1")->order.state, OrderState::kAccepted);
   EXPECT_TRUE(store->GetOrder("o1")->robots.empty());
   EXPECT_EQ(store->ListEvents({}).value().size(), 1u);
@@ -132,8 +132,8 @@ TEST_F(SqliteStoreTest, RunInTransactionIsAllOrNothingAndNests) {
   auto store = OpenOrDie(db_path());
   ASSERT_NE(store, nullptr);
   Status aborted = store->RunInTransaction([](Store& tx) -> Status {
-    if (!tx.InsertOrder(MakeOrder("a", "ca")).ok()) return engine::IoError("unexpected");
-    if (!tx.TransitionOrder({"a", OrderState::kAssigned, 1, std::vector<std::string>{"R1"}, "", {}}).ok()) {
+    if (!tx.InsertOrder(MakeOrder("a", "ca"), "").ok()) return engine::IoError("unexpected");
+    if (!tx.TransitionOrder({"a", OrderState::kAssigned, 1, std::vector<std::string>{"R1"}, "", {}, ""}).ok()) {
       return engine::IoError("unexpected");
     }
     return engine::InvalidArgument("changed my mind");
@@ -144,9 +144,9 @@ TEST_F(SqliteStoreTest, RunInTransactionIsAllOrNothingAndNests) {
   EXPECT_TRUE(store->ListEvents({}).value().empty());
 
   Status nested = store->RunInTransaction([](Store& tx) -> Status {
-    if (!tx.InsertOrder(MakeOrder("outer", "c-outer")).ok()) return engine::IoError("x");
+    if (!tx.InsertOrder(MakeOrder("outer", "c-outer"), "").ok()) return engine::IoError("x");
     Status inner = tx.RunInTransaction([](Store& tx2) -> Status {
-      if (!tx2.InsertOrder(MakeOrder("inner", "c-inner")).ok()) return engine::IoError("x");
+      if (!tx2.InsertOrder(MakeOrder("inner", "c-inner"), "").ok()) return engine::IoError("x");
       return engine::IoError("inner failed");
     });
     EXPECT_FALSE(inner.ok());
@@ -238,7 +238,7 @@ TEST_F(SqliteStoreTest, RandomOperationsMatchAnInMemoryModel) {
     const std::vector<engine::PointId> picks = {static_cast<engine::PointId>(rng() % 3)};
     const auto it = model.find(client);
     if (op == 0) {
-      auto r = store->InsertOrder(MakeOrder("id-" + client, client, picks));
+      auto r = store->InsertOrder(MakeOrder("id-" + client, client, picks), "");
       if (it == model.end()) {
         ASSERT_TRUE(r.ok()) << r.error().message;
         EXPECT_TRUE(r->created);
@@ -255,7 +255,7 @@ TEST_F(SqliteStoreTest, RandomOperationsMatchAnInMemoryModel) {
       }
     } else if (op == 1) {
       const OrderState to = states[rng() % states.size()];
-      auto r = store->TransitionOrder({"id-" + client, to, 1.0, {}, "", {}});
+      auto r = store->TransitionOrder({"id-" + client, to, 1.0, {}, "", {}, ""});
       if (it == model.end()) {
         EXPECT_EQ(r.error().code, ErrorCode::kNotFound);
       } else if (engine::CanTransition(it->second.state, to)) {

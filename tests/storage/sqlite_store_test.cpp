@@ -42,7 +42,7 @@ TEST_F(SqliteStoreTest, MigratesAnEmptyFileInOrderAndReopenIsIdempotent) {
   {
     auto store = OpenOrDie(db_path());
     ASSERT_NE(store, nullptr);
-    ASSERT_TRUE(store->InsertOrder(MakeOrder("o1", "c1")).ok());
+    ASSERT_TRUE(store->InsertOrder(MakeOrder("o1", "c1"), "").ok());
   }
   auto again = OpenOrDie(db_path());
   ASSERT_NE(again, nullptr);
@@ -111,10 +111,10 @@ TEST_F(SqliteStoreTest, EverythingSurvivesCloseAndReopen) {
   {
     auto store = OpenOrDie(db_path());
     ASSERT_NE(store, nullptr);
-    ASSERT_TRUE(store->InsertOrder(MakeOrder("o1", "c1")).ok());
-    ASSERT_TRUE(store->InsertOrder(formation).ok());
+    ASSERT_TRUE(store->InsertOrder(MakeOrder("o1", "c1"), "").ok());
+    ASSERT_TRUE(store->InsertOrder(formation, "").ok());
     ASSERT_TRUE(store->TransitionOrder({"o2", OrderState::kAssigned, 3.0,
-                                        std::vector<std::string>{"R7", "R1", "R2"}, "auction", {}})
+                                        std::vector<std::string>{"R7", "R1", "R2"}, "auction", {}, ""})
                     .ok());
     ASSERT_TRUE(store->AppendProgress("o2", 4.0, "R7 re-planned").ok());
     ASSERT_TRUE(store->UpsertRobot({robot, "differential", 4.5, 17, 18}).ok());
@@ -193,13 +193,13 @@ TEST_F(SqliteStoreTest, EverythingSurvivesCloseAndReopen) {
 TEST_F(SqliteStoreTest, InsertIsIdempotentOnClientId) {
   auto store = OpenOrDie(db_path());
   ASSERT_NE(store, nullptr);
-  auto first = store->InsertOrder(MakeOrder("o1", "wms-1"));
+  auto first = store->InsertOrder(MakeOrder("o1", "wms-1"), "");
   ASSERT_TRUE(first.ok());
   EXPECT_TRUE(first->created);
   // The repeat gets a new server id from the caller, but the same content.
   engine::Order repeat = MakeOrder("o-other", "wms-1");
   repeat.created_time = 99.0;  // not part of the content
-  auto second = store->InsertOrder(repeat);
+  auto second = store->InsertOrder(repeat, "");
   ASSERT_TRUE(second.ok()) << second.error().message;
   EXPECT_FALSE(second->created);
   EXPECT_EQ(second->record.order.id, "o1");
@@ -213,17 +213,17 @@ TEST_F(SqliteStoreTest, InsertIsIdempotentOnClientId) {
 TEST_F(SqliteStoreTest, AConflictingDuplicateIsDetected) {
   auto store = OpenOrDie(db_path());
   ASSERT_NE(store, nullptr);
-  ASSERT_TRUE(store->InsertOrder(MakeOrder("o1", "wms-1")).ok());
-  auto other_picks = store->InsertOrder(MakeOrder("o2", "wms-1", {3, 8}));
+  ASSERT_TRUE(store->InsertOrder(MakeOrder("o1", "wms-1"), "").ok());
+  auto other_picks = store->InsertOrder(MakeOrder("o2", "wms-1", {3, 8}), "");
   ASSERT_FALSE(other_picks.ok());
   EXPECT_EQ(other_picks.error().code, ErrorCode::kFailedPrecondition);
   EXPECT_NE(other_picks.error().message.find("wms-1"), std::string::npos);
   EXPECT_NE(other_picks.error().message.find("different content"), std::string::npos);
   engine::Order formation = MakeOrder("o3", "wms-1");
   formation.formation = true;
-  EXPECT_EQ(store->InsertOrder(formation).error().code, ErrorCode::kFailedPrecondition);
+  EXPECT_EQ(store->InsertOrder(formation, "").error().code, ErrorCode::kFailedPrecondition);
   // The same server id under another client id is a conflict too.
-  auto taken = store->InsertOrder(MakeOrder("o1", "wms-2"));
+  auto taken = store->InsertOrder(MakeOrder("o1", "wms-2"), "");
   ASSERT_FALSE(taken.ok());
   EXPECT_EQ(taken.error().code, ErrorCode::kFailedPrecondition);
   EXPECT_NE(taken.error().message.find("already belongs"), std::string::npos);
@@ -238,41 +238,41 @@ TEST_F(SqliteStoreTest, AConflictingDuplicateIsDetected) {
 TEST_F(SqliteStoreTest, RejectsMalformedOrders) {
   auto store = OpenOrDie(db_path());
   ASSERT_NE(store, nullptr);
-  EXPECT_EQ(store->InsertOrder(MakeOrder("", "c")).error().code, ErrorCode::kInvalidArgument);
-  EXPECT_EQ(store->InsertOrder(MakeOrder("o", "")).error().code, ErrorCode::kInvalidArgument);
-  EXPECT_EQ(store->InsertOrder(MakeOrder("o", "c", {})).error().code,
+  EXPECT_EQ(store->InsertOrder(MakeOrder("", "c"), "").error().code, ErrorCode::kInvalidArgument);
+  EXPECT_EQ(store->InsertOrder(MakeOrder("o", ""), "").error().code, ErrorCode::kInvalidArgument);
+  EXPECT_EQ(store->InsertOrder(MakeOrder("o", "c", {}), "").error().code,
             ErrorCode::kInvalidArgument);
   engine::Order assigned = MakeOrder("o", "c");
   assigned.state = OrderState::kAssigned;
-  EXPECT_EQ(store->InsertOrder(assigned).error().code, ErrorCode::kInvalidArgument);
+  EXPECT_EQ(store->InsertOrder(assigned, "").error().code, ErrorCode::kInvalidArgument);
   engine::Order nan = MakeOrder("o", "c");
   nan.release_time = std::nan("");
-  EXPECT_EQ(store->InsertOrder(nan).error().code, ErrorCode::kInvalidArgument);
+  EXPECT_EQ(store->InsertOrder(nan, "").error().code, ErrorCode::kInvalidArgument);
   EXPECT_TRUE(store->ListOrders({}).value().orders.empty());
 }
 
 TEST_F(SqliteStoreTest, StateTransitionsFollowTheLifecycleAndAreJournaledInOrder) {
   auto store = OpenOrDie(db_path());
   ASSERT_NE(store, nullptr);
-  ASSERT_TRUE(store->InsertOrder(MakeOrder("a", "ca")).ok());
-  ASSERT_TRUE(store->InsertOrder(MakeOrder("b", "cb")).ok());
+  ASSERT_TRUE(store->InsertOrder(MakeOrder("a", "ca"), "").ok());
+  ASSERT_TRUE(store->InsertOrder(MakeOrder("b", "cb"), "").ok());
   const std::vector<std::string> team = {"R1"};
-  ASSERT_TRUE(store->TransitionOrder({"a", OrderState::kAssigned, 2.0, team, "won", {}}).ok());
-  ASSERT_TRUE(store->TransitionOrder({"b", OrderState::kCancelled, 2.5, {}, "client", {}}).ok());
-  ASSERT_TRUE(store->TransitionOrder({"a", OrderState::kInProgress, 3.0, {}, "picking", {}}).ok());
+  ASSERT_TRUE(store->TransitionOrder({"a", OrderState::kAssigned, 2.0, team, "won", {}, ""}).ok());
+  ASSERT_TRUE(store->TransitionOrder({"b", OrderState::kCancelled, 2.5, {}, "client", {}, ""}).ok());
+  ASSERT_TRUE(store->TransitionOrder({"a", OrderState::kInProgress, 3.0, {}, "picking", {}, ""}).ok());
   ASSERT_TRUE(store->AppendProgress("a", 3.5, "picked at P1").ok());
-  ASSERT_TRUE(store->TransitionOrder({"a", OrderState::kCompleted, 4.0, {}, "dropped", {}}).ok());
+  ASSERT_TRUE(store->TransitionOrder({"a", OrderState::kCompleted, 4.0, {}, "dropped", {}, ""}).ok());
 
   // Forbidden moves change nothing and journal nothing.
   const size_t journal = store->ListEvents({}).value().size();
-  auto back = store->TransitionOrder({"a", OrderState::kAssigned, 5.0, {}, "", {}});
+  auto back = store->TransitionOrder({"a", OrderState::kAssigned, 5.0, {}, "", {}, ""});
   ASSERT_FALSE(back.ok());
   EXPECT_EQ(back.error().code, ErrorCode::kFailedPrecondition);
   EXPECT_NE(back.error().message.find("from completed to assigned"), std::string::npos)
       << back.error().message;
-  EXPECT_EQ(store->TransitionOrder({"b", OrderState::kCancelled, 5.0, {}, "", {}}).error().code,
+  EXPECT_EQ(store->TransitionOrder({"b", OrderState::kCancelled, 5.0, {}, "", {}, ""}).error().code,
             ErrorCode::kFailedPrecondition);
-  EXPECT_EQ(store->TransitionOrder({"zz", OrderState::kAssigned, 5.0, {}, "", {}}).error().code,
+  EXPECT_EQ(store->TransitionOrder({"zz", OrderState::kAssigned, 5.0, {}, "", {}, ""}).error().code,
             ErrorCode::kNotFound);
   EXPECT_EQ(store->AppendProgress("zz", 5.0, "").error().code, ErrorCode::kNotFound);
   EXPECT_EQ(store->ListEvents({}).value().size(), journal);
@@ -305,7 +305,7 @@ TEST_F(SqliteStoreTest, TheJournalIsAppendOnly) {
   {
     auto store = OpenOrDie(db_path());
     ASSERT_NE(store, nullptr);
-    ASSERT_TRUE(store->InsertOrder(MakeOrder("a", "ca")).ok());
+    ASSERT_TRUE(store->InsertOrder(MakeOrder("a", "ca"), "").ok());
   }
   EXPECT_NE(RawExec(db_path(), "UPDATE order_events SET detail = 'x'").find("append-only"),
             std::string::npos);
@@ -320,9 +320,9 @@ TEST_F(SqliteStoreTest, ListOrdersPagesWithAStateFilter) {
   ASSERT_NE(store, nullptr);
   for (int i = 0; i < 25; ++i) {
     const std::string id = "o" + std::to_string(i);
-    ASSERT_TRUE(store->InsertOrder(MakeOrder(id, "c" + std::to_string(i))).ok());
+    ASSERT_TRUE(store->InsertOrder(MakeOrder(id, "c" + std::to_string(i)), "").ok());
     if (i % 3 == 0) {
-      ASSERT_TRUE(store->TransitionOrder({id, OrderState::kAssigned, 1, {}, "", {}}).ok());
+      ASSERT_TRUE(store->TransitionOrder({id, OrderState::kAssigned, 1, {}, "", {}, ""}).ok());
     }
   }
   std::vector<std::string> seen;
@@ -335,7 +335,7 @@ TEST_F(SqliteStoreTest, ListOrdersPagesWithAStateFilter) {
     sizes.push_back(page->orders.size());
     for (const OrderRecord& r : page->orders) seen.push_back(r.order.id);
     if (guard == 0) {  // an insert between pages shows up at the end, never twice
-      ASSERT_TRUE(store->InsertOrder(MakeOrder("late", "c-late")).ok());
+      ASSERT_TRUE(store->InsertOrder(MakeOrder("late", "c-late"), "").ok());
     }
     if (page->next_page_token.empty()) break;
     q.page_token = page->next_page_token;

@@ -199,6 +199,37 @@ TEST_F(TrafficGateTest, ARobotIsReleasedPointByPointToTheEndOfItsPlan) {
   EXPECT_GT(gate_->stats().grants, 0u);
 }
 
+// Issue 18 §4: a paused robot stops where its releases end and is held, saying who paused
+// it; resumed, it drives its plan to the end.
+TEST_F(TrafficGateTest, APausedRobotIsHeldWhereItsReleasesEndUntilResumed) {
+  AddRobot("R1", "park-P1", {"K3-2-3N"}, "D-B2", "o1");
+  ASSERT_TRUE(Run(20, {}, [&] { return sims_["R1"].at >= 2; })) << gate_->Describe("R1");
+  ASSERT_TRUE(gate_->SetPaused("R1", "op-1"));
+  EXPECT_TRUE(gate_->Paused("R1"));
+  EXPECT_FALSE(gate_->SetPaused("R9", "op-1"));
+  std::string hold;
+  const std::uint64_t released = gate_->ReleasedUpTo("R1");
+  for (int i = 0; i < 300; ++i) {  // 30 s: it would have driven on long since
+    t_ += 0.1;
+    for (const GateEffect& e : gate_->Step(t_)) {
+      if (e.robot == "R1" && e.kind == GateEffect::Kind::kHold) hold = e.reason;
+      EXPECT_NE(e.kind, GateEffect::Kind::kRelease) << "released while paused";
+    }
+    Sim& s = sims_["R1"];
+    if (s.at + 1 < s.plan.size() && static_cast<std::uint64_t>(s.plan[s.at + 1].seq) <= released) {
+      ++s.at;
+      gate_->Reached("R1", static_cast<std::uint64_t>(s.plan[s.at].seq), t_, s.plan[s.at].xy);
+    }
+  }
+  EXPECT_EQ(hold, "paused by op-1");
+  EXPECT_EQ(gate_->RobotState("R1").paused_by, "op-1");
+  EXPECT_EQ(gate_->ReleasedUpTo("R1"), released);
+  EXPECT_LT(sims_["R1"].at + 1, sims_["R1"].plan.size());
+  ASSERT_TRUE(gate_->SetPaused("R1", ""));
+  ASSERT_TRUE(Run(5000)) << gate_->Describe("R1");
+  EXPECT_EQ(gate_->RobotState("R1").paused_by, "");
+}
+
 TEST_F(TrafficGateTest, RobotsSharingPickAndDropKeepEps1) {
   // Both serve the same pick and drop: they must take turns there.
   AddRobot("R1", "park-P1", {"K3-2-3N"}, "D-B2", "o1");
