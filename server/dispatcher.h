@@ -141,8 +141,10 @@ class Dispatcher {
   // `actor`: who asks (the token's name, server/auth.h; "" without tokens), journaled with the
   // events the call makes.
   void SubmitOrder(engine::OrderRequest request, std::string actor, std::function<void(SubmitReply)> done);
+  // A reason longer than kMaxCancelReasonBytes is refused (INVALID_ARGUMENT).
   void CancelOrder(std::string order_id, std::string reason, std::string actor,
                    std::function<void(OrderReply)> done);
+  static constexpr std::size_t kMaxCancelReasonBytes = 1024;
 
   // --- Operator commands (issue 18 §4) --------------------------------------------------
   // Pauses (paused) or resumes robot `robot_id` for `actor` (the token's name): journaled with

@@ -92,6 +92,12 @@ void Dispatcher::DoSubmit(const engine::OrderRequest& request, const std::string
 void Dispatcher::DoCancel(const std::string& order_id, const std::string& reason, const std::string& actor,
                           const std::function<void(OrderReply)>& done) {
   OrderReply reply;
+  if (reason.size() > kMaxCancelReasonBytes) {  // stored and sent back with the order: bounded
+    reply.status = MakeStatus(StatusCode::kInvalidArgument, "the cancel reason is longer than " +
+                                                                std::to_string(kMaxCancelReasonBytes) + " bytes (" +
+                                                                std::to_string(reason.size()) + ")");
+    return done(std::move(reply));
+  }
   auto view = book_.Find(order_id);
   if (!view) {  // retired (finished) or unknown
     auto stored = FindAnywhere(order_id, false, false);

@@ -6,6 +6,7 @@
 
 #include <optional>
 
+#include "engine/common/text.h"
 #include "engine/dispatch/robot_intake.h"
 #include "server/dispatcher.h"
 #include "server/robot_protocol.h"
@@ -74,7 +75,7 @@ void Dispatcher::DoRobotMessage(const std::shared_ptr<RobotLink>& link, const Ro
 
 void Dispatcher::DoHello(const std::shared_ptr<RobotLink>& link, const RobotInbound& hello) {
   auto reject = [&](StatusCode code, std::string message) {
-    spdlog::warn("robot hello rejected: {}", message);
+    spdlog::warn("robot hello rejected: {}", engine::Clipped(message, 512));
     CloseLink(link, MakeStatus(code, std::move(message)));
   };
   auto located = engine::LocateRobot(*map_, hello.robot_id, hello.pose, options_.robot_snap_tolerance);

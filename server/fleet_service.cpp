@@ -2,6 +2,7 @@
 
 #include <algorithm>
 
+#include "engine/common/text.h"
 #include "server/grpc_auth.h"
 #include "server/grpc_status.h"
 #include "server/proto_convert.h"
@@ -54,7 +55,7 @@ class RobotStreamReactor final
         std::find(allowed_.begin(), allowed_.end(), message->robot_id) == allowed_.end()) {
       dispatcher_.OnRobotGone(link_);
       RequestFinish(Fitted({grpc::StatusCode::PERMISSION_DENIED,
-                            who_ + " may not connect as robot '" + message->robot_id + "'"}));
+                            who_ + " may not connect as robot '" + engine::Clipped(message->robot_id) + "'"}));
       return;
     }
     dispatcher_.OnRobotMessage(link_, std::move(message).value());

@@ -3,6 +3,11 @@
 
 #include <httplib.h>
 
+#include <algorithm>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+
 #include "server/auth.h"
 #include "server/service_status.h"
 #include "server/web_assets.h"
@@ -25,12 +30,45 @@ void Reply(httplib::Response& res, const RestReply& reply) {
   res.set_content(reply.text, reply.content_type);
 }
 
-// The web map: from `web_root` when given, else the copy built into the binary.
+const char* ContentTypeOf(const std::filesystem::path& file) {
+  const std::string ext = file.extension().string();
+  if (ext == ".html") return "text/html";
+  if (ext == ".js") return "text/javascript";
+  if (ext == ".css") return "text/css";
+  if (ext == ".svg") return "image/svg+xml";
+  if (ext == ".png") return "image/png";
+  if (ext == ".json") return "application/json";
+  return "application/octet-stream";
+}
+
+// GET of a file below `root` (the web map from a folder, --web-root). The path is resolved
+// (symbolic links, "..") and must stay inside the folder: a link inside pointing out of it is
+// not followed (404), as nothing outside the folder is served (issue 18 §3).
+void ServeWebRoot(httplib::Server& s, const std::string& web_root) {
+  std::error_code ec;
+  const std::filesystem::path root = std::filesystem::canonical(web_root, ec);
+  s.Get(R"(/(.*))", [root](const httplib::Request& req, httplib::Response& res) {
+    std::string rel = req.matches[1];
+    if (rel.empty() || rel.back() == '/') rel += "index.html";
+    std::error_code err;
+    const std::filesystem::path file = std::filesystem::canonical(root / rel, err);
+    const auto [in_root, in_file] = std::mismatch(root.begin(), root.end(), file.begin(), file.end());
+    std::string body;
+    if (err || root.empty() || in_root != root.end() || !std::filesystem::is_regular_file(file, err)) {
+      Reply(res, {404, RestHandlers::ErrorBody("no such file in the web root: /" + req.matches[1].str())});
+      return;
+    }
+    std::ifstream in(file, std::ios::binary);
+    body.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+    res.set_content(body, ContentTypeOf(file));
+    res.set_header("Cache-Control", "no-cache");
+  });
+}
+
+// The web map: the copy built into the binary (from a folder: ServeWebRoot, registered after
+// the API's routes, which it would otherwise shadow).
 void ServeWebMap(httplib::Server& s, const std::string& web_root) {
-  if (!web_root.empty()) {
-    s.set_mount_point("/", web_root);  // "/" serves index.html
-    return;
-  }
+  if (!web_root.empty()) return;
   for (const WebAsset& asset : BuiltInWebAssets()) {
     auto serve = [&asset](const httplib::Request&, httplib::Response& res) {
       res.set_content(asset.body.data(), asset.body.size(), std::string(asset.content_type).c_str());
@@ -149,6 +187,7 @@ RestServer::RestServer(RestHandlers handlers, const std::string& web_root, const
                      Reply(res, h.CancelOrder(req.matches[1],
                                               req.has_param("reason") ? req.get_param_value("reason") : "", actor));
                    })));
+  if (!web_root.empty()) ServeWebRoot(s, web_root);
   s.set_payload_max_length(kMaxBodyBytes);
   s.new_task_queue = [] { return new httplib::ThreadPool(kHttpThreads); };
   s.set_read_timeout(kReadTimeoutSeconds);

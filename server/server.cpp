@@ -162,6 +162,9 @@ engine::Result<std::unique_ptr<DispatchServer>> DispatchServer::Start(const Serv
   if (store) {
     s->store_ = store;
   } else {
+    auto locked = DatabaseLock::Acquire(config.db);
+    if (!locked.ok()) return locked.error();
+    s->db_lock_.emplace(std::move(locked).value());
     auto opened = storage::SqliteStore::Open(config.db);
     if (!opened.ok()) return opened.error();
     s->owned_store_ = std::move(opened).value();

@@ -12,9 +12,11 @@
 
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <string>
 
 #include "engine/common/result.h"
+#include "server/db_lock.h"
 #include "server/config.h"
 #include "storage/journal_store.h"
 #include "storage/store.h"
@@ -59,6 +61,7 @@ class DispatchServer {
  private:
   DispatchServer() = default;
 
+  std::optional<DatabaseLock> db_lock_;  // config.db's, when the server opens it itself
   std::unique_ptr<storage::Store> owned_store_;
   std::unique_ptr<ServiceMetrics> metrics_;
   std::unique_ptr<MeteredStore> metered_store_;  // wraps the store; store_ points here

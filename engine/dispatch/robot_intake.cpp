@@ -1,5 +1,7 @@
 #include "engine/dispatch/robot_intake.h"
 
+#include "engine/common/text.h"
+
 #include <cctype>
 #include <cmath>
 #include <sstream>
@@ -27,7 +29,7 @@ std::string FormatFixed(double v) {
 Result<PointId> LocateRobot(const WarehouseMap& map, const std::string& robot_id, const Pose& pose,
                             double tolerance) {
   if (!ValidRobotId(robot_id)) {
-    return InvalidArgument("robot id '" + robot_id + "' is invalid: use 1-64 letters, digits, '_', '-' or '.'");
+    return InvalidArgument("robot id '" + Clipped(robot_id) + "' is invalid: use 1-64 letters, digits, '_', '-' or '.'");
   }
   const Eigen::Vector2d& xy = pose.position;
   if (!xy.allFinite() || !std::isfinite(pose.heading)) {

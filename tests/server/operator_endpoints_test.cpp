@@ -282,6 +282,21 @@ TEST_F(OperatorEndpointsTest, WebRootServesThePageFromAFolder) {
   ASSERT_TRUE(missing);
   EXPECT_EQ(missing->status, 404);
   EXPECT_EQ(GetJson("/api/v1/status")["map_name"], "chu2024");  // the API is still there
+  // Issue 18 §3: nothing outside the folder, also not through a link inside it or "..".
+  std::ofstream(dir_.File("secret.txt")) << "outside";
+  std::filesystem::create_symlink(dir_.File("secret.txt"), root + "/leak.txt");
+  std::filesystem::create_directories(root + "/js");
+  std::ofstream(root + "/js/app.js") << "inside";
+  for (const char* path : {"/leak.txt", "/../secret.txt", "/js/../../secret.txt", "/%2e%2e/secret.txt"}) {
+    auto outside = client_->Get(path);
+    ASSERT_TRUE(outside) << path;
+    EXPECT_EQ(outside->status, 404) << path;
+    EXPECT_EQ(outside->body.find("outside"), std::string::npos) << path;
+  }
+  auto inside = client_->Get("/js/app.js");
+  ASSERT_TRUE(inside);
+  EXPECT_EQ(inside->body, "inside");
+  EXPECT_EQ(inside->get_header_value("Content-Type"), "text/javascript");
 
   ServerConfig bad = TestConfig(dir_.File("ops3.db"));
   bad.web_root = dir_.File("no-such-folder");

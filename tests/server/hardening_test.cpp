@@ -1,0 +1,67 @@
+// Issue 18 §3: faults measured on the running service, each fixed and tested here: a second
+// dispatchd on one database, a 3 MB cancel reason, a 1 MB robot id echoed whole.
+#include "tests/server/test_support.h"
+
+#include "engine/common/text.h"
+
+namespace dispatch::server::testing {
+namespace {
+
+TEST(HardeningTest, ASecondServerOnTheSameDatabaseIsRefusedAndTheLockEndsWithTheFirst) {
+  TempDir dir;
+  ServerConfig config = TestConfig(dir.File("one.db"));
+  auto first = DispatchServer::Start(config);
+  ASSERT_TRUE(first.ok()) << first.error().message;
+  auto second = DispatchServer::Start(config);
+  ASSERT_FALSE(second.ok());
+  EXPECT_NE(second.error().message.find("in use by another dispatchd"), std::string::npos) << second.error().message;
+  first.value().reset();
+  auto again = DispatchServer::Start(config);
+  EXPECT_TRUE(again.ok()) << again.error().message;
+}
+
+TEST(HardeningTest, ALongCancelReasonIsRefusedAndNotStored) {
+  TempDir dir;
+  auto server = DispatchServer::Start(TestConfig(dir.File("reason.db")));
+  ASSERT_TRUE(server.ok()) << server.error().message;
+  auto orders = pb::OrderService::NewStub(ChannelTo(**server));
+  grpc::ClientContext submit_ctx;
+  pb::SubmitOrderResponse submitted;
+  ASSERT_TRUE(orders->SubmitOrder(WithDeadline(submit_ctx), OrderRequest("reason-1", {"K3-2-3N"}, "D-B2"), &submitted)
+                  .ok());
+  pb::CancelOrderRequest cancel;
+  cancel.set_order_id(submitted.order().id());
+  cancel.set_reason(std::string(3 << 20, 'r'));
+  grpc::ClientContext cancel_ctx;
+  pb::Order answer;
+  const grpc::Status refused = orders->CancelOrder(WithDeadline(cancel_ctx), cancel, &answer);
+  EXPECT_EQ(refused.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+  EXPECT_NE(refused.error_message().find("longer than 1024 bytes"), std::string::npos) << refused.error_message();
+  grpc::ClientContext get_ctx;
+  pb::GetOrderRequest get;
+  get.set_order_id(submitted.order().id());
+  pb::Order stored;
+  ASSERT_TRUE(orders->GetOrder(WithDeadline(get_ctx), get, &stored).ok());
+  EXPECT_EQ(stored.state(), pb::ORDER_STATE_ACCEPTED);
+  EXPECT_TRUE(stored.reason().empty());
+}
+
+TEST(HardeningTest, AHugeRobotIdIsQuotedClipped) {
+  EXPECT_EQ(engine::Clipped("R1"), "R1");
+  const std::string huge(1 << 20, 'x');
+  const std::string clipped = engine::Clipped(huge);
+  EXPECT_EQ(clipped, std::string(64, 'x') + "... (1048576 bytes)");
+  EXPECT_EQ(engine::Clipped("\xc3\xa9\xc3\xa9", 3), "\xc3\xa9... (4 bytes)");  // whole characters
+  TempDir dir;
+  auto server = DispatchServer::Start(TestConfig(dir.File("id.db")));
+  ASSERT_TRUE(server.ok()) << server.error().message;
+  FakeRobot robot(ChannelTo(**server), huge);
+  robot.Connect(30.625, 24.75);
+  const grpc::Status ended = robot.AwaitEnd();
+  EXPECT_EQ(ended.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+  EXPECT_LT(ended.error_message().size(), 300u) << ended.error_message().substr(0, 300);
+  EXPECT_NE(ended.error_message().find("(1048576 bytes)"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace dispatch::server::testing
