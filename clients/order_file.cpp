@@ -9,6 +9,7 @@
 #include <optional>
 #include <utility>
 
+#include "formats/json_keys.h"
 #include "formats/task_table_text.h"
 
 namespace dispatch::clients {
@@ -134,6 +135,7 @@ OrderFile ParseOrderText(std::string_view text, bool is_json, const std::string&
   } catch (const json::parse_error& e) {
     return fail(std::string("bad JSON: ") + e.what());
   }
+  if (auto key = formats::FirstDuplicateKey(text)) return fail("the key '" + *key + "' appears twice in one object");
   if (doc.is_object() && doc.contains("orders")) doc = doc["orders"];
   if (!doc.is_array()) doc = json::array({doc});
   if (doc.empty()) return fail("no orders in the file");

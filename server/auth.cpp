@@ -10,6 +10,9 @@
 #include <sstream>
 #include <vector>
 
+#include "engine/common/text.h"
+#include "formats/json_keys.h"
+
 namespace dispatch::server {
 namespace {
 
@@ -110,27 +113,16 @@ std::string Sha256Hex(std::string_view data) {
 }
 
 engine::Result<TokenSet> TokenSet::Parse(const std::string& text) {
-  // Duplicate keys would be taken silently (the last one wins): refused.
-  std::vector<std::set<std::string>> open_objects;
-  std::string duplicate;
-  const nlohmann::json::parser_callback_t check = [&](int, nlohmann::json::parse_event_t event,
-                                                       nlohmann::json& parsed) {
-    using Event = nlohmann::json::parse_event_t;
-    if (event == Event::object_start) open_objects.emplace_back();
-    if (event == Event::object_end && !open_objects.empty()) open_objects.pop_back();
-    if (event == Event::key && !open_objects.empty() && parsed.is_string() &&
-        !open_objects.back().insert(parsed.get<std::string>()).second && duplicate.empty()) {
-      duplicate = parsed.get<std::string>();
-    }
-    return true;
-  };
   nlohmann::json j;
   try {
-    j = nlohmann::json::parse(text, check);
+    j = nlohmann::json::parse(text);
   } catch (const nlohmann::json::exception& e) {
     return InvalidArgument(std::string("the token file is not JSON: ") + e.what());
   }
-  if (!duplicate.empty()) return InvalidArgument("the token file repeats the key '" + duplicate + "'");
+  // A repeated key would be taken silently (the last one wins): refused.
+  if (auto duplicate = formats::FirstDuplicateKey(text)) {
+    return InvalidArgument("the token file repeats the key '" + engine::Clipped(*duplicate) + "'");
+  }
   if (!j.is_object() || !j.contains("tokens") || !j["tokens"].is_array()) {
     return InvalidArgument("the token file must be an object with a \"tokens\" array");
   }

@@ -5,6 +5,8 @@
 #include <spdlog/spdlog.h>
 
 
+#include "engine/common/text.h"
+#include "formats/json_keys.h"
 #include "server/proto_convert.h"
 
 namespace dispatch::server {
@@ -57,6 +59,9 @@ engine::Status FromJson(const std::string& body, google::protobuf::Message* out)
     return engine::InvalidArgument("the body is not JSON: " + ValidUtf8(e.what()));
   }
   if (!j.is_object()) return engine::InvalidArgument("the body must be a JSON object (a " + out->GetTypeName() + ")");
+  if (auto key = formats::FirstDuplicateKey(body)) {
+    return engine::InvalidArgument("the body names the key '" + engine::Clipped(ValidUtf8(*key)) + "' twice");
+  }
   google::protobuf::util::JsonParseOptions options;
   options.ignore_unknown_fields = false;
   if (auto status = google::protobuf::util::JsonStringToMessage(body, out, options); !status.ok()) {

@@ -12,7 +12,9 @@
 #include <utility>
 #include <vector>
 
+#include "engine/common/text.h"
 #include "engine/map/map_builder.h"
+#include "formats/json_keys.h"
 
 namespace dispatch::engine {
 namespace {
@@ -403,6 +405,9 @@ Result<WarehouseMap> ParseMapJson(std::string_view text) {
     return InvalidArgument("not valid JSON: " + DescribeParseError(text, e));
   }
   if (!doc.is_object()) return TypeError("top level", "an object", doc);
+  if (auto key = formats::FirstDuplicateKey(text)) {
+    return InvalidArgument("the key '" + Clipped(*key) + "' appears twice in one object (which one counts?)");
+  }
   if (Status s = ReadHeader(doc); !s) return s.error();
 
   auto name_m = Member(doc, "", "name", true);

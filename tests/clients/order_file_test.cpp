@@ -75,6 +75,7 @@ TEST(OrderFileTest, BadFilesNameTheProblem) {
       {"[{\"picks\": [\"P1\"], \"drop\": \"D1\", \"priority\": \"high\"}]", true, "priority"},
       {"[{\"picks\": [\"P1\"], \"drop\": \"D1\", \"work_time\": -1}]", true, "work_time"},
       {"{not json", true, "bad JSON"},
+      {"[{\"picks\": [\"P1\"], \"drop\": \"D1\", \"drop\": \"D2\"}]", true, "the key 'drop' appears twice"},
       {"[]", true, "no orders"},
       {"task,formation,picks,drop\n1,2,1 1,2 2\n", false, "line 2"},
       {"task,formation,picks\n", false, "drop"},

@@ -1,6 +1,9 @@
 // Issue 18 §3: faults measured on the running service, each fixed and tested here: a second
-// dispatchd on one database, a 3 MB cancel reason, a 1 MB robot id echoed whole.
+// dispatchd on one database, a 3 MB cancel reason, a REST body naming a key twice, a 1 MB
+// robot id echoed whole.
 #include "tests/server/test_support.h"
+
+#include <httplib.h>  // after every header that pulls in Eigen (STYLE.md)
 
 #include "engine/common/text.h"
 
@@ -44,6 +47,25 @@ TEST(HardeningTest, ALongCancelReasonIsRefusedAndNotStored) {
   ASSERT_TRUE(orders->GetOrder(WithDeadline(get_ctx), get, &stored).ok());
   EXPECT_EQ(stored.state(), pb::ORDER_STATE_ACCEPTED);
   EXPECT_TRUE(stored.reason().empty());
+}
+
+TEST(HardeningTest, ARestBodyNamingAKeyTwiceIsRefused) {
+  TempDir dir;
+  auto server = DispatchServer::Start(TestConfig(dir.File("keys.db")));
+  ASSERT_TRUE(server.ok()) << server.error().message;
+  httplib::Client client("127.0.0.1", (*server)->ports().http);
+  const std::string twice =
+      R"({"client_order_id": "dup-keys", "picks": [{"point_name": "K3-2-3N"}], "drop": {"point_name": "D-B2"},
+          "drop": {"point_name": "D-B1"}})";
+  auto refused = client.Post("/api/v1/orders", twice, "application/json");
+  ASSERT_TRUE(refused);
+  EXPECT_EQ(refused->status, 400);
+  EXPECT_NE(refused->body.find("the key 'drop' twice"), std::string::npos) << refused->body;
+  const std::string once = R"({"client_order_id": "dup-keys", "picks": [{"point_name": "K3-2-3N"}],
+                              "drop": {"point_name": "D-B2"}})";
+  auto accepted = client.Post("/api/v1/orders", once, "application/json");
+  ASSERT_TRUE(accepted);
+  EXPECT_EQ(accepted->status, 201) << accepted->body;
 }
 
 TEST(HardeningTest, AHugeRobotIdIsQuotedClipped) {

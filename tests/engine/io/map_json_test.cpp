@@ -118,6 +118,22 @@ TEST(MapJsonTest, WriterIsCanonical) {
   EXPECT_EQ(text.back(), '\n');
 }
 
+// Issue 18 §3: a key named twice in one object is refused (which one would count?), at any
+// depth; the same key in two objects is fine.
+TEST(MapJsonTest, AKeyTwiceInOneObjectIsRefused) {
+  const std::string text = R"({
+    "format": "warehouse-map", "version": 1, "name": "tiny",
+    "floor": {"min": [0, 0], "max": [10, 10]},
+    "zones": [{"id": "z", "polygon": [[0, 0], [10, 0], [10, 10], [0, 10]]}],
+    "points": [{"id": "p", "x": 1, "y": 1, "kind": "pick"},
+               {"id": "q", "x": 4, "y": 5, "kind": "drop", "kind": "pick"}],
+    "paths": [{"from": "p", "to": "q", "bidirectional": true}]
+  })";
+  Result<WarehouseMap> map = ParseMapJson(text);
+  ASSERT_FALSE(map.ok());
+  EXPECT_NE(map.error().message.find("the key 'kind' appears twice"), std::string::npos) << map.error().message;
+}
+
 TEST(MapJsonTest, OptionalFieldsTakeTheirDefaults) {
   const std::string text = R"({
     "format": "warehouse-map", "version": 1, "name": "tiny",
