@@ -4,7 +4,8 @@
 #   deploy/setup.sh packages            install packages only
 #   deploy/setup.sh build DIR [ARGS..]  packages, then configure DIR with ARGS and build it
 # With DISPATCH_TEST_DEPS=1 it also installs what only the tests use (deploy/test.sh sets it):
-# headless Chromium and python3-websocket for the web map's browser test.
+# headless Chromium and python3-websocket for the web map's browser test; with
+# DISPATCH_FUZZ_DEPS=1 (deploy/fuzz.sh) clang and its runtime libraries (libFuzzer).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -19,6 +20,9 @@ PACKAGES=(
 )
 if [ "${DISPATCH_TEST_DEPS:-0}" = 1 ]; then
   PACKAGES+=(chromium python3-websocket)
+fi
+if [ "${DISPATCH_FUZZ_DEPS:-0}" = 1 ]; then  # deploy/fuzz.sh: clang's libFuzzer and sanitizers
+  PACKAGES+=(clang libclang-rt-dev)
 fi
 
 install_packages() {

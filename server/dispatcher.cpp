@@ -108,6 +108,10 @@ void Dispatcher::CloseStreams() {
         effects_.MarkChanged();
       }
     }
+    for (const auto& [link, opened] : awaiting_hello_) {
+      CloseLink(link, MakeStatus(StatusCode::kUnavailable, "dispatcher shutting down"));
+    }
+    awaiting_hello_.clear();
   });
   hub_.CloseAll();
 }

@@ -153,6 +153,9 @@ class Dispatcher {
   void PauseRobot(std::string robot_id, bool paused, std::string actor, std::function<void(ServiceStatus)> done);
 
   // --- Robot streams -----------------------------------------------------------------
+  // A stream opened: it must say Hello within heartbeat_timeout or it is ended
+  // (DEADLINE_EXCEEDED), so streams that never say who they are do not pile up (issue 18 §3).
+  void OnRobotStreamOpened(std::shared_ptr<RobotLink> link);
   // Every message of a stream, Hello first. Replies go to `link`.
   void OnRobotMessage(std::shared_ptr<RobotLink> link, RobotInbound message);
   // The stream ended (client gone or cancelled).
@@ -270,6 +273,8 @@ class Dispatcher {
   DispatchClock clock_;
   OrderViews book_;  // every open order and the newest finished ones, as operators read them
   RobotSessions sessions_;  // every robot the core knows, and their streams
+  // Streams opened that have sent nothing yet, with when they opened (OnRobotStreamOpened).
+  std::map<std::shared_ptr<RobotLink>, Clock::time_point> awaiting_hello_;
   std::int64_t last_order_number_ = 0;
   std::uint64_t snapshot_version_ = 0;
   BatchEffects effects_;  // the batch's deferred effects; whether the snapshot is stale

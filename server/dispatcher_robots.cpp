@@ -13,6 +13,10 @@
 
 namespace dispatch::server {
 
+void Dispatcher::OnRobotStreamOpened(std::shared_ptr<RobotLink> link) {
+  Post([this, link = std::move(link)] { awaiting_hello_.emplace(link, Clock::now()); });
+}
+
 void Dispatcher::OnRobotMessage(std::shared_ptr<RobotLink> link, RobotInbound message) {
   Post([this, link = std::move(link), message = std::move(message)] { DoRobotMessage(link, message); });
 }
@@ -39,6 +43,7 @@ void Dispatcher::OnRobotGone(std::shared_ptr<RobotLink> link) {
 }
 
 void Dispatcher::DoRobotMessage(const std::shared_ptr<RobotLink>& link, const RobotInbound& m) {
+  awaiting_hello_.erase(link);  // it spoke: a Hello, or a first message that ends it
   const std::string* known = sessions_.RobotOf(link.get());
   if (auto wrong = OutOfTurn(m.kind, known != nullptr)) {
     return CloseLink(link, MakeStatus(StatusCode::kInvalidArgument, *wrong));
@@ -159,6 +164,7 @@ void Dispatcher::MarkOffline(const std::string& id, const std::string& why) {
 }
 
 void Dispatcher::DoRobotGone(const std::shared_ptr<RobotLink>& link) {
+  awaiting_hello_.erase(link);
   const std::string* known = sessions_.RobotOf(link.get());
   if (!known) return;
   const std::string id = *known;
@@ -183,6 +189,17 @@ void Dispatcher::Tick() {
     } else if (auto why = GraceOver(id, s, core_->robot(id), now, options_.offline_grace)) {
       if (LoseRobot(id, *why)) s.offline_since.reset();
     }
+  }
+  const auto hello_deadline = WallDuration(options_.heartbeat_timeout);
+  for (auto it = awaiting_hello_.begin(); it != awaiting_hello_.end();) {
+    if (now - it->second < hello_deadline) {
+      ++it;
+      continue;
+    }
+    CloseLink(it->first, MakeStatus(StatusCode::kDeadlineExceeded,
+                                    "no Hello within the heartbeat timeout (" +
+                                        engine::FormatFixed(options_.heartbeat_timeout) + " s)"));
+    it = awaiting_hello_.erase(it);
   }
   rounds_due_.Tick();
   memory_trim_.Tick(now);

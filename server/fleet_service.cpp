@@ -36,6 +36,7 @@ class RobotStreamReactor final
   RobotStreamReactor(Dispatcher& dispatcher, std::vector<std::string> allowed, std::string who)
       : dispatcher_(dispatcher), link_(std::make_shared<StreamLink>(this)), allowed_(std::move(allowed)),
         who_(std::move(who)) {
+    dispatcher_.OnRobotStreamOpened(link_);
     StartRead(&in_);
   }
 

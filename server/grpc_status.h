@@ -21,6 +21,7 @@ inline grpc::Status ToGrpcStatus(const ServiceStatus& s) {
     case StatusCode::kInternal: return {grpc::StatusCode::INTERNAL, s.message};
     case StatusCode::kUnauthenticated: return {grpc::StatusCode::UNAUTHENTICATED, s.message};
     case StatusCode::kPermissionDenied: return {grpc::StatusCode::PERMISSION_DENIED, s.message};
+    case StatusCode::kDeadlineExceeded: return {grpc::StatusCode::DEADLINE_EXCEEDED, s.message};
   }
   return {grpc::StatusCode::INTERNAL, s.message};
 }

@@ -27,6 +27,7 @@ int HttpStatus(StatusCode code) {
     case StatusCode::kInternal: return 500;
     case StatusCode::kUnauthenticated: return 401;
     case StatusCode::kPermissionDenied: return 403;
+    case StatusCode::kDeadlineExceeded: return 408;
   }
   return 500;
 }

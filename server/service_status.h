@@ -20,6 +20,7 @@ enum class StatusCode {
   kInternal,            // a broken invariant
   kUnauthenticated,     // no token, or one the server does not know (server/auth.h)
   kPermissionDenied,    // a known token whose role may not do this
+  kDeadlineExceeded,    // the caller took too long (a robot stream with no Hello)
 };
 
 struct ServiceStatus {

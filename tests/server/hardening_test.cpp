@@ -1,6 +1,6 @@
 // Issue 18 §3: faults measured on the running service, each fixed and tested here: a second
-// dispatchd on one database, a 3 MB cancel reason, a REST body naming a key twice, a 1 MB
-// robot id echoed whole.
+// dispatchd on one database, a 3 MB cancel reason, a REST body naming a key twice, a stream
+// that never says Hello, a 1 MB robot id echoed whole.
 #include "tests/server/test_support.h"
 
 #include <httplib.h>  // after every header that pulls in Eigen (STYLE.md)
@@ -66,6 +66,26 @@ TEST(HardeningTest, ARestBodyNamingAKeyTwiceIsRefused) {
   auto accepted = client.Post("/api/v1/orders", once, "application/json");
   ASSERT_TRUE(accepted);
   EXPECT_EQ(accepted->status, 201) << accepted->body;
+}
+
+// A stream that never says Hello is ended after the heartbeat timeout (it held a connection,
+// a thread's worth of buffers and a descriptor for ever).
+TEST(HardeningTest, AStreamThatNeverSaysHelloIsEnded) {
+  TempDir dir;
+  ServerConfig config = TestConfig(dir.File("silent.db"));
+  config.heartbeat_interval = 0.1;
+  config.heartbeat_timeout = 0.5;
+  auto server = DispatchServer::Start(config);
+  ASSERT_TRUE(server.ok()) << server.error().message;
+  auto stub = pb::FleetService::NewStub(ChannelTo(**server));
+  grpc::ClientContext ctx;
+  ctx.set_deadline(std::chrono::system_clock::now() + kTimeout);
+  auto stream = stub->Connect(&ctx);
+  pb::ServerMessage m;
+  EXPECT_FALSE(stream->Read(&m));  // nothing comes; the server ends the stream
+  const grpc::Status status = stream->Finish();
+  EXPECT_EQ(status.error_code(), grpc::StatusCode::DEADLINE_EXCEEDED) << status.error_message();
+  EXPECT_NE(status.error_message().find("no Hello"), std::string::npos) << status.error_message();
 }
 
 TEST(HardeningTest, AHugeRobotIdIsQuotedClipped) {
