@@ -2,11 +2,32 @@
 // server/server.h for what runs. SIGTERM / SIGINT shut it down gracefully.
 #include <spdlog/spdlog.h>
 
+#include <sys/resource.h>
+
 #include <csignal>
 #include <cstdio>
 
 #include "server/config.h"
 #include "server/server.h"
+
+namespace {
+
+// Every connection and stream costs a descriptor; with a low soft limit (256 under some
+// launchers) idle connections locked gRPC out for good (issue 18 §3). The soft limit is raised
+// to the hard one.
+void RaiseDescriptorLimit() {
+  rlimit limit{};
+  if (getrlimit(RLIMIT_NOFILE, &limit) != 0 || limit.rlim_cur >= limit.rlim_max) return;
+  const rlim_t before = limit.rlim_cur;
+  limit.rlim_cur = limit.rlim_max;
+  if (setrlimit(RLIMIT_NOFILE, &limit) == 0) {
+    spdlog::info("open files: soft limit raised from {} to {}", before, limit.rlim_cur);
+  } else {
+    spdlog::warn("open files: the soft limit of {} could not be raised", before);
+  }
+}
+
+}  // namespace
 
 int main(int argc, char** argv) {
   auto parsed = dispatch::server::ParseCommandLine(argc, argv);
@@ -17,6 +38,7 @@ int main(int argc, char** argv) {
   if (parsed->exit_code >= 0) return parsed->exit_code;
   const auto& config = parsed->config;
   spdlog::set_level(spdlog::level::from_str(config.log_level));
+  RaiseDescriptorLimit();
 
   // Block the shutdown signals in every thread (threads inherit the mask) and wait for them
   // here, so no handler runs inside gRPC or SQLite code.

@@ -9,7 +9,20 @@ auto MeteredStore::Timed(const char* op, Fn&& fn) {
   const auto start = std::chrono::steady_clock::now();
   auto result = fn();
   metrics_.ObserveDbWrite(op, std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
+  if (result.ok() || result.error().code == engine::ErrorCode::kIoError) {
+    std::lock_guard<std::mutex> lock(mu_);
+    if (result.ok()) {
+      write_failure_.reset();
+    } else {
+      write_failure_ = result.error().message;
+    }
+  }
   return result;
+}
+
+std::optional<std::string> MeteredStore::WriteFailure() const {
+  std::lock_guard<std::mutex> lock(mu_);
+  return write_failure_;
 }
 
 engine::Result<storage::InsertOrderResult> MeteredStore::InsertOrder(const engine::Order& order,

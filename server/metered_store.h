@@ -2,8 +2,14 @@
 // included) into ServiceMetrics' dispatch_db_write_seconds{op}. Reads pass through untimed.
 // Writes made inside RunInTransaction go through the decorator too (the body is handed this
 // decorator), so a transaction shows as its writes plus one "transaction" observation.
+// It also remembers whether the last write failed for I/O (read-only or full database),
+// until a write succeeds again: readiness (GET /readyz) reads it.
 // Thread-safe if the wrapped store is.
 #pragma once
+
+#include <mutex>
+#include <optional>
+#include <string>
 
 #include "server/metrics.h"
 #include "storage/store.h"
@@ -48,12 +54,17 @@ class MeteredStore final : public storage::Store {
   engine::Result<storage::MapVersion> LatestMapVersion() override { return inner_.LatestMapVersion(); }
   engine::Status RunInTransaction(const std::function<engine::Status(storage::Store&)>& body) override;
 
+  // Why the last write failed for I/O (nullopt: it did not, or a write has succeeded since).
+  std::optional<std::string> WriteFailure() const;
+
  private:
   template <class Fn>
   auto Timed(const char* op, Fn&& fn);
 
   storage::Store& inner_;
   ServiceMetrics& metrics_;
+  mutable std::mutex mu_;  // guards write_failure_
+  std::optional<std::string> write_failure_;
 };
 
 }  // namespace dispatch::server

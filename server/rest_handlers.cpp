@@ -48,9 +48,11 @@ std::optional<engine::OrderState> StateFilter(const std::string& name) {
 
 }  // namespace
 
-RestHandlers::RestHandlers(Dispatcher& dispatcher, ServiceMetrics* metrics)
+RestHandlers::RestHandlers(Dispatcher& dispatcher, ServiceMetrics* metrics,
+                           std::function<std::optional<std::string>()> store_health)
     : dispatcher_(dispatcher),
       metrics_(metrics),
+      store_health_(std::move(store_health)),
       map_json_(std::make_shared<const std::string>(engine::WriteMapJson(dispatcher.map()))) {}
 
 std::string RestHandlers::ErrorBody(const std::string& message) { return ErrorJson(message); }
@@ -92,8 +94,13 @@ RestReply RestHandlers::Ready() const {
   auto snap = dispatcher_.snapshot();
   if (!snap) return Error(503, "dispatcher not ready");
   pb::Readiness out;
-  out.set_ready(true);
   out.set_snapshot(snap->version);
+  if (auto why = store_health_ ? store_health_() : std::nullopt) {
+    out.set_ready(false);
+    out.set_reason(*why);
+    return Json(503, out);
+  }
+  out.set_ready(true);
   return Json(200, out);
 }
 

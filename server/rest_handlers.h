@@ -7,6 +7,7 @@
 #pragma once
 
 #include <cstddef>
+#include <functional>
 #include <memory>
 #include <optional>
 #include <string>
@@ -35,8 +36,10 @@ struct RestReply {
 
 class RestHandlers {
  public:
-  // `metrics` may be null (GET /metrics then answers 404).
-  RestHandlers(Dispatcher& dispatcher, ServiceMetrics* metrics);
+  // `metrics` may be null (GET /metrics then answers 404). `store_health` (optional): why
+  // the database cannot take writes now (nullopt: it can), for GET /readyz.
+  RestHandlers(Dispatcher& dispatcher, ServiceMetrics* metrics,
+               std::function<std::optional<std::string>()> store_health = {});
 
   RestReply Health() const;
   RestReply Ready() const;
@@ -78,6 +81,7 @@ class RestHandlers {
  private:
   Dispatcher& dispatcher_;
   ServiceMetrics* metrics_;
+  std::function<std::optional<std::string>()> store_health_;
   std::shared_ptr<const std::string> map_json_;  // built once
 };
 

@@ -6,11 +6,13 @@
 
 #include <chrono>
 
+#include <sys/statvfs.h>
 #include <unistd.h>
 
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
+#include <filesystem>
 #include <fstream>
 
 #include "engine/common/fnv1a.h"
@@ -31,6 +33,9 @@
 
 namespace dispatch::server {
 namespace {
+
+// Below this much free space on the database's disk dispatchd says it is not ready.
+constexpr double kMinFreeDiskMb = 64.0;
 
 std::string PortsJson(const ServerPorts& ports) {
   return nlohmann::json{{"grpc_port", ports.grpc}, {"http_port", ports.http}}.dump() + "\n";
@@ -243,6 +248,11 @@ engine::Result<std::unique_ptr<DispatchServer>> DispatchServer::Start(const Serv
   grpc::ServerBuilder builder;
   // One listener per port: a second dispatchd on the same port must fail, not share it.
   builder.AddChannelArgument(GRPC_ARG_ALLOW_REUSEPORT, 0);
+  // Connections that never finish their handshake, and connections idle (no stream) for two
+  // minutes, are closed: idle clients cannot hold descriptors for ever (issue 18 §3). A
+  // client's channel reconnects by itself when it calls again.
+  builder.AddChannelArgument(GRPC_ARG_SERVER_HANDSHAKE_TIMEOUT_MS, 10'000);
+  builder.AddChannelArgument(GRPC_ARG_MAX_CONNECTION_IDLE_MS, 120'000);
   int grpc_port = 0;
   builder.AddListeningPort(bind + ":" + std::to_string(config.grpc_port), *credentials, &grpc_port);
   builder.RegisterService(s->order_service_.get());
@@ -260,7 +270,23 @@ engine::Result<std::unique_ptr<DispatchServer>> DispatchServer::Start(const Serv
   security.tls_key = config.tls_key;
   security.auth = s->auth_.get();
   security.metrics_open = config.metrics_open;
-  s->rest_ = std::make_unique<RestServer>(RestHandlers(*s->dispatcher_, s->metrics_.get()), config.web_root, security);
+  // Ready while the database takes writes and its disk has room (GET /readyz).
+  auto store_health = [metered = s->metered_store_.get(),
+                       folder = std::filesystem::absolute(config.db).parent_path().string(),
+                       own_file = store == nullptr]() -> std::optional<std::string> {
+    if (auto failed = metered->WriteFailure()) return "the database's last write failed: " + *failed;
+    struct statvfs disk {};
+    if (own_file && ::statvfs(folder.c_str(), &disk) == 0) {
+      const double free_mb = static_cast<double>(disk.f_bavail) * static_cast<double>(disk.f_frsize) / 1048576.0;
+      if (free_mb < kMinFreeDiskMb) {
+        return "the database's disk (" + folder + ") has " + std::to_string(static_cast<int>(free_mb)) +
+               " MiB free, under " + std::to_string(static_cast<int>(kMinFreeDiskMb));
+      }
+    }
+    return std::nullopt;
+  };
+  s->rest_ = std::make_unique<RestServer>(RestHandlers(*s->dispatcher_, s->metrics_.get(), store_health),
+                                          config.web_root, security);
   if (!s->rest_->valid()) {
     return engine::InvalidArgument("HTTPS: cannot load the certificate '" + config.tls_cert + "' with the key '" +
                                    config.tls_key + "' (do they match?)");

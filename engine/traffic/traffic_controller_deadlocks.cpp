@@ -67,7 +67,8 @@ double TrafficController::Impl::CheapestCost(const traffic_detail::RouteQuery& q
   std::vector<OpenItem>& heap = open;  // here h holds the entry's cost so far
   heap.clear();
   const double* costs = bound_routes->CostsTo(to);  // read in place when the table allows
-  auto lower = [&](PointId v) { return costs ? costs[static_cast<std::size_t>(v)] : bound_routes->Cost(v, to); };
+  const PointId target = to;  // (a structured binding: lambdas may not capture it before C++20 in clang 14)
+  auto lower = [&](PointId v) { return costs ? costs[static_cast<std::size_t>(v)] : bound_routes->Cost(v, target); };
   // Ties to the entry furthest along (on a grid many routes cost the same: without this the
   // search would sweep all of them).
   auto later = [](const OpenItem& a, const OpenItem& b) { return a.key != b.key ? a.key > b.key : a.h < b.h; };
@@ -128,7 +129,8 @@ Detour TrafficController::Impl::Search(const traffic_detail::RouteQuery& q) {
   auto h = [&](PointId v) { return (point_xy[static_cast<std::size_t>(v)] - goal).norm() / config.speed; };
   const RouteTable* table = bound_routes.get();
   const double* costs = table ? table->CostsTo(to) : nullptr;  // read in place when the table allows
-  auto lower = [&](PointId v) { return costs ? costs[static_cast<std::size_t>(v)] : table->Cost(v, to); };
+  const PointId target = to;  // (see CheapestCost)
+  auto lower = [&](PointId v) { return costs ? costs[static_cast<std::size_t>(v)] : table->Cost(v, target); };
   if (++stamp == 0) {
     std::fill(seen.begin(), seen.end(), 0);
     stamp = 1;

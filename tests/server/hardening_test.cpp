@@ -1,11 +1,13 @@
 // Issue 18 §3: faults measured on the running service, each fixed and tested here: a second
 // dispatchd on one database, a 3 MB cancel reason, a REST body naming a key twice, a stream
-// that never says Hello, a 1 MB robot id echoed whole.
+// that never says Hello, /readyz while the database fails writes, a 1 MB robot id echoed whole.
 #include "tests/server/test_support.h"
 
 #include <httplib.h>  // after every header that pulls in Eigen (STYLE.md)
 
 #include "engine/common/text.h"
+#include "storage/fault_injection_store.h"
+#include "storage/sqlite_store.h"
 
 namespace dispatch::server::testing {
 namespace {
@@ -86,6 +88,40 @@ TEST(HardeningTest, AStreamThatNeverSaysHelloIsEnded) {
   const grpc::Status status = stream->Finish();
   EXPECT_EQ(status.error_code(), grpc::StatusCode::DEADLINE_EXCEEDED) << status.error_message();
   EXPECT_NE(status.error_message().find("no Hello"), std::string::npos) << status.error_message();
+}
+
+// /readyz said ready while the database could not take writes: now 503 with why, from a write
+// that failed for I/O until a write succeeds again (the disk back).
+TEST(HardeningTest, NotReadyWhileTheDatabaseFailsWritesAndReadyWhenItRecovers) {
+  TempDir dir;
+  ServerConfig config = TestConfig(dir.File("ready.db"));
+  auto sqlite = storage::SqliteStore::Open(config.db);
+  ASSERT_TRUE(sqlite.ok()) << sqlite.error().message;
+  storage::FaultInjectionStore faulty(**sqlite);
+  auto server = DispatchServer::Start(config, &faulty);
+  ASSERT_TRUE(server.ok()) << server.error().message;
+  httplib::Client client("127.0.0.1", (*server)->ports().http);
+  auto orders = pb::OrderService::NewStub(ChannelTo(**server));
+  auto submit = [&](const std::string& id) {
+    grpc::ClientContext ctx;
+    pb::SubmitOrderResponse response;
+    return orders->SubmitOrder(WithDeadline(ctx), OrderRequest(id, {"K3-2-3N"}, "D-B2"), &response);
+  };
+  auto ready = client.Get("/readyz");
+  ASSERT_TRUE(ready);
+  EXPECT_EQ(ready->status, 200) << ready->body;
+  faulty.FailWritesFrom(faulty.writes() + 1);  // the disk turns read-only, or fills up
+  EXPECT_EQ(submit("ready-1").error_code(), grpc::StatusCode::UNAVAILABLE);
+  auto failing = client.Get("/readyz");
+  ASSERT_TRUE(failing);
+  EXPECT_EQ(failing->status, 503) << failing->body;
+  EXPECT_NE(failing->body.find("last write failed"), std::string::npos) << failing->body;
+  faulty.FailWritesFrom(0);
+  EXPECT_TRUE(submit("ready-1").ok());
+  auto recovered = client.Get("/readyz");
+  ASSERT_TRUE(recovered);
+  EXPECT_EQ(recovered->status, 200) << recovered->body;
+  (*server)->Shutdown();
 }
 
 TEST(HardeningTest, AHugeRobotIdIsQuotedClipped) {
