@@ -132,7 +132,7 @@ OrderFile ParseOrderText(std::string_view text, bool is_json, const std::string&
   json doc;
   try {
     doc = json::parse(text);
-  } catch (const json::parse_error& e) {
+  } catch (const json::exception& e) {  // a syntax error, or a number too large (fuzz_order_file)
     return fail(std::string("bad JSON: ") + e.what());
   }
   if (auto key = formats::FirstDuplicateKey(text)) return fail("the key '" + *key + "' appears twice in one object");

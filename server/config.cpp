@@ -94,7 +94,9 @@ engine::Status ApplyConfigFile(const std::string& path, ServerConfig& config) {
   }
   if (!j.is_object()) return InvalidArgument("config file '" + path + "' must hold a JSON object");
   const auto keys = Keys();
-  for (const auto& [name, value] : j.items()) {
+  for (const auto& item : j.items()) {
+    const std::string& name = item.key();  // (not a structured binding: clang 14 lambdas cannot capture one)
+    const auto& value = item.value();
     auto it = std::find_if(keys.begin(), keys.end(), [&](const Key& k) { return name == k.name; });
     if (it == keys.end()) {
       return InvalidArgument("config file '" + path + "': unknown key '" + name + "'");

@@ -403,6 +403,8 @@ Result<WarehouseMap> ParseMapJson(std::string_view text) {
     doc = json::parse(text.begin(), text.end());
   } catch (const json::parse_error& e) {
     return InvalidArgument("not valid JSON: " + DescribeParseError(text, e));
+  } catch (const json::exception& e) {  // e.g. a number too large for a double (found by fuzz_map_json)
+    return InvalidArgument(std::string("not valid JSON: ") + e.what());
   }
   if (!doc.is_object()) return TypeError("top level", "an object", doc);
   if (auto key = formats::FirstDuplicateKey(text)) {
