@@ -287,7 +287,8 @@ TEST_F(SqliteStoreTest, StateTransitionsFollowTheLifecycleAndAreJournaledInOrder
   const auto all = store->ListEvents({}).value();
   for (size_t i = 1; i < all.size(); ++i) EXPECT_LT(all[i - 1].id, all[i].id);
   std::vector<std::string> a_states;
-  for (const OrderEvent& e : store->ListEvents({"a", 0, 100}).value()) {
+  const auto a_events = store->ListEvents({"a", 0, 100}).value();  // (a range-for over value() of a temporary dangles)
+  for (const OrderEvent& e : a_events) {
     a_states.push_back(std::string(OrderEventTypeName(e.type)) + ":" +
                        engine::OrderStateName(e.state));
   }
