@@ -1,7 +1,13 @@
 #!/usr/bin/env bash
-# The whole test suite: installs what it needs, builds (warnings are errors) and runs CTest.
+# The whole test suite: installs what it needs, builds (warnings are errors) and runs CTest
+# (unit, fuzz replay and end-to-end tests), then the sanitizer runs (deploy/sanitizers.sh:
+# ASan + UBSan, TSan). Arguments go to CTest (e.g. -R Name) and then skip the sanitizer runs;
+# DISPATCH_SANITIZERS=0 skips them too.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 DISPATCH_TEST_DEPS=1 bash deploy/setup.sh build build -DCMAKE_BUILD_TYPE=RelWithDebInfo -DDISPATCH_BUILD_TESTS=ON \
   -DDISPATCH_WERROR=ON
 ctest --test-dir build --output-on-failure -j "$(nproc)" "$@"
+if [ $# -eq 0 ] && [ "${DISPATCH_SANITIZERS:-1}" = 1 ]; then
+  bash deploy/sanitizers.sh
+fi
