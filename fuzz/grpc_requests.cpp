@@ -4,39 +4,16 @@
 // RobotMessage through RobotInboundFromProto and, for a Hello, the robot's checks).
 #include "engine/dispatch/order_intake.h"
 #include "engine/dispatch/robot_intake.h"
-#include "engine/map/chu2024_floor.h"
-#include "fuzz/fuzz_input.h"
+#include "fuzz/chu2024_floor.h"
 #include "server/proto_convert.h"
 #include "warehouse/dispatch/v1/fleet.pb.h"
 #include "warehouse/dispatch/v1/operator.pb.h"
 #include "warehouse/dispatch/v1/orders.pb.h"
 
-namespace {
-
 namespace pb = ::warehouse::dispatch::v1;
 
-struct Floor {
-  std::shared_ptr<const dispatch::engine::WarehouseMap> map;
-  std::shared_ptr<const dispatch::engine::RouteTable> routes;
-  Floor() {
-    map = std::make_shared<const dispatch::engine::WarehouseMap>(dispatch::engine::BuildChu2024Floor().value());
-    routes = std::shared_ptr<const dispatch::engine::RouteTable>(dispatch::engine::MakeRouteTable(map, {}).value());
-  }
-};
-
-}  // namespace
-
-// Built once, before the first input (a route table takes seconds under the sanitizers: not
-// a unit's time).
-const Floor* the_floor = nullptr;
-
-extern "C" int LLVMFuzzerInitialize(int*, char***) {
-  the_floor = new Floor();
-  return 0;
-}
-
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
-  const Floor& f = *the_floor;
+  const dispatch::fuzz::Floor& f = dispatch::fuzz::TheFloor();
   if (size == 0) return 0;
   const int which = data[0] % 4;
   const auto* bytes = data + 1;

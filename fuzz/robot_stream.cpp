@@ -12,8 +12,7 @@
 #include "engine/dispatch/order_intake.h"
 #include "engine/dispatch/robot_intake.h"
 #include "engine/dispatch/strategy.h"
-#include "engine/map/chu2024_floor.h"
-#include "fuzz/fuzz_input.h"
+#include "fuzz/chu2024_floor.h"
 #include "server/proto_convert.h"
 #include "warehouse/dispatch/v1/fleet.pb.h"
 
@@ -22,18 +21,9 @@ namespace {
 namespace engine = dispatch::engine;
 using dispatch::server::RobotInbound;
 
-struct Floor {
-  std::shared_ptr<const engine::WarehouseMap> map;
-  std::shared_ptr<const engine::RouteTable> routes;
-  Floor() {
-    map = std::make_shared<const engine::WarehouseMap>(engine::BuildChu2024Floor().value());
-    routes = std::shared_ptr<const engine::RouteTable>(engine::MakeRouteTable(map, {}).value());
-  }
-};
-
 void ApplyAll(engine::DispatchCore& core, const engine::Change& change) { (void)core.Apply(change); }
 
-void Connect(engine::DispatchCore& core, const Floor& f, const std::string& id, const std::string& at, double now) {
+void Connect(engine::DispatchCore& core, const dispatch::fuzz::Floor& f, const std::string& id, const std::string& at, double now) {
   engine::Robot r;
   r.id = id;
   r.current_point = *f.map->FindPoint(at);
@@ -43,17 +33,8 @@ void Connect(engine::DispatchCore& core, const Floor& f, const std::string& id, 
 
 }  // namespace
 
-// Built once, before the first input (a route table takes seconds under the sanitizers: not
-// a unit's time).
-const Floor* the_floor = nullptr;
-
-extern "C" int LLVMFuzzerInitialize(int*, char***) {
-  the_floor = new Floor();
-  return 0;
-}
-
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
-  const Floor& f = *the_floor;
+  const dispatch::fuzz::Floor& f = dispatch::fuzz::TheFloor();
   auto created = engine::DispatchCore::Create(f.map, f.routes, engine::CoreOptions{});
   if (!created.ok()) __builtin_trap();
   engine::DispatchCore& core = **created;

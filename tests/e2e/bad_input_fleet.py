@@ -28,9 +28,7 @@ acknowledged, also after a restart on the same database.
 """
 import math
 import os
-import queue
 import sys
-import threading
 
 sys.dont_write_bytecode = True  # no __pycache__ in the source tree
 sys.path.insert(0, sys.argv[sys.argv.index("--stubs") + 1])
@@ -39,8 +37,8 @@ from bad_input_common import (GOOD_ORDERS, Book, Cases, check_intact,  # noqa: E
                               check_serving, http_call, json_body, order_request, restart,
                               submit_good)
 from e2e_harness import (ACCEPTED, ASSIGNED, CANCELLED, COMPLETED, Harness,  # noqa: E402
-                         TestFailure, check, common_arguments, state_name)
-from warehouse.dispatch.v1 import common_pb2, fleet_pb2, fleet_pb2_grpc, orders_pb2  # noqa: E402
+                         RobotStream, TestFailure, check, common_arguments, state_name)
+from warehouse.dispatch.v1 import common_pb2, fleet_pb2, orders_pb2  # noqa: E402
 
 SERVER_ARGS = ["--time-scale", "10"]
 ROBOTS = 2  # fleet-sim's R1 (park-P1) and R2 (park-P2): fewer than a formation needs
@@ -62,61 +60,6 @@ def report(x=PARK[0], y=PARK[1], theta=0.0, **fields):
 
 def task(order_id, kind=fleet_pb2.TASK_EVENT_TYPE_DROPPED, **fields):
     return Msg(task_event=fleet_pb2.TaskEvent(order_id=order_id, type=kind, **fields))
-
-
-class RobotStream:
-    """One Connect call driven by the test: send() queues robot messages; a reader thread
-    collects the server's messages and, last, the status the stream ended with."""
-
-    def __init__(self, server, *first):
-        self._out = queue.Queue()
-        for m in first:
-            self._out.put(m)
-        self._in = queue.Queue()
-        stub = fleet_pb2_grpc.FleetServiceStub(server.channel)
-        self.call = stub.Connect(iter(self._out.get, None), timeout=60)
-        threading.Thread(target=self._read, daemon=True).start()
-
-    def _read(self):
-        try:
-            for m in self.call:
-                self._in.put(m)
-            self._in.put(("end", self.call.code(), self.call.details() or ""))
-        except grpc.RpcError as err:
-            self._in.put(("end", err.code(), err.details() or ""))
-
-    def send(self, *messages):
-        for m in messages:
-            self._out.put(m)
-
-    def close(self):
-        self._out.put(None)  # half-close: the server ends the stream
-
-    def next(self, timeout=10):
-        try:
-            return self._in.get(timeout=timeout)  # a wait for the server's answer, not a sleep
-        except queue.Empty:
-            raise TestFailure(f"no message or end of stream within {timeout} s")
-
-    def welcome(self):
-        m = self.next()
-        if isinstance(m, tuple):
-            raise TestFailure(f"stream ended instead of a Welcome: {m[1].name} '{m[2]}'")
-        check(m.WhichOneof("body") == "welcome", f"first server message is {m.WhichOneof('body')}")
-        return m
-
-    def expect_end(self, code, *words, max_len=None):
-        """Skips server messages until the end; the status must be `code` naming `words`."""
-        while True:
-            m = self.next()
-            if isinstance(m, tuple):
-                break
-        _, got, details = m
-        check(got == code, f"stream ended with {got.name} '{details[:300]}', want {code.name}")
-        missing = [w for w in words if w.lower() not in details.lower()]
-        check(not missing, f"{code.name} '{details[:300]}' does not name {missing}")
-        check(max_len is None or len(details) <= max_len, f"status message of {len(details)} bytes")
-        return details
 
 
 def robot(server, robot_id):

@@ -21,6 +21,7 @@ import contextlib
 import ctypes
 import json
 import os
+import queue
 import re
 import select
 import shutil
@@ -28,12 +29,13 @@ import signal
 import subprocess
 import sys
 import tempfile
+import threading
 import time
 import traceback
 import urllib.request
 
 import grpc  # noqa: F401  (the caller put the stubs directory on sys.path first)
-from warehouse.dispatch.v1 import common_pb2, orders_pb2, orders_pb2_grpc  # noqa: F401
+from warehouse.dispatch.v1 import common_pb2, fleet_pb2_grpc, orders_pb2, orders_pb2_grpc  # noqa: F401
 
 ACCEPTED = common_pb2.ORDER_STATE_ACCEPTED
 ASSIGNED = common_pb2.ORDER_STATE_ASSIGNED
@@ -220,6 +222,63 @@ class Fleet(Process):
             os.close(self._control_w)
             self._control_w = None
         return super().stop(timeout)
+
+
+class RobotStream:
+    """One Connect call driven by the test: send() queues robot messages; a reader thread
+    collects the server's messages and, last, the status the stream ended with. `server`: a
+    Server (its channel) or a channel; `metadata`: the call's (e.g. a bearer token)."""
+
+    def __init__(self, server, *first, metadata=()):
+        self._out = queue.Queue()
+        for m in first:
+            self._out.put(m)
+        self._in = queue.Queue()
+        channel = server.channel if hasattr(server, "channel") else server
+        stub = fleet_pb2_grpc.FleetServiceStub(channel)
+        self.call = stub.Connect(iter(self._out.get, None), timeout=60, metadata=list(metadata))
+        threading.Thread(target=self._read, daemon=True).start()
+
+    def _read(self):
+        try:
+            for m in self.call:
+                self._in.put(m)
+            self._in.put(("end", self.call.code(), self.call.details() or ""))
+        except grpc.RpcError as err:
+            self._in.put(("end", err.code(), err.details() or ""))
+
+    def send(self, *messages):
+        for m in messages:
+            self._out.put(m)
+
+    def close(self):
+        self._out.put(None)  # half-close: the server ends the stream
+
+    def next(self, timeout=10):
+        try:
+            return self._in.get(timeout=timeout)  # a wait for the server's answer, not a sleep
+        except queue.Empty:
+            raise TestFailure(f"no message or end of stream within {timeout} s")
+
+    def welcome(self):
+        m = self.next()
+        if isinstance(m, tuple):
+            raise TestFailure(f"stream ended instead of a Welcome: {m[1].name} '{m[2]}'")
+        check(m.WhichOneof("body") == "welcome", f"first server message is {m.WhichOneof('body')}")
+        return m
+
+    def expect_end(self, code, *words, max_len=None):
+        """Skips server messages until the end; the status must be `code` naming `words`."""
+        while True:
+            m = self.next()
+            if isinstance(m, tuple):
+                break
+        _, got, details = m
+        check(got == code, f"stream ended with {got.name} '{details[:300]}', want {code.name}")
+        missing = [w for w in words if w.lower() not in details.lower()]
+        check(not missing, f"{code.name} '{details[:300]}' does not name {missing}")
+        check(max_len is None or len(details) <= max_len, f"status message of {len(details)} bytes")
+        return details
 
 
 class Harness(contextlib.AbstractContextManager):

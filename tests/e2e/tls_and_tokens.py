@@ -24,19 +24,17 @@ roles, as deploy/dev_certs.sh makes them, against real clients:
 import http.client
 import json
 import os
-import queue
 import signal
 import sqlite3
 import ssl
 import subprocess
 import sys
-import threading
 
 sys.dont_write_bytecode = True  # no __pycache__ in the source tree
 sys.path.insert(0, sys.argv[sys.argv.index("--stubs") + 1])
 import grpc  # noqa: E402
-from e2e_harness import COMPLETED, Harness, TestFailure, check, common_arguments  # noqa: E402
-from warehouse.dispatch.v1 import (common_pb2, fleet_pb2, fleet_pb2_grpc, operator_pb2,  # noqa: E402
+from e2e_harness import COMPLETED, Harness, RobotStream, TestFailure, check, common_arguments  # noqa: E402
+from warehouse.dispatch.v1 import (common_pb2, fleet_pb2, operator_pb2,  # noqa: E402
                                    operator_pb2_grpc, orders_pb2, orders_pb2_grpc)
 
 HERE = os.path.dirname(os.path.abspath(__file__))
@@ -101,41 +99,11 @@ def https(server, creds, method, path, secret=None, body=None, content_type="app
         conn.close()
 
 
-class RobotStream:
-    """One Connect call driven by the test (see bad_input_fleet.py)."""
-
-    def __init__(self, channel, secret, robot_id):
-        self._out = queue.Queue()
-        pose = common_pb2.Pose(x=PARK[0], y=PARK[1], theta=0.0)
-        self._out.put(fleet_pb2.RobotMessage(hello=fleet_pb2.Hello(robot_id=robot_id, pose=pose)))
-        self._in = queue.Queue()
-        stub = fleet_pb2_grpc.FleetServiceStub(channel)
-        self.call = stub.Connect(iter(self._out.get, None), timeout=30, metadata=bearer(secret))
-        threading.Thread(target=self._read, daemon=True).start()
-
-    def _read(self):
-        try:
-            for m in self.call:
-                self._in.put(m)
-            self._in.put(("end", self.call.code(), self.call.details() or ""))
-        except grpc.RpcError as err:
-            self._in.put(("end", err.code(), err.details() or ""))
-
-    def expect_end(self, what, code, *words):
-        while True:
-            try:
-                m = self._in.get(timeout=15)  # the server's answer, not a sleep
-            except queue.Empty:
-                raise TestFailure(f"{what}: the stream neither answered nor ended")
-            if isinstance(m, tuple):
-                break
-            check(m.WhichOneof("body") != "welcome", f"{what}: the server welcomed the stream")
-        _, got, details = m
-        self._out.put(None)
-        check(got == code, f"{what}: stream ended with {got.name} '{details}', want {code.name}")
-        missing = [w for w in words if w.lower() not in details.lower()]
-        check(not missing, f"{what}: '{details}' does not name {missing}")
-        print(f"[e2e] {what}: {code.name} '{details}'", flush=True)
+def robot_stream(channel, secret, robot_id):
+    """A Connect call on `channel` with `secret`'s token that says Hello as `robot_id`."""
+    pose = common_pb2.Pose(x=PARK[0], y=PARK[1], theta=0.0)
+    hello = fleet_pb2.RobotMessage(hello=fleet_pb2.Hello(robot_id=robot_id, pose=pose))
+    return RobotStream(channel, hello, metadata=bearer(secret))
 
 
 def order_request(client_id, pick="K3-2-3N", drop="D-B2"):
@@ -193,14 +161,14 @@ def main():
         check(status == 415, f"text/plain POST: HTTP {status} {body[:200]!r}")
 
         # Robot identity.
-        RobotStream(creds.channel(server), creds.robot_secrets["R1"], "R1").expect_end(
-            "robot stream without a client certificate", Code.UNAUTHENTICATED, "certificate")
-        RobotStream(creds.channel(server, "R1"), wms, "R1").expect_end(
-            "wms token connects as a robot", Code.PERMISSION_DENIED, "wms")
-        RobotStream(creds.channel(server, "R1"), creds.robot_secrets["R1"], "R2").expect_end(
-            "R1 says Hello as R2", Code.PERMISSION_DENIED, "R2")
-        RobotStream(creds.channel(server, "R1"), creds.robot_secrets["R2"], "R2").expect_end(
-            "R1's certificate with R2's token", Code.PERMISSION_DENIED, "R1")
+        robot_stream(creds.channel(server), creds.robot_secrets["R1"], "R1").expect_end(
+            Code.UNAUTHENTICATED, "certificate")
+        robot_stream(creds.channel(server, "R1"), wms, "R1").expect_end(
+            Code.PERMISSION_DENIED, "wms")
+        robot_stream(creds.channel(server, "R1"), creds.robot_secrets["R1"], "R2").expect_end(
+            Code.PERMISSION_DENIED, "R2")
+        robot_stream(creds.channel(server, "R1"), creds.robot_secrets["R2"], "R2").expect_end(
+            Code.PERMISSION_DENIED, "R1")
 
         # The fleet and a WMS, each with its own credentials, run an order to the end; a
         # hijack of R1 meanwhile is refused.
@@ -208,8 +176,8 @@ def main():
                                   "--robot-tokens", os.path.join(folder, "secrets", "robot-tokens.json"),
                                   "--robot-certs", os.path.join(folder, "robots")])
         submitted = orders.SubmitOrder(order_request("tls-1"), timeout=10, metadata=bearer(wms))
-        RobotStream(creds.channel(server, "R3"), creds.robot_secrets["R3"], "R1").expect_end(
-            "hijack of R1 with R3's credentials", Code.PERMISSION_DENIED, "R1")
+        robot_stream(creds.channel(server, "R3"), creds.robot_secrets["R3"], "R1").expect_end(
+            Code.PERMISSION_DENIED, "R1")
         wmsctl = [args.wmsctl, "--server", f"localhost:{server.grpc_port}", "--tls-ca", os.path.join(folder, "ca.crt"),
                   "--token-file", os.path.join(folder, "secrets", "wms.token")]
         r = subprocess.run(wmsctl + ["submit", "--pick", "K3-3-1N", "--drop", "D-B2", "--id", "tls-2", "--wait"],
