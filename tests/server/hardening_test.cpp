@@ -1,11 +1,15 @@
 // Issue 18 §3: faults measured on the running service, each fixed and tested here: a second
 // dispatchd on one database, a 3 MB cancel reason, a REST body naming a key twice, a stream
-// that never says Hello, /readyz while the database fails writes, a 1 MB robot id echoed whole.
+// that never says Hello, /readyz while the database fails writes, /metrics without a role, a
+// 1 MB robot id echoed whole.
 #include "tests/server/test_support.h"
 
 #include <httplib.h>  // after every header that pulls in Eigen (STYLE.md)
 
+#include <fstream>
+
 #include "engine/common/text.h"
+#include "server/auth.h"
 #include "storage/fault_injection_store.h"
 #include "storage/sqlite_store.h"
 
@@ -122,6 +126,35 @@ TEST(HardeningTest, NotReadyWhileTheDatabaseFailsWritesAndReadyWhenItRecovers) {
   ASSERT_TRUE(recovered);
   EXPECT_EQ(recovered->status, 200) << recovered->body;
   (*server)->Shutdown();
+}
+
+// Issue 18 §2: /metrics needs a role that reads them (operator, admin) unless metrics_open;
+// /healthz and /readyz stay open.
+TEST(HardeningTest, MetricsNeedARoleUnlessOpen) {
+  TempDir dir;
+  const std::string tokens = dir.File("tokens.json");
+  std::ofstream(tokens) << R"({"tokens": [{"name": "w", "role": "wms", "sha256": ")" << Sha256Hex("wms-secret")
+                        << R"("}, {"name": "o", "role": "operator", "sha256": ")" << Sha256Hex("op-secret") << R"("}]})";
+  for (const bool open : {false, true}) {
+    ServerConfig config = TestConfig(dir.File(open ? "open.db" : "closed.db"));
+    config.auth_tokens = tokens;
+    config.metrics_open = open;
+    auto server = DispatchServer::Start(config);
+    ASSERT_TRUE(server.ok()) << server.error().message;
+    httplib::Client client("127.0.0.1", (*server)->ports().http);
+    auto status_with = [&](const std::string& path, const std::string& secret) {
+      httplib::Headers headers;
+      if (!secret.empty()) headers.emplace("Authorization", "Bearer " + secret);
+      auto r = client.Get(path, headers);
+      return r ? r->status : -1;
+    };
+    EXPECT_EQ(status_with("/metrics", ""), open ? 200 : 401) << open;
+    EXPECT_EQ(status_with("/metrics", "wms-secret"), open ? 200 : 403) << open;
+    EXPECT_EQ(status_with("/metrics", "op-secret"), 200) << open;
+    EXPECT_EQ(status_with("/healthz", ""), 200);
+    EXPECT_EQ(status_with("/readyz", ""), 200);
+    EXPECT_EQ(status_with("/api/v1/robots", ""), 401);
+  }
 }
 
 TEST(HardeningTest, AHugeRobotIdIsQuotedClipped) {
