@@ -1,6 +1,7 @@
 #include "clients/client_security.h"
 
 #include <CLI/CLI.hpp>
+#include <nlohmann/json.hpp>
 
 #include <cstdlib>
 #include <fstream>
@@ -65,6 +66,21 @@ std::shared_ptr<grpc::ChannelCredentials> Credentials(const ClientSecurity& secu
     ReadWholeFile(security.tls_key, options.pem_private_key);
   }
   return grpc::SslCredentials(options);
+}
+
+bool ReadRobotTokens(const std::string& path, std::map<std::string, std::string>& out, std::string& error) {
+  std::string text;
+  if (!ReadWholeFile(path, text)) {
+    error = "cannot read '" + path + "'";
+    return false;
+  }
+  try {
+    out = nlohmann::json::parse(text).get<std::map<std::string, std::string>>();
+  } catch (const nlohmann::json::exception& e) {
+    error = "'" + path + "' is not a JSON object of robot ids and secrets: " + e.what();
+    return false;
+  }
+  return true;
 }
 
 void Authorize(grpc::ClientContext& context, const std::string& token) {

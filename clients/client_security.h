@@ -8,6 +8,7 @@
 
 #include <grpcpp/grpcpp.h>
 
+#include <map>
 #include <memory>
 #include <string>
 
@@ -33,6 +34,9 @@ bool Resolve(ClientSecurity& security, std::string& error);
 std::shared_ptr<grpc::ChannelCredentials> Credentials(const ClientSecurity& security);
 // Adds `authorization: Bearer <token>` to the call (nothing without a token).
 void Authorize(grpc::ClientContext& context, const std::string& token);
+// A robot-tokens file (fleet-sim --robot-tokens): a JSON object of robot id -> its token's
+// secret. False with `error` set when it cannot be read or is not such an object.
+bool ReadRobotTokens(const std::string& path, std::map<std::string, std::string>& out, std::string& error);
 // Reads a whole file; false when it cannot be read.
 bool ReadWholeFile(const std::string& path, std::string& out);
 

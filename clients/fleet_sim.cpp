@@ -48,8 +48,6 @@
 #include <thread>
 #include <vector>
 
-#include <nlohmann/json.hpp>
-
 #include "clients/client_security.h"
 #include "clients/robot_stream.h"
 #include "clients/sim_robot.h"
@@ -260,16 +258,8 @@ int Main(int argc, char** argv) {
   std::string error;
   if (!Resolve(security, error)) return std::fprintf(stderr, "fleet-sim: %s\n", error.c_str()), 2;
   std::map<std::string, std::string> robot_tokens;
-  if (!robot_tokens_file.empty()) {
-    std::string text;
-    if (!ReadWholeFile(robot_tokens_file, text)) {
-      return std::fprintf(stderr, "fleet-sim: cannot read --robot-tokens '%s'\n", robot_tokens_file.c_str()), 2;
-    }
-    try {
-      robot_tokens = nlohmann::json::parse(text).get<std::map<std::string, std::string>>();
-    } catch (const nlohmann::json::exception& e) {
-      return std::fprintf(stderr, "fleet-sim: --robot-tokens: not a JSON object of strings: %s\n", e.what()), 2;
-    }
+  if (!robot_tokens_file.empty() && !ReadRobotTokens(robot_tokens_file, robot_tokens, error)) {
+    return std::fprintf(stderr, "fleet-sim: --robot-tokens: %s\n", error.c_str()), 2;
   }
   auto channel = grpc::CreateCustomChannel(server, Credentials(security), channel_args);
   v1::GetMapResponse map;

@@ -130,12 +130,13 @@ OrderFile ParseOrderText(std::string_view text, bool is_json, const std::string&
     return out;
   }
   json doc;
+  std::optional<std::string> key;
   try {
-    doc = json::parse(text);
+    doc = formats::ParseNotingDuplicateKey(text, &key);
   } catch (const json::exception& e) {  // a syntax error, or a number too large (fuzz_order_file)
     return fail(std::string("bad JSON: ") + e.what());
   }
-  if (auto key = formats::FirstDuplicateKey(text)) return fail("the key '" + *key + "' appears twice in one object");
+  if (key) return fail("the key '" + *key + "' appears twice in one object");
   if (doc.is_object() && doc.contains("orders")) doc = doc["orders"];
   if (!doc.is_array()) doc = json::array({doc});
   if (doc.empty()) return fail("no orders in the file");

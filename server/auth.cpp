@@ -114,13 +114,14 @@ std::string Sha256Hex(std::string_view data) {
 
 engine::Result<TokenSet> TokenSet::Parse(const std::string& text) {
   nlohmann::json j;
+  std::optional<std::string> duplicate;
   try {
-    j = nlohmann::json::parse(text);
+    j = formats::ParseNotingDuplicateKey(text, &duplicate);
   } catch (const nlohmann::json::exception& e) {
     return InvalidArgument(std::string("the token file is not JSON: ") + e.what());
   }
   // A repeated key would be taken silently (the last one wins): refused.
-  if (auto duplicate = formats::FirstDuplicateKey(text)) {
+  if (duplicate) {
     return InvalidArgument("the token file repeats the key '" + engine::Clipped(*duplicate) + "'");
   }
   if (!j.is_object() || !j.contains("tokens") || !j["tokens"].is_array()) {

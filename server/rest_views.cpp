@@ -53,13 +53,14 @@ std::string ToJson(const google::protobuf::Message& message) {
 engine::Status FromJson(const std::string& body, google::protobuf::Message* out) {
   // Whether it is JSON at all first: protobuf's parser says less about that.
   nlohmann::json j;
+  std::optional<std::string> key;
   try {
-    j = nlohmann::json::parse(body);
+    j = formats::ParseNotingDuplicateKey(body, &key);
   } catch (const nlohmann::json::exception& e) {
     return engine::InvalidArgument("the body is not JSON: " + ValidUtf8(e.what()));
   }
   if (!j.is_object()) return engine::InvalidArgument("the body must be a JSON object (a " + out->GetTypeName() + ")");
-  if (auto key = formats::FirstDuplicateKey(body)) {
+  if (key) {
     return engine::InvalidArgument("the body names the key '" + engine::Clipped(ValidUtf8(*key)) + "' twice");
   }
   google::protobuf::util::JsonParseOptions options;

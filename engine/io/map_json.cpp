@@ -399,15 +399,16 @@ std::string DescribeParseError(std::string_view text, const json::parse_error& e
 
 Result<WarehouseMap> ParseMapJson(std::string_view text) {
   json doc;
+  std::optional<std::string> key;
   try {
-    doc = json::parse(text.begin(), text.end());
+    doc = formats::ParseNotingDuplicateKey(text, &key);
   } catch (const json::parse_error& e) {
     return InvalidArgument("not valid JSON: " + DescribeParseError(text, e));
   } catch (const json::exception& e) {  // e.g. a number too large for a double (found by fuzz_map_json)
     return InvalidArgument(std::string("not valid JSON: ") + e.what());
   }
   if (!doc.is_object()) return TypeError("top level", "an object", doc);
-  if (auto key = formats::FirstDuplicateKey(text)) {
+  if (key) {
     return InvalidArgument("the key '" + Clipped(*key) + "' appears twice in one object (which one counts?)");
   }
   if (Status s = ReadHeader(doc); !s) return s.error();
