@@ -13,6 +13,7 @@ engine::Result<std::vector<storage::OrderEvent>> StoreChange(
   std::set<std::string> robots;  // records to store: new plans (their queue), reserved sequences
   for (const auto& [id, plan] : change.plans) robots.insert(id);
   for (const auto& [id, n] : messages) robots.insert(id);
+  for (const auto& [id, marks] : change.marks) robots.insert(id);
   std::vector<storage::OrderEvent> events;
   auto committed = store.RunInTransaction([&](storage::Store& s) -> engine::Status {
     events.clear();
@@ -40,6 +41,7 @@ engine::Result<std::vector<storage::OrderEvent>> StoreChange(
       storage::RobotRecord rec = record_of(id);
       if (auto plan = change.plans.find(id); plan != change.plans.end()) rec.robot.task_queue = plan->second.order_ids;
       if (auto n = messages.find(id); n != messages.end()) rec.next_sequence += n->second;
+      if (auto m = change.marks.find(id); m != change.marks.end()) rec.marks = m->second;
       if (auto saved = s.UpsertRobot(rec); !saved.ok()) return saved.error();
     }
     return engine::Ok{};

@@ -147,10 +147,15 @@ class Dispatcher {
   static constexpr std::size_t kMaxCancelReasonBytes = 1024;
 
   // --- Operator commands (issue 18 §4) --------------------------------------------------
-  // Pauses (paused) or resumes robot `robot_id` for `actor` (the token's name): journaled with
-  // who, and the robot held at its next point (engine DispatchCore::Pause). `done` runs once
-  // the snapshot shows it (RobotView::paused_by).
-  void PauseRobot(std::string robot_id, bool paused, std::string actor, std::function<void(ServiceStatus)> done);
+  // Carries out `kind` on robot `robot_id` for `actor` (the token's name; engine
+  // DispatchCore::PlanCommand): pause, resume, out of service, return to service, clear, send
+  // (to `station`: a parking or charging station's name, or the name of a park or charge
+  // point). Stored with the robot (its marks, kept across restarts) and the orders it gives
+  // back (their events name the actor), then applied. `done` runs once the snapshot shows it.
+  // Errors: NOT_FOUND (robot, station), FAILED_PRECONDITION (the core's refusals),
+  // UNAVAILABLE (the store failed: nothing changed).
+  void CommandRobot(engine::RobotCommandKind kind, std::string robot_id, std::string station, std::string actor,
+                    std::function<void(ServiceStatus)> done);
 
   // --- Robot streams -----------------------------------------------------------------
   // A stream opened: it must say Hello within heartbeat_timeout or it is ended
@@ -198,6 +203,7 @@ class Dispatcher {
   // Orders (dispatcher_orders.cpp).
   void DoSubmit(const engine::OrderRequest& request, const std::string& actor,
                 const std::function<void(SubmitReply)>& done);
+  ServiceStatus DoCommand(engine::OperatorCommand command, const std::string& station);
   void DoCancel(const std::string& order_id, const std::string& reason, const std::string& actor,
                 const std::function<void(OrderReply)>& done);
   std::string NextOrderId();

@@ -21,21 +21,34 @@ void Dispatcher::OnRobotMessage(std::shared_ptr<RobotLink> link, RobotInbound me
   Post([this, link = std::move(link), message = std::move(message)] { DoRobotMessage(link, message); });
 }
 
-void Dispatcher::PauseRobot(std::string robot_id, bool paused, std::string actor,
-                            std::function<void(ServiceStatus)> done) {
-  Post([this, id = std::move(robot_id), paused, actor = std::move(actor), done = std::move(done)] {
-    const engine::Status status = core_->Pause(id, paused, actor);
-    ServiceStatus reply;
-    if (!status.ok()) {
-      reply = status.error().code == engine::ErrorCode::kNotFound
-                  ? MakeStatus(StatusCode::kNotFound, status.error().message)
-                  : FromEngineError(status.error());
-    } else {
-      spdlog::info("robot {} {} by {}", id, paused ? "paused" : "resumed", actor.empty() ? "an operator" : actor);
+void Dispatcher::CommandRobot(engine::RobotCommandKind kind, std::string robot_id, std::string station,
+                              std::string actor, std::function<void(ServiceStatus)> done) {
+  Post([this, kind, id = std::move(robot_id), station = std::move(station), actor = std::move(actor),
+        done = std::move(done)] {
+    ServiceStatus reply = DoCommand({kind, id, actor, engine::kNoPoint}, station);
+    if (reply.ok()) {
+      spdlog::info("robot {}: {}{} by {}", id, engine::RobotCommandName(kind), station.empty() ? "" : " to " + station,
+                   actor.empty() ? "an operator" : actor);
     }
     effects_.MarkChanged();
     Defer([done, reply = std::move(reply)] { done(reply); });
   });
+}
+
+ServiceStatus Dispatcher::DoCommand(engine::OperatorCommand command, const std::string& station) {
+  auto refused = [](const engine::Error& e) {  // an unknown robot or station: NOT_FOUND
+    return e.code == engine::ErrorCode::kNotFound ? MakeStatus(StatusCode::kNotFound, e.message) : FromEngineError(e);
+  };
+  if (command.kind == engine::RobotCommandKind::kSend) {
+    auto point = engine::StationPoint(*map_, station);
+    if (!point.ok()) return refused(point.error());
+    command.to = *point;
+  }
+  auto change = core_->PlanCommand(command, Now());
+  if (!change.ok()) return refused(change.error());
+  ServiceStatus status;
+  if (!Commit(*change, nullptr, &status, command.by)) return status;
+  return {};
 }
 
 void Dispatcher::OnRobotGone(std::shared_ptr<RobotLink> link) {

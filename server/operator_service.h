@@ -1,5 +1,6 @@
 // OperatorService (proto/warehouse/dispatch/v1/operator.proto, issue 18 §4): operators'
-// commands on robots over gRPC, the same as REST's POST /api/v1/robots/{id}/pause | /resume.
+// commands on robots over gRPC, the same as REST's POST /api/v1/robots/{id}/pause | /resume |
+// /out-of-service | /return-to-service | /clear | /send.
 // Every call needs a token that may send robot commands (operator, admin). Thread-safe.
 #pragma once
 
@@ -12,16 +13,19 @@ namespace dispatch::server {
 class OperatorServiceImpl final : public ::warehouse::dispatch::v1::OperatorService::CallbackService {
  public:
   OperatorServiceImpl(Dispatcher& dispatcher, const Authenticator& auth) : dispatcher_(dispatcher), auth_(auth) {}
-  grpc::ServerUnaryReactor* PauseRobot(grpc::CallbackServerContext* context,
-                                       const ::warehouse::dispatch::v1::RobotCommandRequest* request,
-                                       ::warehouse::dispatch::v1::RobotInfo* response) override;
-  grpc::ServerUnaryReactor* ResumeRobot(grpc::CallbackServerContext* context,
-                                        const ::warehouse::dispatch::v1::RobotCommandRequest* request,
-                                        ::warehouse::dispatch::v1::RobotInfo* response) override;
+  using Request = ::warehouse::dispatch::v1::RobotCommandRequest;
+  using Info = ::warehouse::dispatch::v1::RobotInfo;
+  grpc::ServerUnaryReactor* PauseRobot(grpc::CallbackServerContext* c, const Request* r, Info* out) override;
+  grpc::ServerUnaryReactor* ResumeRobot(grpc::CallbackServerContext* c, const Request* r, Info* out) override;
+  grpc::ServerUnaryReactor* TakeOutOfService(grpc::CallbackServerContext* c, const Request* r, Info* out) override;
+  grpc::ServerUnaryReactor* ReturnToService(grpc::CallbackServerContext* c, const Request* r, Info* out) override;
+  grpc::ServerUnaryReactor* ClearRobot(grpc::CallbackServerContext* c, const Request* r, Info* out) override;
+  grpc::ServerUnaryReactor* SendRobot(grpc::CallbackServerContext* c,
+                                      const ::warehouse::dispatch::v1::SendRobotRequest* r, Info* out) override;
 
  private:
-  grpc::ServerUnaryReactor* Pause(grpc::CallbackServerContext* context, const std::string& robot_id, bool paused,
-                                  ::warehouse::dispatch::v1::RobotInfo* response);
+  grpc::ServerUnaryReactor* Command(grpc::CallbackServerContext* context, engine::RobotCommandKind kind,
+                                    const std::string& robot_id, const std::string& station, Info* response);
   Dispatcher& dispatcher_;
   const Authenticator& auth_;
 };

@@ -159,14 +159,37 @@ RestServer::RestServer(RestHandlers handlers, const std::string& web_root, const
   s.Get(R"(/api/v1/robots/([^/]+))",
         Guarded(auth, Access::kReadFleet,
                 [&h](const httplib::Request& req, httplib::Response& res) { Reply(res, h.Robot(req.matches[1])); }));
-  for (const bool paused : {true, false}) {
-    s.Post(paused ? R"(/api/v1/robots/([^/]+)/pause)" : R"(/api/v1/robots/([^/]+)/resume)",
+  s.Get("/api/v1/session", [auth](const httplib::Request& req, httplib::Response& res) {
+    // Who the token is: every role may ask (kReadMap is every role's); 401 without a valid one.
+    const bool given = req.has_header("Authorization");
+    const std::string value = given ? req.get_header_value("Authorization") : std::string();
+    Authenticator::Outcome who;
+    if (auth) who = auth->Authorize(given ? std::optional<std::string_view>(value) : std::nullopt, Access::kReadMap);
+    if (!who.status.ok()) {
+      res.set_header("WWW-Authenticate", "Bearer");
+      Reply(res, {HttpStatus(who.status.code), RestHandlers::ErrorBody(who.status.message)});
+      return;
+    }
+    Reply(res, RestHandlers::Session(who.principal, auth && auth->enabled()));
+  });
+  using engine::RobotCommandKind;
+  for (const auto& [path, kind] : {std::pair{"pause", RobotCommandKind::kPause},
+                                   std::pair{"resume", RobotCommandKind::kResume},
+                                   std::pair{"out-of-service", RobotCommandKind::kTakeOutOfService},
+                                   std::pair{"return-to-service", RobotCommandKind::kReturnToService},
+                                   std::pair{"clear", RobotCommandKind::kClear}}) {
+    s.Post(std::string(R"(/api/v1/robots/([^/]+)/)") + path,
            Guarded(auth, Access::kRobotCommand,
-                   ActorHandler([&h, paused](const httplib::Request& req, httplib::Response& res,
-                                             const std::string& actor) {
-                     Reply(res, h.PauseRobot(req.matches[1], paused, actor));
+                   ActorHandler([&h, kind](const httplib::Request& req, httplib::Response& res,
+                                           const std::string& actor) {
+                     Reply(res, h.CommandRobot(kind, req.matches[1], actor));
                    })));
   }
+  s.Post(R"(/api/v1/robots/([^/]+)/send)",
+         Guarded(auth, Access::kRobotCommand,
+                 ActorHandler([&h](const httplib::Request& req, httplib::Response& res, const std::string& actor) {
+                   if (JsonBody(req, res)) Reply(res, h.SendRobot(req.matches[1], req.body, actor));
+                 })));
   s.Get("/api/v1/orders", Guarded(auth, Access::kReadOrders, [&h](const httplib::Request& req, httplib::Response& res) {
           std::optional<std::string> state, finished;
           if (req.has_param("state")) state = req.get_param_value("state");

@@ -8,6 +8,7 @@
 #include <set>
 #include <string>
 
+#include "engine/common/text.h"
 #include "engine/io/map_json.h"
 #include "server/dispatcher.h"
 #include "server/metrics.h"
@@ -56,6 +57,15 @@ RestHandlers::RestHandlers(Dispatcher& dispatcher, ServiceMetrics* metrics,
       map_json_(std::make_shared<const std::string>(engine::WriteMapJson(dispatcher.map()))) {}
 
 std::string RestHandlers::ErrorBody(const std::string& message) { return ErrorJson(message); }
+
+RestReply RestHandlers::Session(const Principal& who, bool tokens_required) {
+  pb::Session out;
+  out.set_name(who.name);
+  out.set_role(RoleName(who.role));
+  out.set_robot_commands(Permits(who.role, Access::kRobotCommand));
+  out.set_tokens_required(tokens_required);
+  return Json(200, out);
+}
 
 RestReply RestHandlers::Map() const { return {200, *map_json_}; }
 
@@ -136,10 +146,26 @@ RestReply RestHandlers::Robot(const std::string& id) const {
   return Json(200, out);
 }
 
-RestReply RestHandlers::PauseRobot(const std::string& id, bool paused, const std::string& actor) {
-  const ServiceStatus status = dispatcher_.Call<ServiceStatus>([this, id, paused, actor](
+RestReply RestHandlers::CommandRobot(engine::RobotCommandKind kind, const std::string& id, const std::string& actor) {
+  return Command(kind, id, "", actor);
+}
+
+RestReply RestHandlers::SendRobot(const std::string& id, const std::string& body, const std::string& actor) {
+  pb::SendRobotRequest parsed;
+  if (auto read = FromJson(body, &parsed); !read.ok()) return Error(FromEngineError(read.error()));
+  if (!parsed.robot_id().empty() && parsed.robot_id() != id) {
+    return Error(400, "robot_id in the body ('" + engine::Clipped(parsed.robot_id()) + "') is not the path's ('" +
+                          engine::Clipped(id) + "')");
+  }
+  if (parsed.station().empty()) return Error(400, "station is required");
+  return Command(engine::RobotCommandKind::kSend, id, parsed.station(), actor);
+}
+
+RestReply RestHandlers::Command(engine::RobotCommandKind kind, const std::string& id, const std::string& station,
+                                const std::string& actor) {
+  const ServiceStatus status = dispatcher_.Call<ServiceStatus>([this, kind, id, station, actor](
                                                                    std::function<void(ServiceStatus)> done) {
-    dispatcher_.PauseRobot(id, paused, actor, std::move(done));
+    dispatcher_.CommandRobot(kind, id, station, actor, std::move(done));
   });
   if (!status.ok()) return Error(status);
   return Robot(id);

@@ -13,6 +13,9 @@
 #include <string>
 #include <utility>
 
+#include "engine/dispatch/robot_commands.h"
+#include "server/auth.h"
+
 namespace dispatch::server {
 
 class Dispatcher;
@@ -47,7 +50,10 @@ class RestHandlers {
   RestReply Robots() const;
   RestReply Robot(const std::string& id) const;
   // POST /api/v1/robots/{id}/pause | /resume (issue 18 §4): the robot's RobotInfo afterwards.
-  RestReply PauseRobot(const std::string& id, bool paused, const std::string& actor);
+  // POST /api/v1/robots/{id}/pause | resume | out-of-service | return-to-service | clear
+  // (no body), /send (a SendRobotRequest's JSON, the robot id from the path): the RobotInfo after it.
+  RestReply CommandRobot(engine::RobotCommandKind kind, const std::string& id, const std::string& actor);
+  RestReply SendRobot(const std::string& id, const std::string& body, const std::string& actor);
   // state: an order state, lower case (in_progress) or as the enum (ORDER_STATE_IN_PROGRESS);
   // nullopt for all.
   // Every open order and the newest `finished` (default kListedFinished, at most
@@ -77,8 +83,12 @@ class RestHandlers {
 
   // An ErrorReply body (also for httplib's own errors: 404, 413, ...).
   static std::string ErrorBody(const std::string& message);
+  // GET /api/v1/session: the caller (a Session message).
+  static RestReply Session(const Principal& who, bool tokens_required);
 
  private:
+  RestReply Command(engine::RobotCommandKind kind, const std::string& id, const std::string& station,
+                    const std::string& actor);
   Dispatcher& dispatcher_;
   ServiceMetrics* metrics_;
   std::function<std::optional<std::string>()> store_health_;

@@ -99,8 +99,11 @@ void RobotToProto(const RobotView& view, const engine::WarehouseMap& map, pb::Ro
   out->set_formation_order_id(view.formation);
   out->set_held(view.held);
   out->set_hold_reason(view.hold_reason);
-  out->set_paused_by(view.paused_by);
+  out->set_paused_by(view.marks.paused_by);
+  out->set_out_of_service_by(view.marks.out_of_service_by);
+  out->set_off_floor(view.marks.off_floor);
   if (r.current_point != engine::kNoPoint) StopToProto(r.current_point, map, out->mutable_point());
+  if (view.sent_to != engine::kNoPoint) StopToProto(view.sent_to, map, out->mutable_sent_to());
 }
 
 void StatusToProto(const Snapshot& snap, pb::ServiceState* out) {

@@ -46,7 +46,10 @@ std::optional<double> TrackHold(RobotSession& session, RobotOutbound::Kind kind,
 
 storage::RobotRecord RecordOf(const engine::BookRobot* robot, const RobotSession* session) {
   storage::RobotRecord rec;
-  if (robot) rec.robot = robot->robot;
+  if (robot) {
+    rec.robot = robot->robot;
+    rec.marks = robot->marks;
+  }
   if (session) {
     rec.kind = session->kind;
     rec.last_seen = session->last_seen;

@@ -46,7 +46,8 @@ struct RobotView {
   std::size_t waypoints = 0;  // in its current plan
   bool held = false;          // a traffic Hold is in force
   std::string hold_reason;
-  std::string paused_by;  // who paused it ("": not paused)
+  engine::OperatorMarks marks;  // operator commands in force
+  engine::PointId sent_to = engine::kNoPoint;  // the station it is sent to, while on its way
   std::string formation;      // the formation order whose team it is in ("": none)
 };
 

@@ -53,6 +53,8 @@ std::shared_ptr<Snapshot> BuildSnapshot(const engine::WarehouseMap& map, const e
       view.connected = s->link != nullptr;
       view.last_seen = s->last_seen;
     }
+    view.marks = r.marks;
+    view.sent_to = core.TripTo(id);
     if (r.has_assignment) {
       view.plan_id = r.assignment.plan_id;
       view.waypoints = r.assignment.plan.waypoints.size();
@@ -61,7 +63,6 @@ std::shared_ptr<Snapshot> BuildSnapshot(const engine::WarehouseMap& map, const e
       engine::GateRobotState traffic = gate->RobotState(id);
       view.held = traffic.held;
       view.hold_reason = std::move(traffic.reason);
-      view.paused_by = std::move(traffic.paused_by);
       view.formation = std::move(traffic.formation);
     }
     snap->robots.emplace(id, std::move(view));

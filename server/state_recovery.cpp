@@ -45,7 +45,7 @@ engine::Result<RecoveredState> RecoverState(storage::Store& store, bool traffic_
     auto plan = plans.find(id);
     core.RestoreRobot(std::move(record.robot),
                       plan == plans.end() ? std::nullopt : std::optional<engine::Assignment>(std::move(plan->second)),
-                      !was_on_line);
+                      !was_on_line, std::move(record.marks));
   }
   std::uint64_t retired = 0;
   for (const auto& [state, n] : book.finished_in_store()) retired += n;

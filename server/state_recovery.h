@@ -1,7 +1,7 @@
 // RecoverState: the dispatcher loop's state at start-up, read back from the store
 // (dispatcher.h, "Durability" and "Restart"):
 // - the order views (OrderViews::Load), each open order entered in the core with its robots;
-// - every stored robot, in the core with its stored plan and in the sessions (its message
+// - every stored robot, in the core with its stored plan and operator marks and in the sessions (its message
 //   sequences), offline until it reconnects;
 // - with traffic control, the robots that were on line when the old process stopped are
 //   awaited by the restart wait (where they are now is known when they report); the others

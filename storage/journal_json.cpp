@@ -266,7 +266,10 @@ Result<std::string> EncodeCoreInput(const CoreInput& in) {
     if (in.change) j["change"] = in.change;
     if (in.max) j["max"] = in.max;
     if (in.cancelled) j["cancelled"] = true;
-    if (in.paused) j["paused"] = true;
+    if (in.marks != engine::OperatorMarks{}) j["marks"] = json::parse(EncodeMarks(in.marks));
+    if (in.command) {
+      j["cmd"] = {engine::RobotCommandName(in.command->kind), in.command->robot, in.command->by, in.command->to};
+    }
     return j.dump();
   });
 }
@@ -324,7 +327,22 @@ Result<CoreInput> DecodeCoreInput(CoreInput::Kind kind, double time, const std::
     in.change = j.value("change", std::uint64_t{0});
     in.max = j.value("max", std::size_t{0});
     in.cancelled = j.value("cancelled", false);
-    in.paused = j.value("paused", false);
+    if (j.contains("marks")) {
+      auto marks = DecodeMarks(j.at("marks").dump());
+      if (!marks.ok()) return marks.error();
+      in.marks = std::move(*marks);
+    }
+    if (j.contains("cmd")) {
+      const json& c = j.at("cmd");
+      auto command = engine::ParseRobotCommand(c.at(0).get<std::string>());
+      if (!command) return Corrupt("journal entry", "unknown robot command");
+      in.command = engine::OperatorCommand{*command, c.at(1).get<std::string>(), c.at(2).get<std::string>(),
+                                           c.at(3).get<engine::PointId>()};
+    } else if (kind == CoreInput::Kind::kPlanCommand) {  // a journal's "pause" entry before "plan_command"
+      in.command = engine::OperatorCommand{
+          j.value("paused", false) ? engine::RobotCommandKind::kPause : engine::RobotCommandKind::kResume,
+          in.robot_id, in.reason, engine::kNoPoint};
+    }
     return in;
   });
 }

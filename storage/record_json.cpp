@@ -35,7 +35,36 @@ Status ReadJson(const char* what, const std::string& text, F&& read) {
   }
 }
 
+json MarksJson(const engine::OperatorMarks& m) {
+  json j = json::object();
+  if (!m.paused_by.empty()) j["paused_by"] = m.paused_by;
+  if (!m.out_of_service_by.empty()) j["out_of_service_by"] = m.out_of_service_by;
+  if (m.off_floor) j["off_floor"] = true;
+  return j;
+}
+
+engine::OperatorMarks MarksOf(const json& j) {
+  engine::OperatorMarks m;
+  m.paused_by = j.value("paused_by", "");
+  m.out_of_service_by = j.value("out_of_service_by", "");
+  m.off_floor = j.value("off_floor", false);
+  return m;
+}
+
 }  // namespace
+
+std::string EncodeMarks(const engine::OperatorMarks& marks) { return MarksJson(marks).dump(); }
+
+Result<engine::OperatorMarks> DecodeMarks(const std::string& text) {
+  engine::OperatorMarks out;
+  Status s = ReadJson("operator marks", text, [&](const json& j) -> Status {
+    if (!j.is_object()) return Corrupt("operator marks", "not an object");
+    out = MarksOf(j);
+    return engine::Ok{};
+  });
+  if (!s.ok()) return s.error();
+  return out;
+}
 
 const char* OrderEventTypeName(OrderEventType type) {
   switch (type) {
@@ -95,7 +124,7 @@ Status DecodeOrderBody(const std::string& body, engine::Order& order) {
   });
 }
 
-Result<std::string> EncodeRobotBody(const engine::Robot& robot) {
+Result<std::string> EncodeRobotBody(const engine::Robot& robot, const engine::OperatorMarks& marks) {
   const engine::Pose& p = robot.pose;
   if (!AllFinite({robot.diameter, robot.max_speed, p.position.x(), p.position.y(), p.heading,
                   robot.battery.value_or(0.0)})) {
@@ -108,6 +137,7 @@ Result<std::string> EncodeRobotBody(const engine::Robot& robot) {
   j["current_point"] = robot.current_point;
   j["task_queue"] = robot.task_queue;
   j["battery"] = robot.battery ? json(*robot.battery) : json(nullptr);
+  if (marks != engine::OperatorMarks{}) j["marks"] = MarksJson(marks);
   try {
     return j.dump();
   } catch (const json::exception& e) {
@@ -115,7 +145,7 @@ Result<std::string> EncodeRobotBody(const engine::Robot& robot) {
   }
 }
 
-Status DecodeRobotBody(const std::string& body, engine::Robot& robot) {
+Status DecodeRobotBody(const std::string& body, engine::Robot& robot, engine::OperatorMarks* marks) {
   return ReadJson("robot", body, [&](const json& j) -> Status {
     robot.diameter = j.at("diameter").get<double>();
     robot.max_speed = j.at("max_speed").get<double>();
@@ -128,6 +158,11 @@ Status DecodeRobotBody(const std::string& body, engine::Robot& robot) {
     const json& battery = j.at("battery");
     robot.battery =
         battery.is_null() ? std::nullopt : std::optional<double>(battery.get<double>());
+    if (marks) {
+      const auto m = j.find("marks");
+      if (m != j.end() && !m->is_object()) return Corrupt("robot", "marks are not an object");
+      *marks = m == j.end() ? engine::OperatorMarks{} : MarksOf(*m);
+    }
     return engine::Ok{};
   });
 }

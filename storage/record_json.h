@@ -20,9 +20,15 @@ Result<std::string> EncodeOrderBody(const engine::Order& order);
 // Fills picks, drop, work_time, release_time of `order` from `body`.
 Status DecodeOrderBody(const std::string& body, engine::Order& order);
 
-// Robot body: everything of engine::Robot except id and state.
-Result<std::string> EncodeRobotBody(const engine::Robot& robot);
-Status DecodeRobotBody(const std::string& body, engine::Robot& robot);
+// Robot body: everything of engine::Robot except id and state, and the operator marks in force
+// (a "marks" object, absent when there are none).
+Result<std::string> EncodeRobotBody(const engine::Robot& robot, const engine::OperatorMarks& marks = {});
+Status DecodeRobotBody(const std::string& body, engine::Robot& robot, engine::OperatorMarks* marks = nullptr);
+
+// Operator marks: {"paused_by": ..., "out_of_service_by": ..., "off_floor": true}, each key
+// only when set.
+std::string EncodeMarks(const engine::OperatorMarks& marks);
+Result<engine::OperatorMarks> DecodeMarks(const std::string& text);
 
 // Plan waypoints.
 Result<std::string> EncodeWaypoints(const std::vector<engine::Waypoint>& waypoints);

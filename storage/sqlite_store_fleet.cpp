@@ -28,7 +28,7 @@ Status SqliteStore::UpsertRobot(const RobotRecord& r) {
     return engine::InvalidArgument("robot '" + r.robot.id +
                                    "': non-finite last_seen or sequence beyond 2^63");
   }
-  Result<std::string> body = EncodeRobotBody(r.robot);
+  Result<std::string> body = EncodeRobotBody(r.robot, r.marks);
   if (!body.ok()) return body.error();
   std::lock_guard lock(mu_);
   Status status = InTransaction([&]() -> Status {
@@ -65,7 +65,7 @@ Result<RobotRecord> ReadRobot(Stmt& s) {
   r.last_seen = s.ColReal(3);
   r.last_acked_sequence = static_cast<std::uint64_t>(s.ColInt(4));
   r.next_sequence = static_cast<std::uint64_t>(s.ColInt(5));
-  if (Status st = DecodeRobotBody(s.ColText(6), r.robot); !st.ok()) {
+  if (Status st = DecodeRobotBody(s.ColText(6), r.robot, &r.marks); !st.ok()) {
     return WithContext("robot '" + r.robot.id + "'", st.error());
   }
   return r;

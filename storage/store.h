@@ -29,6 +29,7 @@
 
 #include "engine/common/result.h"
 #include "engine/dispatch/assignment.h"
+#include "engine/dispatch/robot_commands.h"
 #include "engine/fleet/order.h"
 #include "engine/fleet/plan.h"
 #include "engine/fleet/robot.h"
@@ -116,6 +117,7 @@ struct RobotRecord {
   double last_seen = 0.0;                 // dispatcher seconds of its last message
   std::uint64_t last_acked_sequence = 0;  // server message sequence it acknowledged
   std::uint64_t next_sequence = 1;        // next server message sequence to use
+  engine::OperatorMarks marks;            // operator commands in force (issue 18 §4)
 };
 
 // A robot's current plan and what it serves (one per robot; saving replaces it): the dispatch

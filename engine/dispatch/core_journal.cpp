@@ -28,7 +28,7 @@ constexpr std::array<std::pair<CoreInput::Kind, const char*>, 18> kKinds{{
     {CoreInput::Kind::kCommitted, "committed"},
     {CoreInput::Kind::kStep, "step"},
     {CoreInput::Kind::kSampleDistances, "sample_distances"},
-    {CoreInput::Kind::kPause, "pause"},
+    {CoreInput::Kind::kPlanCommand, "plan_command"},
 }};
 
 std::string Join(const std::vector<std::string>& items, const char* sep) {
@@ -107,6 +107,7 @@ std::optional<CoreInput::Kind> ParseCoreInputKind(const std::string& name) {
   for (const auto& [k, n] : kKinds) {
     if (name == n) return k;
   }
+  if (name == "pause") return CoreInput::Kind::kPlanCommand;  // journals before "plan_command"
   return std::nullopt;
 }
 
@@ -137,6 +138,14 @@ std::string DescribeChange(const Change& change) {
   }
   for (const auto& [order, members] : change.dropped_by) {
     Add(out, order + " dropped by " + Join(std::vector<std::string>(members.begin(), members.end()), ","));
+  }
+  for (const auto& [robot, marks] : change.marks) {
+    std::string s = robot + " marks:";
+    if (!marks.paused_by.empty()) s += " paused by " + marks.paused_by;
+    if (!marks.out_of_service_by.empty()) s += " out of service by " + marks.out_of_service_by;
+    if (marks.off_floor) s += " off the floor";
+    if (marks == OperatorMarks{}) s += " none";
+    Add(out, s);
   }
   return out;
 }

@@ -4,7 +4,7 @@
 //
 // An entry is one call of DispatchCore (AddOrder, RestoreRobot, Place, Connect, Disconnect,
 // Report, Reached, PlanTask, PlanCancel, PlanLoss, Apply, MakeRound, PlanAwards, Committed,
-// Step, SampleDistances, Pause) or the result of an allocation round coming back (kRoundResult: the
+// Step, SampleDistances, PlanCommand) or the result of an allocation round coming back (kRoundResult: the
 // round runs outside the core, on the service's worker). Calls that refer to an earlier one
 // carry its entry number: Apply the entry whose Change it applies, PlanAwards / Committed /
 // kRoundResult the MakeRound of their round (Change::origin, RoundCommit::origin).
@@ -50,18 +50,20 @@ struct CoreInput {
     kCommitted,
     kStep,
     kSampleDistances,
-    kPause,  // an operator's pause or resume (paused; reason: who)
+    kPlanCommand,  // an operator's command on a robot (command)
   };
   Kind kind = Kind::kStep;
   double time = 0.0;      // the call's `now` (0 for calls without one)
   std::string robot_id;   // Place, Disconnect, Report, Reached, PlanTask, PlanLoss
   std::string order_id;   // PlanCancel
-  std::string reason;     // PlanCancel, PlanLoss; Pause: who paused or resumed
+  std::string reason;     // PlanCancel, PlanLoss
   std::optional<Order> order;          // AddOrder
   std::vector<std::string> robots;     // AddOrder: the robots a recovered order has
   std::optional<Robot> robot;          // RestoreRobot, Connect
   std::optional<Assignment> plan;      // RestoreRobot
   bool place = false;                  // RestoreRobot
+  OperatorMarks marks;                 // RestoreRobot
+  std::optional<OperatorCommand> command;  // PlanCommand
   std::optional<Pose> pose;            // Report (always), Reached (when sent)
   std::optional<int> arc_id;           // Report
   std::optional<RobotState> state;     // Report
@@ -72,7 +74,6 @@ struct CoreInput {
   std::uint64_t change = 0;  // Committed: the PlanAwards entry whose change was committed
   std::size_t max = 0;       // PlanAwards
   bool cancelled = false;    // RoundResult: the round did not run (the service stopped)
-  bool paused = false;       // Pause: paused (false: resumed)
 };
 
 // "add_order", "restore_robot", "place", "connect", ... (the journal's kind column).

@@ -94,7 +94,7 @@ Result<std::string> CoreReplay::Feed(const JournalEntry& e) {
     }
     case K::kRestoreRobot:
       if (!in.robot) return Malformed(e, "no robot");
-      core_->RestoreRobot(*in.robot, in.plan, in.place);
+      core_->RestoreRobot(*in.robot, in.plan, in.place, in.marks);
       return std::string();
     case K::kPlace:
       core_->Place(in.robot_id);
@@ -105,9 +105,12 @@ Result<std::string> CoreReplay::Feed(const JournalEntry& e) {
     case K::kDisconnect:
       core_->Disconnect(in.robot_id);
       return std::string();
-    case K::kPause: {
-      const Status paused = core_->Pause(in.robot_id, in.paused, in.reason);
-      return paused.ok() ? std::string() : "refused: " + paused.error().message;
+    case K::kPlanCommand: {
+      if (!in.command) return Malformed(e, "no command");
+      Result<Change> out = core_->PlanCommand(*in.command, in.time);
+      if (!out.ok()) return "refused: " + out.error().message;
+      changes_[e.seq] = *out;
+      return DescribeChange(*out);
     }
     case K::kReport:
     case K::kReached: {

@@ -112,7 +112,7 @@ Result<Change> DispatchCore::PlanCancel(const std::string& order_id, const std::
 
 Change DispatchCore::PlanLoss(const std::string& id, const std::string& why, double now) {
   const BookRobot* r = robot(id);
-  if (!r || !r->has_assignment || r->assignment.order_ids.empty()) return Change{now, {}, {}, {}, {}, 0};
+  if (!r || !r->has_assignment || r->assignment.order_ids.empty()) return Change{now, {}, {}, {}, {}, 0, {}};
   return PlanReleaseOf(r->assignment.order_ids, StateAfterRobotLoss, why, now);
 }
 
@@ -167,7 +167,8 @@ std::optional<OrderChange> DispatchCore::StartLine(const std::string& order_id, 
 
 bool DispatchCore::Eligible(const BookRobot& r) const {
   return r.connected && r.robot.current_point != kNoPoint && r.robot.state != RobotState::kFault &&
-         (!gate_ || (gate_->Available(r.robot.id) && !gate_->Paused(r.robot.id)));
+         r.marks.paused_by.empty() && r.marks.out_of_service_by.empty() && !OnTrip(r) &&
+         (!gate_ || gate_->Available(r.robot.id));
 }
 
 PointId DispatchCore::StartOf(const BookRobot& r) const {
@@ -335,6 +336,17 @@ std::vector<RobotCommand> DispatchCore::Apply(const Change& change) {
     r->round_copy.reset();
     r->has_assignment = true;
     r->robot.task_queue = plan.order_ids;
+  }
+  for (const auto& [id, marks] : change.marks) {
+    BookRobot* r = FindRobot(id);
+    if (!r) continue;
+    const bool was_held = !r->marks.HeldFor().empty();
+    r->marks = marks;
+    if (gate_) {
+      gate_->SetPaused(id, marks.HeldFor());
+      if (marks.off_floor && !r->connected) gate_->Remove(id);
+    }
+    if (was_held && marks.HeldFor().empty()) allocation_due_ = true;  // it may bid again
   }
   // The gate learns every plan before any is sent (a formation needs all three members').
   for (const auto& [id, plan] : change.plans) {

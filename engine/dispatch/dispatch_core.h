@@ -37,6 +37,7 @@
 #include "engine/common/result.h"
 #include "engine/dispatch/allocation_round.h"
 #include "engine/dispatch/assignment.h"
+#include "engine/dispatch/robot_commands.h"
 #include "engine/dispatch/robot_message.h"
 #include "engine/dispatch/robot_progress.h"
 #include "engine/fleet/order.h"
@@ -85,6 +86,7 @@ struct BookRobot {
   RobotProgress progress;
   double blocked_at = -1.0;  // >= 0: in fault since then because the controller blocked it
   GateBot* gate_entry = nullptr;  // its entry in the traffic gate, once it has one (GateEntry)
+  OperatorMarks marks;            // operator commands in force (PlanCommand)
 };
 
 // One order's line in a Change: a state transition (to) or a journal note only.
@@ -115,7 +117,10 @@ struct Change {
   std::vector<PlanSend> sends;
   std::map<std::string, std::set<std::string>> dropped_by;  // order -> members that dropped now
   std::uint64_t origin = 0;  // the journal entry of the call that made it (JournaledCore); 0: none
-  bool empty() const { return orders.empty() && plans.empty() && sends.empty() && dropped_by.empty(); }
+  std::map<std::string, OperatorMarks> marks;  // robot -> its operator marks after the change
+  bool empty() const {
+    return orders.empty() && plans.empty() && sends.empty() && dropped_by.empty() && marks.empty();
+  }
   // Messages per robot once applied (the owner reserves their sequence numbers with the change).
   std::map<std::string, std::uint64_t> MessageCounts() const;
 };
@@ -206,6 +211,8 @@ class DispatchCore {
   const CoreCounts& counts() const { return counts_; }
   // Highest waypoint sequence released to the robot.
   std::uint64_t ReleasedUpTo(const std::string& robot) const;
+  // The station point an operator sent the robot to, while it drives there; kNoPoint otherwise.
+  PointId TripTo(const std::string& robot) const;
   // The waypoints of `order_id` its robots have not reached yet.
   OrderRoutes RoutesOf(const std::string& order_id) const;
   // True once since the last call when something happened that a new allocation round may
@@ -235,10 +242,11 @@ class DispatchCore {
   void Committed(RoundCommit& commit, const Change& change) const;
 
   // --- Robots ----------------------------------------------------------------------------
-  // Recovery: a robot as stored (offline until it reconnects) with its plan; `place` puts it in
-  // the gate at its stored point as an obstacle (Place).
-  void RestoreRobot(Robot robot, std::optional<Assignment> plan, bool place);
-  // Puts a robot that is not connected in the gate at its point (an obstacle there).
+  // Recovery: a robot as stored (offline until it reconnects) with its plan and the operator
+  // marks in force; `place` puts it in the gate at its stored point as an obstacle (Place).
+  void RestoreRobot(Robot robot, std::optional<Assignment> plan, bool place, OperatorMarks marks = {});
+  // Puts a robot that is not connected in the gate at its point (an obstacle there), unless an
+  // operator cleared it off the floor.
   void Place(const std::string& robot);
   // A checked Hello (robot_intake.h): the robot stands at robot.current_point. Returns its
   // current plan again when it has orders (it skips waypoints it has passed).
@@ -256,10 +264,23 @@ class DispatchCore {
                         double now);
   // "Picked" / "dropped": a pick starts the order, every member's drop completes it.
   TaskOutcome PlanTask(const std::string& robot, const TaskReport& report, double now);
-  // An operator (`by`: who) pauses or resumes the robot: TrafficGate::SetPaused; a paused
-  // robot bids for nothing (Eligible), a resumed one makes a round due. Errors:
-  // unknown robot (kNotFound), no traffic control (kFailedPrecondition: nothing to hold with).
-  Status Pause(const std::string& robot, bool paused, const std::string& by);
+  // An operator's command on a robot (robot_commands.h); the change carries the robot's new
+  // marks (Change::marks), which the owner stores with the robot. Applied:
+  // - pause / resume: held at its next point by the gate (TrafficGate::SetPaused) / released
+  //   again; plan and orders stay. A robot out of service stays held when resumed.
+  // - out_of_service: its orders given back as for a lost robot (started ones fail, the others
+  //   are re-allocated), held where it stands; return_to_service: released, allocatable again.
+  // - clear: a robot that is not connected is taken off the floor (TrafficGate::Remove: no
+  //   obstacle for the others), its orders given back, until it says Hello again.
+  // - send: an idle robot (connected, in service, not paused, in fault, or serving orders)
+  //   drives its route to point `to` (a park or charge waypoint at the end); it bids for
+  //   nothing until it has reached it. Not to a point another robot stands at or is sent to.
+  // Paused, out-of-service and robots on their way to a station are not Eligible; robots
+  // paused or out of service stay so across reconnects. Errors: unknown robot (kNotFound); no
+  // traffic control for pause (kFailedPrecondition: nothing to hold with); clear of a connected
+  // robot, send of a busy robot or to a taken point (kFailedPrecondition); no route
+  // (kUnreachable); an unknown point (kNotFound).
+  Result<Change> PlanCommand(const OperatorCommand& command, double now);
 
   // --- Applying and traffic --------------------------------------------------------------
   // Applies a stored Change: order states, plans, the gate; returns the plan messages.
@@ -276,6 +297,10 @@ class DispatchCore {
   BookRobot* FindRobot(const std::string& id);
   BookRobot& Book(const std::string& id);  // the robot's entry, made (and indexed) if new
   bool Eligible(const BookRobot& r) const;
+  // On its way to a station an operator sent it to (its order-less plan ends at a park or
+  // charge waypoint it has not reached).
+  bool OnTrip(const BookRobot& r) const;
+  Result<Change> PlanTrip(const BookRobot& r, PointId to, double now) const;
   PointId StartOf(const BookRobot& r) const;
   RoundKey KeyOf(const BookRobot& r) const;
   // r's entry in the gate (nullptr: none yet), looked up by id until it has one.

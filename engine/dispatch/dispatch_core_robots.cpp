@@ -9,12 +9,14 @@
 
 namespace dispatch::engine {
 
-void DispatchCore::RestoreRobot(Robot robot, std::optional<Assignment> plan, bool place) {
+void DispatchCore::RestoreRobot(Robot robot, std::optional<Assignment> plan, bool place, OperatorMarks marks) {
   const std::string id = robot.id;
   BookRobot& r = Book(id);
   r.robot = std::move(robot);
   r.robot.state = RobotState::kOffline;
   r.connected = false;
+  r.marks = std::move(marks);
+  if (gate_ && !r.marks.HeldFor().empty()) gate_->SetPaused(id, r.marks.HeldFor());
   if (plan) {
     r.assignment = std::move(*plan);
     r.round_copy.reset();
@@ -26,7 +28,7 @@ void DispatchCore::RestoreRobot(Robot robot, std::optional<Assignment> plan, boo
 
 void DispatchCore::Place(const std::string& id) {
   const BookRobot* r = robot(id);
-  if (!r || !gate_) return;
+  if (!r || !gate_ || r->marks.off_floor) return;
   const PointId p = r->robot.current_point;
   if (p == kNoPoint || static_cast<std::size_t>(p) >= map_->points().size()) return;
   gate_->Connect(id, map_->point(p).position, p);
@@ -39,6 +41,7 @@ std::vector<RobotCommand> DispatchCore::Connect(Robot robot, double now) {
   r.robot = std::move(robot);
   r.robot.task_queue = r.has_assignment ? r.assignment.order_ids : std::vector<std::string>{};
   r.connected = true;
+  r.marks.off_floor = false;  // a Hello puts a cleared robot back on the floor
   const bool was_blocked = r.blocked_at >= 0.0;
   r.blocked_at = -1.0;  // a Hello ends a block's fault (Recover drops it from blocked_)
   allocation_due_ = true;
@@ -47,17 +50,9 @@ std::vector<RobotCommand> DispatchCore::Connect(Robot robot, double now) {
     if (was_blocked) gate_->Unblock(id, now);
     SyncGate(r);
   }
-  if (!r.has_assignment || r.assignment.order_ids.empty()) return {};
+  if (!r.has_assignment || (r.assignment.order_ids.empty() && !OnTrip(r))) return {};
   // Resume: the robot gets its whole current plan again (it skips waypoints it has passed).
   return {{id, PlanMessage(r, true, 0)}};
-}
-
-Status DispatchCore::Pause(const std::string& id, bool paused, const std::string& by) {
-  if (!FindRobot(id)) return NotFound("no robot '" + id + "'");
-  if (!gate_) return Error{ErrorCode::kFailedPrecondition, "pausing robots needs traffic control (it holds them)"};
-  if (!gate_->SetPaused(id, paused ? (by.empty() ? "an operator" : by) : "")) return NotFound("robot '" + id + "' is not on the floor");
-  if (!paused) allocation_due_ = true;  // it may bid again
-  return Ok{};
 }
 
 void DispatchCore::Disconnect(const std::string& id) {
@@ -126,7 +121,7 @@ ReportOutcome DispatchCore::Reached(const std::string& id, std::uint64_t seq, co
   if (w.action == WaypointAction::kPick) {
     const std::string order_id = arrival.fresh ? arrival.order : OrderOfWaypoint(r->assignment, i);
     if (auto line = StartLine(order_id, id + " reached pick '" + map_->point(w.point).name + "'")) {
-      out.change = Change{now, {std::move(*line)}, {}, {}, {}, 0};
+      out.change = Change{now, {std::move(*line)}, {}, {}, {}, 0, {}};
     }
   }
   out.retry = std::move(arrival.retry);

@@ -101,7 +101,7 @@ void JournaledCore::Committed(RoundCommit& commit, const Change& change) {
   Record(seq, std::move(in), "");
 }
 
-void JournaledCore::RestoreRobot(Robot robot, std::optional<Assignment> plan, bool place) {
+void JournaledCore::RestoreRobot(Robot robot, std::optional<Assignment> plan, bool place, OperatorMarks marks) {
   const std::uint64_t seq = Begin();
   CoreInput in;
   in.kind = CoreInput::Kind::kRestoreRobot;
@@ -110,7 +110,8 @@ void JournaledCore::RestoreRobot(Robot robot, std::optional<Assignment> plan, bo
     in.plan = plan;
   }
   in.place = place;
-  core_->RestoreRobot(std::move(robot), std::move(plan), place);
+  in.marks = marks;
+  core_->RestoreRobot(std::move(robot), std::move(plan), place, std::move(marks));
   Record(seq, std::move(in), "");
 }
 
@@ -134,15 +135,16 @@ std::vector<RobotCommand> JournaledCore::Connect(Robot robot, double now) {
   return out;
 }
 
-Status JournaledCore::Pause(const std::string& robot, bool paused, const std::string& by) {
+Result<Change> JournaledCore::PlanCommand(const OperatorCommand& command, double now) {
   const std::uint64_t seq = Begin();
-  Status out = core_->Pause(robot, paused, by);
+  Result<Change> out = core_->PlanCommand(command, now);
+  if (out.ok()) out.value().origin = seq;
   CoreInput in;
-  in.kind = CoreInput::Kind::kPause;
-  in.robot_id = robot;
-  in.reason = by;
-  in.paused = paused;
-  Record(seq, std::move(in), out.ok() ? "" : "refused: " + out.error().message);
+  in.kind = CoreInput::Kind::kPlanCommand;
+  in.time = now;
+  in.robot_id = command.robot;
+  in.command = command;
+  Record(seq, std::move(in), out.ok() ? DescribeChange(*out) : "refused: " + out.error().message);
   return out;
 }
 

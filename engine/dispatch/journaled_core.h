@@ -41,6 +41,7 @@ class JournaledCore {
   const CoreCounts& counts() const { return core_->counts(); }
   std::uint64_t ReleasedUpTo(const std::string& robot) const { return core_->ReleasedUpTo(robot); }
   OrderRoutes RoutesOf(const std::string& order_id) const { return core_->RoutesOf(order_id); }
+  PointId TripTo(const std::string& robot) const { return core_->TripTo(robot); }
   bool TakeAllocationDue() { return core_->TakeAllocationDue(); }  // a flag; not journaled
 
   void AddOrder(Order order, std::vector<std::string> robots = {});
@@ -52,7 +53,7 @@ class JournaledCore {
   void RoundResult(const RoundCommit& commit, bool cancelled);
   Change PlanAwards(RoundCommit& commit, std::size_t max, double now);
   void Committed(RoundCommit& commit, const Change& change);
-  void RestoreRobot(Robot robot, std::optional<Assignment> plan, bool place);
+  void RestoreRobot(Robot robot, std::optional<Assignment> plan, bool place, OperatorMarks marks = {});
   void Place(const std::string& robot);
   std::vector<RobotCommand> Connect(Robot robot, double now);
   void Disconnect(const std::string& robot);
@@ -61,7 +62,7 @@ class JournaledCore {
                        double now);
   ReportOutcome Reached(const std::string& robot, std::uint64_t seq, const std::optional<Pose>& pose, double now);
   TaskOutcome PlanTask(const std::string& robot, const TaskReport& report, double now);
-  Status Pause(const std::string& robot, bool paused, const std::string& by);
+  Result<Change> PlanCommand(const OperatorCommand& command, double now);
   std::vector<RobotCommand> Apply(const Change& change);
   StepOutcome Step(double now);
   void SampleDistances(double now);

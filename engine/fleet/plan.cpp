@@ -27,6 +27,56 @@ void Append(Plan& plan, PointId point, const Eigen::Vector2d& xy, double eta,
   plan.waypoints.push_back(w);
 }
 
+Status CheckDrive(double speed, double start_time, double turn_time) {
+  if (!std::isfinite(speed) || speed <= 0.0) {
+    return InvalidArgument("speed must be > 0 m/s, got " + std::to_string(speed));
+  }
+  if (!std::isfinite(start_time)) return InvalidArgument("start time is not finite");
+  if (!std::isfinite(turn_time) || turn_time < 0.0) {
+    return InvalidArgument("turn time must be finite and >= 0 s, got " + std::to_string(turn_time));
+  }
+  return Ok{};
+}
+
+// Builds a plan stop by stop: drives the RouteTable's route from the last stop to the next,
+// timing arcs by length / speed (capped by an arc's own max_speed) plus the turning time.
+struct PlanDriver {
+  PlanDriver(const WarehouseMap& map, const RouteTable& routes, PointId start, double start_time, double speed,
+             double turn_time)
+      : map(map), routes(routes), speed(speed), turn_time(turn_time), at(start), time(start_time) {
+    Append(plan, start, map.point(start).position, start_time, WaypointAction::kMove, 0.0);
+  }
+  // Drives from `at` to `stop`, then works `dwell` there.
+  Status Visit(PointId stop, WaypointAction action, double dwell) {
+    Result<Route> route = routes.Path(at, stop);
+    if (!route.ok()) return route.error();
+    const Route& r = *route;
+    for (std::size_t i = 0; i < r.arcs.size(); ++i) {
+      const Arc& arc = map.arc(r.arcs[i]);
+      const double v = arc.max_speed > 0.0 ? std::min(speed, arc.max_speed) : speed;
+      if (turn_time > 0.0 && last_arc >= 0) {
+        time += turn_time * TurnAngle(map, last_arc, r.arcs[i]) / (std::numbers::pi / 2.0);
+      }
+      last_arc = r.arcs[i];
+      time += arc.length / v;
+      const PointId p = r.points[i + 1];
+      if (i + 1 < r.arcs.size()) Append(plan, p, map.point(p).position, time, WaypointAction::kMove, 0.0);
+    }
+    Append(plan, stop, map.point(stop).position, time, action, dwell);
+    time += dwell;
+    at = stop;
+    return Ok{};
+  }
+
+  const WarehouseMap& map;
+  const RouteTable& routes;
+  const double speed, turn_time;
+  Plan plan;
+  PointId at;
+  double time;
+  ArcId last_arc = -1;  // the arc the robot came by (turning time from its heading)
+};
+
 }  // namespace
 
 const char* WaypointActionName(WaypointAction action) {
@@ -99,10 +149,7 @@ double TaskWorkTime(const PlanTask& task) { return TaskPointCount(task) * task.w
 Result<Plan> BuildPlan(const WarehouseMap& map, const RouteTable& routes, PointId start,
                        double start_time, double speed, const std::vector<PlanTask>& tasks,
                        double turn_time) {
-  if (!std::isfinite(speed) || speed <= 0.0) {
-    return InvalidArgument("speed must be > 0 m/s, got " + std::to_string(speed));
-  }
-  if (!std::isfinite(start_time)) return InvalidArgument("start time is not finite");
+  if (Status s = CheckDrive(speed, start_time, turn_time); !s.ok()) return s.error();
   if (!ValidPoint(map, start)) return NotFound("unknown start point id " + std::to_string(start));
   for (std::size_t k = 0; k < tasks.size(); ++k) {
     const PlanTask& task = tasks[k];
@@ -120,51 +167,35 @@ Result<Plan> BuildPlan(const WarehouseMap& map, const RouteTable& routes, PointI
     }
   }
 
-  Plan plan;
-  Append(plan, start, map.point(start).position, start_time, WaypointAction::kMove, 0.0);
-  if (!std::isfinite(turn_time) || turn_time < 0.0) {
-    return InvalidArgument("turn time must be finite and >= 0 s, got " + std::to_string(turn_time));
-  }
-  PointId at = start;
-  double time = start_time;
-  ArcId last_arc = -1;  // the arc the robot came by (turning time from its heading)
-  // Drives from `at` to `stop` along the table's route, then works `dwell` there.
-  auto visit = [&](PointId stop, WaypointAction action, double dwell) -> Status {
-    Result<Route> route = routes.Path(at, stop);
-    if (!route.ok()) return route.error();
-    const Route& r = *route;
-    for (std::size_t i = 0; i < r.arcs.size(); ++i) {
-      const Arc& arc = map.arc(r.arcs[i]);
-      const double v = arc.max_speed > 0.0 ? std::min(speed, arc.max_speed) : speed;
-      if (turn_time > 0.0 && last_arc >= 0) {
-        time += turn_time * TurnAngle(map, last_arc, r.arcs[i]) / (std::numbers::pi / 2.0);
-      }
-      last_arc = r.arcs[i];
-      time += arc.length / v;
-      const PointId p = r.points[i + 1];
-      if (i + 1 < r.arcs.size()) {
-        Append(plan, p, map.point(p).position, time, WaypointAction::kMove, 0.0);
-      }
-    }
-    Append(plan, stop, map.point(stop).position, time, action, dwell);
-    time += dwell;
-    at = stop;
-    return Ok{};
-  };
+  PlanDriver driver(map, routes, start, start_time, speed, turn_time);
   for (std::size_t k = 0; k < tasks.size(); ++k) {
     const PlanTask& task = tasks[k];
     const std::string what = "task " + std::to_string(k + 1);
     for (std::size_t i = 0; i < task.picks.size(); ++i) {
-      if (Status s = visit(task.picks[i], WaypointAction::kPick, task.work_time); !s.ok()) {
+      if (Status s = driver.Visit(task.picks[i], WaypointAction::kPick, task.work_time); !s.ok()) {
         return Error{s.error().code,
                      what + ", pick " + std::to_string(i + 1) + ": " + s.error().message};
       }
     }
-    if (Status s = visit(task.drop, WaypointAction::kDrop, task.work_time); !s.ok()) {
+    if (Status s = driver.Visit(task.drop, WaypointAction::kDrop, task.work_time); !s.ok()) {
       return Error{s.error().code, what + ", drop: " + s.error().message};
     }
   }
-  return plan;
+  return std::move(driver.plan);
+}
+
+Result<Plan> BuildTrip(const WarehouseMap& map, const RouteTable& routes, PointId start, double start_time,
+                       double speed, PointId to, WaypointAction action, double turn_time) {
+  if (Status s = CheckDrive(speed, start_time, turn_time); !s.ok()) return s.error();
+  if (!ValidPoint(map, start)) return NotFound("unknown start point id " + std::to_string(start));
+  if (!ValidPoint(map, to)) return NotFound("unknown destination point id " + std::to_string(to));
+  PlanDriver driver(map, routes, start, start_time, speed, turn_time);
+  if (to == start) {  // already there: the start waypoint says what it is for
+    driver.plan.waypoints.back().action = action;
+    return std::move(driver.plan);
+  }
+  if (Status s = driver.Visit(to, action, 0.0); !s.ok()) return s.error();
+  return std::move(driver.plan);
 }
 
 }  // namespace dispatch::engine

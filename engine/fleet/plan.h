@@ -92,4 +92,11 @@ Result<Plan> BuildPlan(const WarehouseMap& map, const RouteTable& routes, PointI
                        double start_time, double speed, const std::vector<PlanTask>& tasks,
                        double turn_time = 0.0);
 
+// The plan of one robot at `start` at `start_time` driving to `to` (an operator sending it to a
+// station): as BuildPlan, the route's points as move waypoints, the last one `action` (e.g.
+// park) with no dwell. `to` == `start`: the start waypoint alone, with `action`.
+// Errors: as BuildPlan (kNotFound names the destination).
+Result<Plan> BuildTrip(const WarehouseMap& map, const RouteTable& routes, PointId start, double start_time,
+                       double speed, PointId to, WaypointAction action, double turn_time = 0.0);
+
 }  // namespace dispatch::engine

@@ -197,6 +197,7 @@ void TrafficGate::Connect(const std::string& robot, const Eigen::Vector2d& xy, P
   GateBot& b = s.Get(robot);
   b.id = robot;
   b.connected = true;
+  b.removed = false;
   b.synced = false;
   b.resume_pending = true;  // it may still hold on a Hold from before the stream broke
   b.held = false;
@@ -239,9 +240,22 @@ void TrafficGate::SetPlan(const std::string& robot, GatePlan plan) {
 }
 
 bool TrafficGate::SetPaused(const std::string& robot, const std::string& by) {
-  GateBot* b = impl_->Find(robot);
-  if (!b) return false;
-  b->paused_by = by;
+  if (robot.empty()) return false;
+  GateBot& b = impl_->Get(robot);
+  b.id = robot;
+  b.paused_by = by;
+  return true;
+}
+
+bool TrafficGate::Remove(const std::string& robot) {
+  Impl& s = *impl_;
+  GateBot* b = s.Find(robot);
+  if (!b || b->connected || !b->team.empty()) return false;
+  if (s.OnFloor(*b)) s.ctl.Remove(static_cast<std::size_t>(b->ctl));
+  s.strays.erase(robot);
+  b->removed = true;
+  b->leg_stale = true;
+  b->held = false;
   return true;
 }
 

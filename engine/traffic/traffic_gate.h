@@ -172,9 +172,15 @@ class TrafficGate {
   // Pauses the robot for `by` (an operator's name; "": resumes it), issue 18 §4: nothing more
   // is released to it, or to the team it drives in; it stops at the last waypoint released
   // and is held there ("paused by <by>") until resumed, when the next Step releases it as
-  // usual. Its place, plan and orders stay. False for a robot the gate does not know.
+  // usual. Its place, plan and orders stay. A robot the gate does not know yet gets an entry
+  // (paused from its first connection on, e.g. after a restart); false for an empty id.
   bool SetPaused(const std::string& robot, const std::string& by);
   bool Paused(const std::string& robot) const;
+  // Takes a robot that is not connected off the floor (an operator cleared it, issue 18 §4):
+  // it is no obstacle any more and releases what it held, until it connects again (Connect
+  // places it where it then stands). Its plan stays (the owner changes it). False when the robot is unknown,
+  // connected or in a formation team (its team's agent stands for it).
+  bool Remove(const std::string& robot);
   // What happened to formations since the last call (formed again, broken up, members
   // leaving the drop), one line each, for the owner's log.
   std::vector<std::string> TakeNotes();

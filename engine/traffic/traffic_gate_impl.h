@@ -38,6 +38,7 @@ struct GateBot {
   std::string id;
   int ctl = -1;  // its controller agent (on the floor unless it is in a team or was removed)
   bool connected = false;
+  bool removed = false;  // cleared off the floor while offline (TrafficGate::Remove), until Connect
   bool synced = false;  // a state report since it connected (its last waypoint is known)
   GatePlan plan;
   std::uint64_t plan_version = 0;  // counts the plan's changes (Reindex)

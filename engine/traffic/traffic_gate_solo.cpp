@@ -86,7 +86,7 @@ void GateImpl::PlaceStrays() {
 
 // One solo agent standing or driving: releases, requests, rewrites.
 void GateImpl::StepSolo(GateBot& b, double t, std::vector<GateEffect>& out) {
-  if (!b.team.empty()) return;
+  if (!b.team.empty() || b.removed) return;
   if (b.connected && b.synced && !b.plan.teams.empty()) {
     if (auto inside = SpanAround(b)) {  // inside its formation's segment without the team
       if (RejoinTeam(b, inside->first, inside->second, t, out)) return;

@@ -22,8 +22,14 @@ window.WebMap = window.WebMap || {};
       id: j.id, state: robotState(j.state), connected: j.connected, x: pose.x, y: pose.y, heading: pose.theta,
       orders: list(j.order_ids), held: !!j.held, hold_reason: j.hold_reason || "",
       formation: j.formation_order_id || null, point: stop(j.point), battery: j.battery ?? null,
+      paused_by: j.paused_by || "", out_of_service_by: j.out_of_service_by || "", off_floor: !!j.off_floor,
+      sent_to: stop(j.sent_to),
     };
   }
+
+  // Session: who the token is.
+  const session = j => ({ name: j.name || "", role: j.role || "", robot_commands: !!j.robot_commands,
+    tokens_required: !!j.tokens_required });
 
   // Order
   function order(j) {
@@ -85,5 +91,5 @@ window.WebMap = window.WebMap || {};
     };
   }
 
-  WM.Api = { robot, order, detail, allocation, zone, intersection, status, orderState, robotState };
+  WM.Api = { robot, order, detail, allocation, zone, intersection, status, session, orderState, robotState };
 })(window.WebMap);

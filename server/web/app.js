@@ -1,8 +1,9 @@
 // The live map's controller: polls the REST API (robots, intersections and zones every 200 ms,
-// status every 500 ms, orders and the selected order every second; the map once and
-// again when its version changes), keeps the latest answers, and redraws the live layers once
-// per animation frame after new data (the answers' proto JSON turned into views by api.js).
-// Fetch failures are shown in the page and retried.
+// status every 500 ms, orders and the selected order every second, who the token is every
+// 2 s and when it is changed; the map once and again when its version changes), keeps the
+// latest answers, and redraws the live layers once per animation frame after new data (the
+// answers' proto JSON turned into views by api.js). Fetch failures are shown in the page and
+// retried. Operator commands on the selected robot are POSTed from the robots panel.
 // window.dispatchMap = {robots(): [{id, x, y, state}] as drawn, frames: live updates applied}.
 "use strict";
 
@@ -17,21 +18,32 @@
     floor: null, mapVersion: null, view: new WM.Floor.View(), autoFit: true,
     robots: [], intersections: [], zones: [], orders: [], ordersById: new Map(),
     selectedId: null, detail: null, heatMax: 0.01, frames: 0, robotsFresh: false, finishedTotal: null,
-    problems: new Map(),
+    problems: new Map(), session: null, selectedRobot: null, commandNote: null,
   };
   const live = new WM.Live.LiveLayer($("live"));
   // The bearer token typed into the header (dispatchd --auth-tokens): in this page's memory
   // only, never stored, sent with every API request.
   let token = "";
-  $("token").addEventListener("change", e => { token = e.target.value.trim(); });
+  $("token").addEventListener("change", e => {
+    token = e.target.value.trim();
+    state.session = null;  // until the server says who the new token is
+    renderRobots();
+    refreshSession();
+  });
   const EMPTY_FLOOR = { intersections: new Map(), ref: () => null };
 
   // ---- fetching ---------------------------------------------------------------------------
-  async function getJson(path, timeoutMs = REQUEST_TIMEOUT_MS) {
+  async function getJson(path, timeoutMs = REQUEST_TIMEOUT_MS, post = null) {
     let res;
     try {
       const headers = token ? { Authorization: "Bearer " + token } : {};
-      res = await fetch(API + path, { cache: "no-store", headers, signal: AbortSignal.timeout(timeoutMs) });
+      const init = { cache: "no-store", headers, signal: AbortSignal.timeout(timeoutMs) };
+      if (post) {
+        init.method = "POST";
+        headers["Content-Type"] = "application/json";
+        init.body = JSON.stringify(post);
+      }
+      res = await fetch(API + path, init);
     } catch (err) {
       const e = new Error(err.name === "TimeoutError" ? `no answer within ${timeoutMs / 1000} s` : "server unreachable");
       e.network = true;
@@ -76,6 +88,48 @@
       }
     };
     tick();
+  }
+
+  // ---- robots and operator commands ---------------------------------------------------------
+  function renderRobots() {
+    const stations = state.floor && state.floor.stations ? state.floor.stations.map(s => s.id) : [];
+    WM.Commands.renderRobots(state.robots, state.selectedRobot, state.session, stations, state.commandNote);
+  }
+
+  let sessionAsked = 0;  // answers to older questions (an earlier token) are dropped
+  function refreshSession() {
+    const asked = ++sessionAsked;
+    getJson("session").then(j => {
+      if (asked !== sessionAsked) return;
+      problem("session", null);
+      state.session = WM.Api.session(j);
+      renderRobots();
+    }, err => {
+      if (asked !== sessionAsked) return;
+      problem("session", err);
+      state.session = null;
+      renderRobots();
+    });
+  }
+
+  function selectRobot(id) {
+    state.selectedRobot = id === state.selectedRobot ? null : id;
+    state.commandNote = null;
+    renderRobots();
+  }
+
+  async function command(kind) {
+    const id = state.selectedRobot, spec = WM.Commands.COMMANDS[kind];
+    if (!id || !spec) return;
+    const body = kind === "send" ? { station: $("send-station").value } : {};
+    try {
+      const r = WM.Api.robot(await getJson(`robots/${encodeURIComponent(id)}/${spec.path}`, REQUEST_TIMEOUT_MS, body));
+      state.robots = state.robots.map(x => (x.id === r.id ? r : x));  // shown at once, not at the next poll
+      state.commandNote = { ok: true, text: `${spec.label.toLowerCase()}: done` };
+    } catch (err) {
+      state.commandNote = { ok: false, text: `${spec.label.toLowerCase()} failed: ${err.message}` };
+    }
+    renderRobots();
   }
 
   // ---- drawing ----------------------------------------------------------------------------
@@ -178,6 +232,7 @@
     state.autoFit = true;
     floorDirty = true;
     $("map-note").hidden = true;
+    renderRobots();  // the stations to send robots to
     scheduleDraw();
   }
 
@@ -194,8 +249,11 @@
     poll("robots", () => "robots", 200, j => {
       state.robots = (Array.isArray(j.robots) ? j.robots : []).map(WM.Api.robot);
       state.robotsFresh = true;
+      renderRobots();
       scheduleDraw();
     });
+    refreshSession();
+    setInterval(refreshSession, 2000);
     poll("intersections", () => "intersections?active=1", 200, j => {
       state.intersections = (Array.isArray(j.intersections) ? j.intersections : []).map(WM.Api.intersection);
       WM.Panels.renderIntersections(state.intersections);
@@ -255,6 +313,18 @@
       if (li && (e.key === "Enter" || e.key === " ")) { e.preventDefault(); select(li.dataset.orderId); }
     });
     $("detail-close").addEventListener("click", () => select(null));
+    $("robot-list").addEventListener("click", e => {
+      const li = e.target.closest("li[data-robot-id]");
+      if (li) selectRobot(li.dataset.robotId);
+    });
+    $("robot-list").addEventListener("keydown", e => {
+      const li = e.target.closest("li[data-robot-id]");
+      if (li && (e.key === "Enter" || e.key === " ")) { e.preventDefault(); selectRobot(li.dataset.robotId); }
+    });
+    $("robot-commands").addEventListener("click", e => {
+      const b = e.target.closest("button[data-command]");
+      if (b) command(b.dataset.command);
+    });
 
     const map = $("map");
     map.addEventListener("wheel", e => {
@@ -285,6 +355,7 @@
     get frames() { return state.frames; },
     get problems() { return [...state.problems].map(([source, p]) => `${source}: ${p.message}`); },
     select,
+    get session() { return state.session; },
   };
 
   WM.Panels.renderLegend(state.heatMax);

@@ -238,12 +238,12 @@ def main():
         def journaled():
             db = sqlite3.connect(f"file:{os.path.join(h.work, 'dispatch.db')}?mode=ro", uri=True, timeout=5)
             try:
-                rows = db.execute("SELECT input FROM core_journal WHERE kind = 'pause' ORDER BY seq").fetchall()
+                rows = db.execute("SELECT input FROM core_journal WHERE kind = 'plan_command' ORDER BY seq").fetchall()
             finally:
                 db.close()
-            inputs = [json.loads(r[0]) for r in rows]
-            return len(inputs) >= 2 and inputs[0].get("paused") and inputs[0].get("why") == "operator-dev" and \
-                not inputs[-1].get("paused") and inputs[-1].get("why") == "operator-dev"
+            commands = [json.loads(r[0]).get("cmd") for r in rows]  # [command, robot, by, point]
+            on_r1 = [c[:3] for c in commands if c and c[1] == "R1"]  # R9's refused pause is journaled too
+            return on_r1 == [["pause", "R1", "operator-dev"], ["resume", "R1", "operator-dev"]]
         h.wait_for(journaled, 30, "the journal's pause and resume naming operator-dev")
 
         # SIGHUP: the wms token revoked.

@@ -278,12 +278,16 @@ def browser_checks(h, server, page, base_url, orders, out):
     check(not page.errors, "JavaScript errors or error log entries:\n  " + "\n  ".join(page.errors))
 
 
-def main():
-    p = common_arguments(__doc__)
-    p.add_argument("--out", required=True, help="folder for web_map.png")
+def browser_arguments(description, screenshot):
+    """The e2e arguments with --out and --chromium; exits 77 (skipped) without Chromium or
+    python3-websocket."""
+    p = common_arguments(description)
+    p.add_argument("--out", required=True, help=f"folder for {screenshot}")
     p.add_argument("--chromium", default="/usr/bin/chromium")
-    p.add_argument("--web-root", help="serve the page from this folder (dispatchd --web-root)")
-    args = p.parse_args()
+    return p
+
+
+def check_browser(args):
     try:
         import websocket  # noqa: F401
     except ImportError:
@@ -293,24 +297,38 @@ def main():
         print(f"SKIPPED: no Chromium at {args.chromium}")
         sys.exit(SKIP)
     os.makedirs(args.out, exist_ok=True)
+
+
+def in_browser(h, args, screenshot, checks):
+    """Runs checks(page) on a page of a fresh headless Chromium; on a failure the page's
+    screenshot (OUT/screenshot), its errors and Chromium's log tail are printed."""
+    with Chromium(args.chromium, h.work) as browser:
+        page = None
+        try:
+            page = DevTools(browser.debugger_port())
+            checks(page)
+        except BaseException:
+            if page is not None:
+                with contextlib.suppress(Exception):
+                    page.screenshot(os.path.join(args.out, screenshot))
+                print("---- page errors:\n  " + "\n  ".join(page.errors or ["none"]), flush=True)
+            print(f"---- chromium log (last 40 lines): {browser.log_path}\n{browser.log_tail()}", flush=True)
+            raise
+
+
+def main():
+    p = browser_arguments(__doc__, "web_map.png")
+    p.add_argument("--web-root", help="serve the page from this folder (dispatchd --web-root)")
+    args = p.parse_args()
+    check_browser(args)
     with Harness(args, "webmap") as h:
         extra = ["--time-scale", "10"] + (["--web-root", args.web_root] if args.web_root else [])
         server = h.start_server(extra)
         h.start_fleet(server, ROBOTS)
         rows = h.submit_file(server, os.path.join(args.scenarios, "chu2024-table1.csv"))
         check(len(rows) == 6, f"submitted {len(rows)} orders of Table 1, want 6")
-        with Chromium(args.chromium, h.work) as browser:
-            page = None
-            try:
-                page = DevTools(browser.debugger_port())
-                browser_checks(h, server, page, f"http://{server.http}", [r[1] for r in rows], args.out)
-            except BaseException:
-                if page is not None:
-                    with contextlib.suppress(Exception):
-                        page.screenshot(os.path.join(args.out, "web_map.png"))
-                    print("---- page errors:\n  " + "\n  ".join(page.errors or ["none"]), flush=True)
-                print(f"---- chromium log (last 40 lines): {browser.log_path}\n{browser.log_tail()}", flush=True)
-                raise
+        in_browser(h, args, "web_map.png", lambda page: browser_checks(
+            h, server, page, f"http://{server.http}", [r[1] for r in rows], args.out))
 
 
 if __name__ == "__main__":

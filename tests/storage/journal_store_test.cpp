@@ -109,6 +109,18 @@ std::vector<JournalEntry> SampleEntries() {
   reached.robot_id = "R2";
   reached.sequence = 5;
   add(reached, "");  // without a pose
+  CoreInput command;
+  command.kind = CoreInput::Kind::kPlanCommand;
+  command.time = 17;
+  command.robot_id = "R2";
+  command.command = engine::OperatorCommand{engine::RobotCommandKind::kSend, "R2", "op-1", 4};
+  add(command, "R2 plan p3 4 wp #0badcafe []");
+  CoreInput restored;
+  restored.kind = CoreInput::Kind::kRestoreRobot;
+  restored.robot = engine::Robot{};
+  restored.robot->id = "R3";
+  restored.marks = {"op-1", "op-2", true};
+  add(restored, "");
   return out;
 }
 
@@ -170,6 +182,14 @@ void ExpectSameInput(const CoreInput& a, const CoreInput& b) {
   EXPECT_EQ(a.change, b.change);
   EXPECT_EQ(a.max, b.max);
   EXPECT_EQ(a.cancelled, b.cancelled);
+  EXPECT_EQ(a.marks, b.marks);
+  ASSERT_EQ(a.command.has_value(), b.command.has_value());
+  if (a.command) {
+    EXPECT_EQ(a.command->kind, b.command->kind);
+    EXPECT_EQ(a.command->robot, b.command->robot);
+    EXPECT_EQ(a.command->by, b.command->by);
+    EXPECT_EQ(a.command->to, b.command->to);
+  }
 }
 
 TEST(JournalStoreTest, EntriesOfEveryKindReadBackExactly) {

@@ -117,7 +117,7 @@ TEST_F(SqliteStoreTest, EverythingSurvivesCloseAndReopen) {
                                         std::vector<std::string>{"R7", "R1", "R2"}, "auction", {}, ""})
                     .ok());
     ASSERT_TRUE(store->AppendProgress("o2", 4.0, "R7 re-planned").ok());
-    ASSERT_TRUE(store->UpsertRobot({robot, "differential", 4.5, 17, 18}).ok());
+    ASSERT_TRUE(store->UpsertRobot({robot, "differential", 4.5, 17, 18, {"op-1", "op-2", false}}).ok());
     ASSERT_TRUE(store->SaveAssignment({"R7", 3, {"o2"}, plan, 1, 4.0}).ok());
     ASSERT_TRUE(store->RecordMapVersion({0, "chu2024", "abc123", "builtin:chu2024", 0.0, {}}).ok());
   }
@@ -166,6 +166,7 @@ TEST_F(SqliteStoreTest, EverythingSurvivesCloseAndReopen) {
   EXPECT_EQ(r->last_seen, 4.5);
   EXPECT_EQ(r->last_acked_sequence, 17u);
   EXPECT_EQ(r->next_sequence, 18u);
+  EXPECT_EQ(r->marks, (engine::OperatorMarks{"op-1", "op-2", false}));
 
   auto a = store->GetAssignment("R7");
   ASSERT_TRUE(a.ok()) << a.error().message;

@@ -11,13 +11,11 @@
 
 #include "dispatch_test_support.h"
 #include "engine/dispatch/dispatch_core.h"
-#include "engine/dispatch/strategy.h"
 
 namespace dispatch::engine {
 namespace {
 
 using testing_util::Chu2024;
-using testing_util::Chu2024Routes;
 using testing_util::PointsOfKind;
 
 constexpr double kBlockedAfter = 5.0;
@@ -30,12 +28,8 @@ class BlockedRecoveryTest : public ::testing::Test {
     CoreOptions options;
     options.traffic.blocked_after = kBlockedAfter;
     options.blocked_recovery = recovery;
-    auto core = DispatchCore::Create(Chu2024(), Chu2024Routes(), options);
-    ASSERT_TRUE(core.ok()) << core.error().message;
-    core_ = std::move(core).value();
-    auto allocator = MakeAllocator("auction");
-    ASSERT_TRUE(allocator.ok());
-    rounds_ = std::make_unique<RoundRunner>(Chu2024(), Chu2024Routes(), AllocationConfig{}, std::move(allocator).value());
+    core_ = testing_util::Chu2024Core(options);
+    rounds_ = testing_util::AuctionRounds();
 
     const PointId pick = PointsOfKind(*Chu2024(), PointKind::kPick).at(3);
     Robot ghost;
@@ -60,14 +54,7 @@ class BlockedRecoveryTest : public ::testing::Test {
   }
 
   // One allocation round, every award applied; false when there was nothing to allocate.
-  bool RunRound() {
-    RoundCommit commit;
-    std::optional<RoundInput> input = core_->MakeRound(now_, commit);
-    if (!input) return false;
-    commit.awards = rounds_->Run(*input).awards;
-    (void)core_->Apply(core_->PlanAwards(commit, commit.awards.size(), now_));
-    return true;
-  }
+  bool RunRound() { return testing_util::ApplyRound(*core_, *rounds_, now_); }
 
   // R1 drives at once to every waypoint released to it, then reports.
   void Drive() {

@@ -11,13 +11,11 @@
 #include <vector>
 
 #include "dispatch_test_support.h"
-#include "engine/dispatch/strategy.h"
 
 namespace dispatch::engine {
 namespace {
 
 using testing_util::Chu2024;
-using testing_util::Chu2024Routes;
 using testing_util::PointsOfKind;
 
 class DispatchCoreTest : public ::testing::Test {
@@ -26,12 +24,8 @@ class DispatchCoreTest : public ::testing::Test {
 
   void Build(CoreOptions options) {
     options.traffic_control = false;  // every waypoint released at once: the test drives them
-    auto core = DispatchCore::Create(Chu2024(), Chu2024Routes(), options);
-    ASSERT_TRUE(core.ok()) << core.error().message;
-    core_ = std::move(core).value();
-    auto allocator = MakeAllocator("auction");
-    ASSERT_TRUE(allocator.ok());
-    rounds_ = std::make_unique<RoundRunner>(Chu2024(), Chu2024Routes(), AllocationConfig{}, std::move(allocator).value());
+    core_ = testing_util::Chu2024Core(options);
+    rounds_ = testing_util::AuctionRounds();
   }
 
   void ConnectRobot(const std::string& id, PointId at) {

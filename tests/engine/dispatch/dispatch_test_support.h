@@ -5,12 +5,14 @@
 #include <gtest/gtest.h>
 
 #include <memory>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <vector>
 
+#include "engine/dispatch/dispatch_core.h"
+#include "engine/dispatch/strategy.h"
 #include "engine/fleet/order.h"
-
 #include "engine/map/chu2024_floor.h"
 #include "engine/routing/route_table.h"
 
@@ -33,6 +35,31 @@ inline std::shared_ptr<const RouteTable> Chu2024Routes() {
     return std::shared_ptr<const RouteTable>(std::move(table).value());
   }();
   return routes;
+}
+
+// A dispatch core on the floor (throws on an error: a bad test set-up).
+inline std::unique_ptr<DispatchCore> Chu2024Core(CoreOptions options) {
+  auto core = DispatchCore::Create(Chu2024(), Chu2024Routes(), options);
+  if (!core.ok()) throw std::runtime_error(core.error().message);
+  return std::move(core).value();
+}
+
+// Allocation rounds on the floor with the auction.
+inline std::unique_ptr<RoundRunner> AuctionRounds() {
+  auto allocator = MakeAllocator("auction");
+  if (!allocator.ok()) throw std::runtime_error(allocator.error().message);
+  return std::make_unique<RoundRunner>(Chu2024(), Chu2024Routes(), AllocationConfig{}, std::move(allocator).value());
+}
+
+// One allocation round, every award applied; false when there was nothing to allocate (no
+// accepted order, or no robot that may bid).
+inline bool ApplyRound(DispatchCore& core, RoundRunner& rounds, double now) {
+  RoundCommit commit;
+  std::optional<RoundInput> input = core.MakeRound(now, commit);
+  if (!input) return false;
+  commit.awards = rounds.Run(*input).awards;
+  (void)core.Apply(core.PlanAwards(commit, commit.awards.size(), now));
+  return true;
 }
 
 // The floor's points of one kind, in id order.

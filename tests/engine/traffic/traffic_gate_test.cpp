@@ -206,7 +206,7 @@ TEST_F(TrafficGateTest, APausedRobotIsHeldWhereItsReleasesEndUntilResumed) {
   ASSERT_TRUE(Run(20, {}, [&] { return sims_["R1"].at >= 2; })) << gate_->Describe("R1");
   ASSERT_TRUE(gate_->SetPaused("R1", "op-1"));
   EXPECT_TRUE(gate_->Paused("R1"));
-  EXPECT_FALSE(gate_->SetPaused("R9", "op-1"));
+  EXPECT_FALSE(gate_->SetPaused("", "op-1"));
   std::string hold;
   const std::uint64_t released = gate_->ReleasedUpTo("R1");
   for (int i = 0; i < 300; ++i) {  // 30 s: it would have driven on long since
@@ -228,6 +228,25 @@ TEST_F(TrafficGateTest, APausedRobotIsHeldWhereItsReleasesEndUntilResumed) {
   ASSERT_TRUE(gate_->SetPaused("R1", ""));
   ASSERT_TRUE(Run(5000)) << gate_->Describe("R1");
   EXPECT_EQ(gate_->RobotState("R1").paused_by, "");
+}
+
+// Issue 18 §3-4: an offline robot is an obstacle where it stands (a ghost at R1's drop keeps
+// R1 from finishing) until an operator clears it off the floor; connected again, it is placed
+// where it then stands.
+TEST_F(TrafficGateTest, AClearedOfflineRobotIsNoObstacleUntilItConnectsAgain) {
+  gate_->Connect("G", map_->point(P("D-B2")).position, P("D-B2"));
+  gate_->Disconnect("G");
+  AddRobot("R1", "park-P1", {"K3-2-3N"}, "D-B2", "o1");
+  EXPECT_FALSE(Run(600)) << "R1 reached a drop a robot stands on";  // 60 s, below blocked_after
+  EXPECT_FALSE(gate_->Remove("R9"));  // unknown
+  EXPECT_FALSE(gate_->Remove("R1"));  // connected: not cleared
+  ASSERT_TRUE(gate_->Remove("G"));
+  ASSERT_TRUE(Run(5000)) << gate_->Describe("R1");
+  EXPECT_EQ(sims_["R1"].plan[sims_["R1"].at].point, P("D-B2"));
+  // Back: it stands where it connects, and a robot sent there waits for it again.
+  gate_->Connect("G", map_->point(P("K3-2-3N")).position, P("K3-2-3N"));
+  AddRobot("R2", "park-P2", {"K3-2-3N"}, "D-B2", "o2");
+  EXPECT_FALSE(Run(600)) << "R2 reached a pick a robot stands on";
 }
 
 TEST_F(TrafficGateTest, RobotsSharingPickAndDropKeepEps1) {
