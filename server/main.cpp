@@ -39,6 +39,10 @@ int main(int argc, char** argv) {
   const auto& config = parsed->config;
   spdlog::set_level(spdlog::level::from_str(config.log_level));
   RaiseDescriptorLimit();
+  // A file grown to the file-size limit (RLIMIT_FSIZE, a quota) fails the write with EFBIG
+  // like a full disk instead of killing the process: the store reports it, SubmitOrder answers
+  // UNAVAILABLE, and the service goes on once there is room (issue 18 §5).
+  std::signal(SIGXFSZ, SIG_IGN);
 
   // Block the shutdown signals in every thread (threads inherit the mask) and wait for them
   // here, so no handler runs inside gRPC or SQLite code.
