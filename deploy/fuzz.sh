@@ -14,7 +14,7 @@ DISPATCH_FUZZ_DEPS=1 bash deploy/setup.sh packages
 export CC=clang CXX=clang++
 cmake -S . -B build-fuzz -DCMAKE_BUILD_TYPE=RelWithDebInfo -DDISPATCH_FUZZ=ON -DDISPATCH_BUILD_TESTS=OFF >/dev/null
 names=("$@")
-[ ${#names[@]} -gt 0 ] || names=(map_json movingai_map order_file rest_body grpc_requests robot_stream)
+[ ${#names[@]} -gt 0 ] || names=(map_json movingai_map order_file rest_body rest_paths grpc_requests robot_stream)
 cmake --build build-fuzz -j "$(nproc)" --target "${names[@]/#/fuzz_}"
 failed=()
 for name in "${names[@]}"; do

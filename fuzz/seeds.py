@@ -80,4 +80,31 @@ write("robot_stream", "hello-then-reports.bin", stream(
     robot('hello { robot_id: "R3" pose { x: 30.625 y: 24.75 } }'),
     robot('state_report { pose { x: 30.6 y: 24.7 } }'),
     robot('waypoint_reached { sequence: 1 }')))
+# rest_paths: method byte (0 GET, 1 POST, 2 DELETE), request target, newline, body.
+REST = [
+    ("get-orders", 0, "/api/v1/orders?state=in_progress&finished=5", ""),
+    ("get-orders-enum", 0, "/api/v1/orders?state=ORDER_STATE_FAILED&finished=-1", ""),
+    ("get-order", 0, "/api/v1/orders/ord-000001", ""),
+    ("get-order-escaped", 0, "/api/v1/orders/%00%ff%2F..%2f", ""),
+    ("post-order", 1, "/api/v1/orders", ORDER),
+    ("cancel", 2, "/api/v1/orders/ord-000001?reason=operator%20asked", ""),
+    ("robot", 0, "/api/v1/robots/R1", ""),
+    ("robots", 0, "/api/v1/robots", ""),
+    ("pause", 1, "/api/v1/robots/R1/pause", ""),
+    ("out-of-service", 1, "/api/v1/robots/R1/out-of-service", "{}"),
+    ("send", 1, "/api/v1/robots/R1/send", '{"station": "P5"}'),
+    ("clear", 1, "/api/v1/robots/R%201/clear", ""),
+    ("intersections", 0, "/api/v1/intersections?active=1", ""),
+    ("zones", 0, "/api/v1/zones", ""),
+    ("status", 0, "/api/v1/status", ""),
+    ("traffic", 0, "/api/v1/traffic", ""),
+    ("session", 0, "/api/v1/session", ""),
+    ("map", 0, "/api/v1/map", ""),
+    ("readyz", 0, "/readyz", ""),
+    ("metrics", 0, "/metrics", ""),
+    ("web", 0, "/../../etc/passwd", ""),
+    ("app", 0, "/app.js?x=%zz", ""),
+]
+for name, method, target, body in REST:
+    write("rest_paths", name, bytes([method]) + (target + "\n" + body).encode())
 print("seed corpora written to", CORPUS)

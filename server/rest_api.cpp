@@ -180,8 +180,8 @@ RestServer::RestServer(RestHandlers handlers, const std::string& web_root, const
                                    std::pair{"clear", RobotCommandKind::kClear}}) {
     s.Post(std::string(R"(/api/v1/robots/([^/]+)/)") + path,
            Guarded(auth, Access::kRobotCommand,
-                   ActorHandler([&h, kind](const httplib::Request& req, httplib::Response& res,
-                                           const std::string& actor) {
+                   ActorHandler([&h, kind = kind](const httplib::Request& req, httplib::Response& res,
+                                                  const std::string& actor) {
                      Reply(res, h.CommandRobot(kind, req.matches[1], actor));
                    })));
   }

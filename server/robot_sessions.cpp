@@ -74,6 +74,7 @@ storage::RobotRecord HelloRecord(storage::RobotRecord record, const RobotInbound
   record.robot.pose = hello.pose;
   record.robot.current_point = point;
   record.robot.state = engine::RobotState::kIdle;
+  record.marks.off_floor = false;  // a Hello puts a robot cleared off the floor back on it
   if (record.robot.battery && !(*record.robot.battery >= 0.0 && *record.robot.battery <= 1.0)) {
     record.robot.battery.reset();  // stored by an older server that took any report
   }

@@ -71,7 +71,8 @@ storage::RobotRecord RecordOf(const engine::BookRobot* robot, const RobotSession
 void RestoreSession(RobotSession& session, const storage::RobotRecord& record);
 // What a Hello makes of the robot's record: its pose and point, the size and speed it states
 // (the allocation's speed when it states none), idle, seen now, and message sequences that
-// continue after what it acknowledged. The caller validates the robot.
+// continue after what it acknowledged; back on the floor if an operator had cleared it off. The
+// caller validates the robot.
 storage::RobotRecord HelloRecord(storage::RobotRecord record, const RobotInbound& hello, engine::PointId point,
                                  double default_speed, double now);
 

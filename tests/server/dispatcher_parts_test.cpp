@@ -70,6 +70,7 @@ TEST(RobotSessionsTest, AHelloContinuesTheMessageSequenceAfterWhatTheRobotAcknow
   known.robot.battery = 7.0;  // stored by an older server
   known.next_sequence = 5;
   known.last_acked_sequence = 3;
+  known.marks = {"op-1", "op-2", true};  // paused, out of service, cleared off the floor
   RobotInbound hello;
   hello.robot_id = "R1";
   hello.pose.position = {1.0, 2.0};
@@ -83,6 +84,7 @@ TEST(RobotSessionsTest, AHelloContinuesTheMessageSequenceAfterWhatTheRobotAcknow
   EXPECT_FALSE(r.robot.battery.has_value());
   EXPECT_EQ(r.kind, "differential");
   EXPECT_EQ(r.last_seen, 12.0);
+  EXPECT_EQ(r.marks, (engine::OperatorMarks{"op-1", "op-2", false})) << "back on the floor, still held";
   hello.last_acked_sequence = 1;
   hello.max_speed = 0.8;
   hello.robot_kind = "four_wheel_steer";
