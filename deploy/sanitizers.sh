@@ -28,7 +28,14 @@ for run in "${runs[@]}"; do
   case "$run" in
     asan)
       cmake -S . -B build-asan "${flags[@]}" -DDISPATCH_SANITIZE=address,undefined >/dev/null
-      cmake --build build-asan -j "$jobs"
+      # Only what the run executes: every GoogleTest program (with the tools some of them start,
+      # their declared dependencies) and the fuzz replays; not the clients nor the tools the
+      # end-to-end tests alone use.
+      mapfile -t targets < <(find tests -name CMakeLists.txt -exec sed -nE 's/^dispatch_add_test\(([a-z0-9_]+)( .*)?$/\1/p' {} +)
+      for h in $(sed -nE 's/^set\(dispatch_fuzz_harnesses (.*)\)/\1/p' fuzz/CMakeLists.txt); do
+        targets+=("fuzz_${h}_replay")
+      done
+      cmake --build build-asan -j "$jobs" --target "${targets[@]}"
       ctest --test-dir build-asan --output-on-failure -j "$jobs" -LE e2e
       ;;
     tsan)

@@ -129,7 +129,8 @@ TEST(HardeningTest, NotReadyWhileTheDatabaseFailsWritesAndReadyWhenItRecovers) {
 }
 
 // Issue 18 §2: /metrics needs a role that reads them (operator, admin) unless metrics_open;
-// /healthz and /readyz stay open.
+// /healthz and /readyz stay open; /api/v1/session tells any valid token who it is (the web
+// map offers robot commands from it), and everyone is admin without tokens.
 TEST(HardeningTest, MetricsNeedARoleUnlessOpen) {
   TempDir dir;
   const std::string tokens = dir.File("tokens.json");
@@ -154,7 +155,23 @@ TEST(HardeningTest, MetricsNeedARoleUnlessOpen) {
     EXPECT_EQ(status_with("/healthz", ""), 200);
     EXPECT_EQ(status_with("/readyz", ""), 200);
     EXPECT_EQ(status_with("/api/v1/robots", ""), 401);
+    EXPECT_EQ(status_with("/api/v1/session", ""), 401);
+    EXPECT_EQ(status_with("/api/v1/session", "not-a-token"), 401);
+    for (const auto& [secret, body] :
+         {std::pair{"wms-secret", R"({"name":"w","role":"wms","robot_commands":false,"tokens_required":true})"},
+          std::pair{"op-secret", R"({"name":"o","role":"operator","robot_commands":true,"tokens_required":true})"}}) {
+      auto r = client.Get("/api/v1/session", {{"Authorization", std::string("Bearer ") + secret}});
+      ASSERT_TRUE(r);
+      EXPECT_EQ(r->status, 200);
+      EXPECT_EQ(r->body, body);
+    }
   }
+  auto server = DispatchServer::Start(TestConfig(dir.File("no-tokens.db")));
+  ASSERT_TRUE(server.ok()) << server.error().message;
+  httplib::Client client("127.0.0.1", (*server)->ports().http);
+  auto r = client.Get("/api/v1/session");
+  ASSERT_TRUE(r);
+  EXPECT_EQ(r->body, R"({"name":"","role":"admin","robot_commands":true,"tokens_required":false})");
 }
 
 TEST(HardeningTest, AHugeRobotIdIsQuotedClipped) {

@@ -2,7 +2,8 @@
 // engine/dispatch/robot_commands.h, DispatchCore::PlanCommand): each is a Change that changes
 // nothing until applied; out of service gives the robot's orders back and keeps it out of every
 // round until returned; pause keeps it out of rounds too; only an offline robot is cleared off
-// the floor; a robot sent to a station bids again once it is there.
+// the floor; a robot sent to a station bids again once it is there; the commands replay from
+// the core's journal.
 #include "engine/dispatch/robot_commands.h"
 
 #include <gtest/gtest.h>
@@ -13,7 +14,9 @@
 #include <vector>
 
 #include "dispatch_test_support.h"
+#include "engine/dispatch/core_replay.h"
 #include "engine/dispatch/dispatch_core.h"
+#include "engine/dispatch/journaled_core.h"
 
 namespace dispatch::engine {
 namespace {
@@ -203,6 +206,56 @@ TEST_F(RobotCommandsTest, MarksRestoredWithARobotKeepItOutOfRounds) {
   AddOrder("O1");
   EXPECT_FALSE(RunRound()) << "bid while out of service after a restart";
   EXPECT_EQ(core_->robot("R1")->marks.out_of_service_by, "op-2");
+}
+
+// Every command is a journal entry; a fresh core fed the journal (CoreReplay, as dispatch-sim
+// replay does) gives the same output for each, refusals included, and ends with the same marks.
+TEST(RobotCommandsJournalTest, CommandsReplayEntryByEntry) {
+  CoreOptions options;
+  JournaledCore core(testing_util::Chu2024Core(options), /*recording=*/true);
+  const auto parks = PointsOfKind(*Chu2024(), PointKind::kPark);
+  for (const auto& [id, at] : {std::pair{"R1", parks.at(0)}, std::pair{"R2", parks.at(1)}}) {
+    Robot r;
+    r.id = id;
+    r.current_point = at;
+    r.pose.position = Chu2024()->point(at).position;
+    (void)core.Connect(r, 0.0);
+  }
+  double now = 1.0;
+  auto command = [&](RobotCommandKind kind, const std::string& robot, PointId to = kNoPoint) {
+    Result<Change> c = core.PlanCommand({kind, robot, "op-1", to}, now += 1.0);
+    if (c.ok()) (void)core.Apply(*c);
+    return c.ok();
+  };
+  EXPECT_TRUE(command(RobotCommandKind::kPause, "R1"));
+  EXPECT_TRUE(command(RobotCommandKind::kSend, "R2", parks.at(3)));
+  EXPECT_TRUE(command(RobotCommandKind::kTakeOutOfService, "R1"));
+  EXPECT_FALSE(command(RobotCommandKind::kClear, "R2"));  // connected: refused, journaled too
+  core.Disconnect("R1");
+  EXPECT_TRUE(command(RobotCommandKind::kClear, "R1"));
+  EXPECT_TRUE(command(RobotCommandKind::kResume, "R1"));
+  const std::vector<JournalEntry> journal = core.TakeEntries();
+
+  ReplaySetup setup;
+  setup.map = Chu2024();
+  setup.routes = testing_util::Chu2024Routes();
+  setup.core = options;
+  auto replay = CoreReplay::Create(setup);
+  ASSERT_TRUE(replay.ok()) << replay.error().message;
+  std::size_t commands = 0;
+  for (const JournalEntry& e : journal) {
+    auto out = (*replay)->Feed(e);
+    ASSERT_TRUE(out.ok()) << out.error().message;
+    EXPECT_EQ(*out, e.output) << "entry " << e.seq << " (" << CoreInputKindName(e.input.kind) << ")";
+    if (e.input.kind == CoreInput::Kind::kPlanCommand) ++commands;
+  }
+  EXPECT_EQ(commands, 6u);
+  for (const char* id : {"R1", "R2"}) {
+    EXPECT_EQ((*replay)->core().robot(id)->marks, core.robot(id)->marks) << id;
+    EXPECT_EQ((*replay)->core().TripTo(id), core.core().TripTo(id)) << id;
+  }
+  EXPECT_EQ(core.robot("R1")->marks, (OperatorMarks{"", "op-1", true}));
+  EXPECT_EQ(core.core().TripTo("R2"), parks.at(3));
 }
 
 TEST(StationPointTest, AStationOrAParkOrChargePointByName) {
