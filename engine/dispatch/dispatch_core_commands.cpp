@@ -1,7 +1,6 @@
 // DispatchCore: operators' commands on robots (issue 18 §4, robot_commands.h): pause and
 // resume, out of service and back, clear off the floor, send to a station.
 #include "engine/dispatch/dispatch_core.h"
-#include "engine/dispatch/order_release.h"
 
 namespace dispatch::engine {
 
@@ -21,10 +20,7 @@ Result<Change> DispatchCore::PlanCommand(const OperatorCommand& command, double 
     case RobotCommandKind::kResume: marks.paused_by.clear(); break;
     case RobotCommandKind::kTakeOutOfService:
       marks.out_of_service_by = by;
-      if (r->has_assignment && !r->assignment.order_ids.empty()) {
-        c = PlanReleaseOf(r->assignment.order_ids, StateAfterRobotLoss, "robot " + id + " taken out of service by " + by,
-                          now);
-      }
+      c = PlanLoss(id, "robot " + id + " taken out of service by " + by, now);
       break;
     case RobotCommandKind::kReturnToService: marks.out_of_service_by.clear(); break;
     case RobotCommandKind::kClear:
@@ -34,10 +30,7 @@ Result<Change> DispatchCore::PlanCommand(const OperatorCommand& command, double 
                      "of service instead)"};
       }
       marks.off_floor = true;
-      if (r->has_assignment && !r->assignment.order_ids.empty()) {
-        c = PlanReleaseOf(r->assignment.order_ids, StateAfterRobotLoss,
-                          "robot " + id + " cleared off the floor by " + by, now);
-      }
+      c = PlanLoss(id, "robot " + id + " cleared off the floor by " + by, now);
       break;
     case RobotCommandKind::kSend: {
       Result<Change> sent = PlanTrip(*r, command.to, now);

@@ -28,13 +28,7 @@ class DispatchCoreTest : public ::testing::Test {
     rounds_ = testing_util::AuctionRounds();
   }
 
-  void ConnectRobot(const std::string& id, PointId at) {
-    Robot r;
-    r.id = id;
-    r.current_point = at;
-    r.pose.position = Chu2024()->point(at).position;
-    (void)core_->Connect(std::move(r), now_);
-  }
+  void ConnectRobot(const std::string& id, PointId at) { testing_util::ConnectAt(*core_, id, at, now_); }
 
   Order MakeOrder(const std::string& id) const {
     const auto picks = PointsOfKind(*Chu2024(), PointKind::kPick);

@@ -51,6 +51,15 @@ inline std::unique_ptr<RoundRunner> AuctionRounds() {
   return std::make_unique<RoundRunner>(Chu2024(), Chu2024Routes(), AllocationConfig{}, std::move(allocator).value());
 }
 
+// Robot `id` says Hello standing at point `at` (its plan messages, if any, are dropped).
+inline void ConnectAt(DispatchCore& core, const std::string& id, PointId at, double now) {
+  Robot r;
+  r.id = id;
+  r.current_point = at;
+  r.pose.position = Chu2024()->point(at).position;
+  (void)core.Connect(std::move(r), now);
+}
+
 // One allocation round, every award applied; false when there was nothing to allocate (no
 // accepted order, or no robot that may bid).
 inline bool ApplyRound(DispatchCore& core, RoundRunner& rounds, double now) {

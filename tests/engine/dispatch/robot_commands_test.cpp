@@ -36,13 +36,7 @@ class RobotCommandsTest : public ::testing::Test {
 
   PointId Park(std::size_t i) const { return PointsOfKind(*Chu2024(), PointKind::kPark).at(i); }
 
-  void ConnectRobot(const std::string& id, PointId at) {
-    Robot r;
-    r.id = id;
-    r.current_point = at;
-    r.pose.position = Chu2024()->point(at).position;
-    (void)core_->Connect(std::move(r), now_);
-  }
+  void ConnectRobot(const std::string& id, PointId at) { testing_util::ConnectAt(*core_, id, at, now_); }
 
   void AddOrder(const std::string& id) {
     Order o;
