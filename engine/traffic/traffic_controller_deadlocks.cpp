@@ -216,7 +216,11 @@ bool TrafficController::Impl::TryBackOff(std::size_t r, PointId avoid, PointId b
   for (ArcId a : M().out_arcs(x.at)) {
     const PointId n = M().arc(a).to;
     if (n == avoid || n == ban_point || PointBlocker(n, r) >= 0) continue;
-    if (M().IntersectionOf(n) >= 0) continue;
+    // Never into an intersection, but within the one it stands in (it holds its grant): a
+    // robot, or a formation, stopped inside an intersection before an exit that stays held
+    // backs off by the intersection's other exit.
+    const int g = M().IntersectionOf(n);
+    if (g >= 0 && g != M().IntersectionOf(x.at)) continue;
     const int c = CorridorOf(a);
     if (c >= 0 && CorridorBlocker(c, lanes.Direction(M(), a), r) >= 0) continue;
     std::vector<PointId> route{x.at};

@@ -308,6 +308,17 @@ void GateImpl::OnReached(GateBot& b, std::uint64_t seq, double t) {
       b.stepped_aside = false;  // idle where it arrived: may have to step aside again
       // Out of the formation's envelope around where it left the team: one agent of its own.
       const double envelope = config.point_clearance + FormationRadius();
+      // A robot of one of the teams it left (every one it forgets below), in it or left it
+      // too, whichever of its own former teams that is for it (found by the safety check:
+      // a former teammate whose newest former team was another was not looked at).
+      auto former_mate = [&](const GateBot& o) {
+        if (&o == &b) return false;
+        for (const std::string* k : {&b.former_team, &b.older_former, &b.oldest_former}) {
+          if (k->empty()) continue;
+          if (o.team == *k || o.former_team == *k || o.older_former == *k || o.oldest_former == *k) return true;
+        }
+        return false;
+      };
       auto teammates_out = [&] {  // nobody of its former team still stands in a slot there
         if (b.former_at == kNoPoint) return true;
         const Eigen::Vector2d& d = map->point(b.former_at).position;
@@ -317,14 +328,22 @@ void GateImpl::OnReached(GateBot& b, std::uint64_t seq, double t) {
         }
         return true;
       };
-      // Nor beside one of them where it arrived: exempt from them, it may have driven up to one
-      // closer than eps1 (found by the safety check: a member of a broken-up team arrived
-      // 0.400 m from a former teammate and lost the exemption there).
+      // Nor beside one of them where it arrived, or where one of them drives to: exempt from
+      // them, it may have driven up to one closer than eps1, or one may have been let drive up to
+      // it (found by the safety check: a member of a broken-up team arrived 0.400 m from a former
+      // teammate and lost the exemption there; Tables 1+2 x10 at 0.4 s steps, a former teammate
+      // was sent, in the step it arrived, to a point 0.500 m from it).
       auto none_beside = [&] {
         const Eigen::Vector2d& here = map->point(ctl.At(r)).position;
         for (const auto& [id, o] : bots) {
-          if (&o == &b || (o.former_team != b.former_team && o.team != b.former_team)) continue;
+          if (!former_mate(o)) continue;
           if (o.has_xy && (o.xy - here).norm() < config.point_clearance - 1e-9) return false;
+          const PointId next = o.ctl >= 0 && !ctl.removed(static_cast<std::size_t>(o.ctl))
+                                   ? ctl.Next(static_cast<std::size_t>(o.ctl))
+                                   : kNoPoint;
+          if (next != kNoPoint && (map->point(next).position - here).norm() < config.point_clearance - 1e-9) {
+            return false;
+          }
         }
         return true;
       };
@@ -336,6 +355,10 @@ void GateImpl::OnReached(GateBot& b, std::uint64_t seq, double t) {
         b.older_former.clear();
         b.oldest_former.clear();
         ctl.SetEnvelope(r, 0.0);
+        // At once: a former teammate asking later in this step is no longer exempt from it
+        // (found by the safety check, Tables 1+2 x10 at 0.4 s steps: one was sent to a point
+        // 0.500 m from it in the step it drove off its team).
+        SetGroups(b);
       }
     }
   }

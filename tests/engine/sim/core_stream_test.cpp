@@ -294,6 +294,34 @@ TEST(CoreStreamTest, AMemberStuckFarFromItsRendezvousIsNoTeammateOnceTheTeamBrea
   EXPECT_GE(r->completed * 10, orders.size() * 9) << r->completed << " of " << orders.size();
 }
 
+// The same burst in coarse steps, as a service's tick at a time scale drives it (0.4 s and
+// 0.5 s instead of 0.1 s), checked on true positions. Found here: in the step a member of a
+// broken-up team drove out of its former team and lost the exemption, a former teammate that
+// asked later in the step was still exempt from it and was sent to a point 0.500 m from it
+// (0.4 s); a formation stopped inside intersection I5-4 before a drop that stayed held closed
+// a wait cycle nobody in it could back off from, and 21 orders failed blocked (0.5 s: 119/140,
+// now 140/140; the controller backs it off through the intersection's other exit).
+TEST(CoreStreamTest, TheBurstInCoarseStepsStaysSafeAndFailsOnlyBlocked) {
+  const World w = Chu();
+  const std::vector<Order> orders = Repeated(w, {"chu2024-table1.csv", "chu2024-table2.csv"}, 10);
+  for (double dt : {0.4, 0.5}) {
+    SCOPED_TRACE("dt " + std::to_string(dt));
+    StreamConfig c = ProductFormationConfig();
+    c.time_step = dt;
+    auto r = SimulateOnCore(w.map, w.routes, Fleet(w, 18), orders, c);
+    ASSERT_TRUE(r.ok()) << r.error().message;
+    ExpectSane(w, orders, *r, c);
+    for (const StreamOrderOutcome& o : r->orders) {
+      if (!o.completed) {
+        EXPECT_NE(o.failure.find("blocked"), std::string::npos) << o.order_id << ": " << o.failure;
+      }
+    }
+    ASSERT_TRUE(r->safety.has_value());
+    EXPECT_TRUE(r->safety->ok()) << r->safety->violations.front().Describe();
+    EXPECT_GE(r->completed * 5, orders.size() * 4) << r->completed << " of " << orders.size();
+  }
+}
+
 // A team whose order goes before its drop (a member blocked, the orders put back) leaves the
 // point it stands on one member at a time, as after a drop, its agent's envelope over the
 // slots until each has driven off (GateImpl::DissolveTeam); one with no way off within T_w2

@@ -372,6 +372,49 @@ TEST(TrafficControllerTest, IntersectionNeedsAGrantAndReleasesItBehind) {
   EXPECT_EQ(third.Request(cross, 2.0), TrafficDecision::kGo);
 }
 
+// A robot stopped inside an intersection before an exit that stays held backs off by the
+// intersection's other exit when it closes a wait cycle (it holds the grant; backing off never
+// enters an intersection otherwise). Found in the Chu2024 burst (Tables 1+2 x10, 0.5 s steps): a
+// formation at X11-9 inside I5-4 waited for D-T5, where the team before it waited for a member
+// whose way out led back through I5-4: 21 orders failed blocked, none with the back-off.
+TEST(TrafficControllerTest, ARobotInsideAnIntersectionBacksOffByItsOtherExit) {
+  MapBuilder b("loop");
+  b.SetFloor({-1, -1}, {11, 11});
+  b.AddRectZone("z", {-1, -1}, {11, 11});
+  b.AddPoint("W", {2, 5}, PointKind::kLane);
+  b.AddPoint("C1", {5, 5}, PointKind::kIntersection);
+  b.AddPoint("C2", {6, 5}, PointKind::kIntersection);
+  b.AddPoint("D", {5, 8}, PointKind::kLane);
+  b.AddPoint("E", {9, 5}, PointKind::kLane);
+  b.AddPoint("S", {5, 1}, PointKind::kLane);
+  b.AddPath("W", "C1");
+  b.AddPath("C1", "D");
+  b.AddPath("D", "W");
+  b.AddPath("C1", "C2");
+  b.AddPath("C2", "E");
+  b.AddPath("E", "S");
+  b.AddPath("S", "W");
+  b.AddIntersection("X", {"C1", "C2"}, {"W"});
+  MapBuildOptions options;
+  options.check_service_connectivity = false;
+  auto built = b.Build(options);
+  ASSERT_TRUE(built.ok()) << built.error().message;
+  auto map = std::make_shared<const WarehouseMap>(std::move(built).value());
+  TrafficController ctl = Make(map);
+  const std::size_t h = *ctl.AddRobot("H", P(*map, "D"));  // works at D, waits on A
+  ctl.SetWorking(h, true, 1e9);
+  ctl.SetIdle(h, false);
+  const std::size_t a = *ctl.AddRobot("A", P(*map, "C1"));  // inside X, holds its grant
+  ASSERT_TRUE(ctl.SetRoute(a, Route(*map, {"C1", "D"})).ok());
+  EXPECT_EQ(ctl.Request(a, 0.0), TrafficDecision::kWait);
+  EXPECT_EQ(ctl.WaitsOn(a), static_cast<int>(h));
+  ctl.WaitOn(h, static_cast<int>(a), 0.0, "waiting for a member A holds up");
+  EXPECT_EQ(ctl.ResolveDeadlocks(0.0), 1u);
+  EXPECT_EQ(ctl.Request(a, 0.0), TrafficDecision::kGo);
+  EXPECT_EQ(ctl.Next(a), P(*map, "C2"));
+  EXPECT_EQ(ctl.RemainingRoute(a), Route(*map, {"C1", "C2", "E", "S", "W", "C1", "D"}));
+}
+
 // Wang2019 §3.2 step 4: a robot waiting on a held point waits T_w2, then re-plans a route
 // around the point if one exists. Cells of a 5-wide grid are c<row * 5 + column>.
 TEST(TrafficControllerTest, AWaitOnAHeldPointRePlansAfterTw2) {
