@@ -313,9 +313,10 @@ class Harness(contextlib.AbstractContextManager):
         check(r.returncode == 0, f"wmsctl exited {r.returncode}")
         return r.stdout
 
-    def submit_file(self, server, path):
-        """wmsctl submit FILE; returns [(client id, order id, state, created)] in file order."""
-        out = self.wmsctl(server, "submit", path)
+    def submit_file(self, server, path, prefix=None):
+        """wmsctl submit FILE [--prefix P]; returns [(client id, order id, state, created)] in
+        file order."""
+        out = self.wmsctl(server, "submit", path, *(["--prefix", prefix] if prefix else []))
         rows = []
         for line in out.splitlines():
             m = re.match(r"^(\S+)\s+->\s+(\S+)\s+(\S+)\s+(created|already submitted)", line)
