@@ -366,6 +366,15 @@ class Harness(contextlib.AbstractContextManager):
             call.cancel()
         raise TestFailure(f"the watch ended before {what}")
 
+    def check_min_distance(self, server, eps1=0.6):
+        """The closest approach the dispatcher saw between robots of different agents (REST
+        /api/v1/status) is at least eps1."""
+        closest = server.rest("/api/v1/status")["traffic"].get("min_robot_distance")
+        check(closest is not None, "no minimum distance measured")
+        check(closest["distance"] >= eps1 - 1e-6,
+              f"robots {closest['robot_ids']} came {closest['distance']:.6f} m close at t = {closest['time']:.1f} s "
+              f"(eps1 = {eps1} m)")
+
     def log_traffic(self, server):
         """Logs every robot's traffic state (REST /api/v1/traffic), for a failure's report."""
         try:

@@ -55,14 +55,8 @@ def main():
             robots = server.rest("/api/v1/robots")["robots"]
             return all("FAULT" not in str(r.get("state", "")).upper() for r in robots)
         h.wait_for(none_in_fault, timeout=60, what="every robot back in service")
-        status = server.rest("/api/v1/status")
-        h.log(f"status: {status}")
-        traffic = status["traffic"]
-        closest = traffic.get("min_robot_distance")
-        check(closest is not None, "no minimum distance measured")
-        check(closest["distance"] >= EPS1 - 1e-6,
-              f"robots {closest['robot_ids']} came {closest['distance']:.6f} m close at t = {closest['time']:.1f} s "
-              f"(eps1 = {EPS1} m)")
+        h.log(f"status: {server.rest('/api/v1/status')}")
+        h.check_min_distance(server, EPS1)
 
 
 if __name__ == "__main__":

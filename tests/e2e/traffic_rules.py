@@ -66,11 +66,7 @@ def main():
         h.log(f"traffic: {traffic}")
         check(traffic["control"], "traffic control is off")
         check(int(traffic["grants"]) > 100, f"only {traffic['grants']} grants: waypoints were not released by the controller")
-        closest = traffic.get("min_robot_distance")
-        check(closest is not None, "no minimum distance measured")
-        check(closest["distance"] >= EPS1 - 1e-6,
-              f"robots {closest['robot_ids']} came {closest['distance']:.6f} m close at t = {closest['time']:.1f} s "
-              f"(eps1 = {EPS1} m)")
+        h.check_min_distance(server, EPS1)
 
 
 if __name__ == "__main__":

@@ -277,10 +277,14 @@ TEST(CoreStreamTest, MembersOnTheirWayStayExemptFromEachOtherWhenTheirTeamBreaks
 // to it at 0.400 m (t = 1770 s). Since teams broken up leave their point one member at a time
 // and a member left in its slot is seen where it stands, nothing waits for ever either: the
 // orders that fail say they were blocked.
-TEST(CoreStreamTest, AMemberStuckFarFromItsRendezvousIsNoTeammateOnceTheTeamBreaksUp) {
+// The burst of seed Tables 1 and 2 ten times at once on 18 robots, with the product's formation
+// settings and time step `dt`: sane, safe on true positions, every order that fails says it was
+// blocked, and at least `share` of them complete.
+void ExpectBurstEndsSafely(double dt, double share) {
   const World w = Chu();
   const std::vector<Order> orders = Repeated(w, {"chu2024-table1.csv", "chu2024-table2.csv"}, 10);
-  const StreamConfig c = ProductFormationConfig();
+  StreamConfig c = ProductFormationConfig();
+  c.time_step = dt;
   auto r = SimulateOnCore(w.map, w.routes, Fleet(w, 18), orders, c);
   ASSERT_TRUE(r.ok()) << r.error().message;
   ExpectSane(w, orders, *r, c);
@@ -291,7 +295,12 @@ TEST(CoreStreamTest, AMemberStuckFarFromItsRendezvousIsNoTeammateOnceTheTeamBrea
   }
   ASSERT_TRUE(r->safety.has_value());
   EXPECT_TRUE(r->safety->ok()) << r->safety->violations.front().Describe();
-  EXPECT_GE(r->completed * 10, orders.size() * 9) << r->completed << " of " << orders.size();
+  EXPECT_GE(static_cast<double>(r->completed), share * static_cast<double>(orders.size()))
+      << r->completed << " of " << orders.size();
+}
+
+TEST(CoreStreamTest, AMemberStuckFarFromItsRendezvousIsNoTeammateOnceTheTeamBreaksUp) {
+  ExpectBurstEndsSafely(0.1, 0.9);
 }
 
 // The same burst in coarse steps, as a service's tick at a time scale drives it (0.4 s and
@@ -302,23 +311,9 @@ TEST(CoreStreamTest, AMemberStuckFarFromItsRendezvousIsNoTeammateOnceTheTeamBrea
 // a wait cycle nobody in it could back off from, and 21 orders failed blocked (0.5 s: 119/140,
 // now 140/140; the controller backs it off through the intersection's other exit).
 TEST(CoreStreamTest, TheBurstInCoarseStepsStaysSafeAndFailsOnlyBlocked) {
-  const World w = Chu();
-  const std::vector<Order> orders = Repeated(w, {"chu2024-table1.csv", "chu2024-table2.csv"}, 10);
   for (double dt : {0.4, 0.5}) {
     SCOPED_TRACE("dt " + std::to_string(dt));
-    StreamConfig c = ProductFormationConfig();
-    c.time_step = dt;
-    auto r = SimulateOnCore(w.map, w.routes, Fleet(w, 18), orders, c);
-    ASSERT_TRUE(r.ok()) << r.error().message;
-    ExpectSane(w, orders, *r, c);
-    for (const StreamOrderOutcome& o : r->orders) {
-      if (!o.completed) {
-        EXPECT_NE(o.failure.find("blocked"), std::string::npos) << o.order_id << ": " << o.failure;
-      }
-    }
-    ASSERT_TRUE(r->safety.has_value());
-    EXPECT_TRUE(r->safety->ok()) << r->safety->violations.front().Describe();
-    EXPECT_GE(r->completed * 5, orders.size() * 4) << r->completed << " of " << orders.size();
+    ExpectBurstEndsSafely(dt, 0.8);
   }
 }
 
