@@ -148,6 +148,7 @@ Result<std::string> EncodeRunSetup(const RunSetup& s) {
                  {"traffic_control", s.core.traffic_control},
                  {"one_formation_per_pick", s.core.one_formation_per_pick},
                  {"blocked_recovery", s.core.blocked_recovery},
+                 {"max_give_backs", s.core.max_give_backs},
                  {"speed", t.speed},
                  {"point_clearance", t.point_clearance},
                  {"t_w1", t.t_w1},
@@ -209,6 +210,7 @@ Result<RunSetup> DecodeRunSetup(const std::string& text) {
     s.core.traffic_control = k.at("traffic_control").get<bool>();
     s.core.one_formation_per_pick = k.value("one_formation_per_pick", false);
     s.core.blocked_recovery = k.value("blocked_recovery", 0.0);  // journals before it: never
+    s.core.max_give_backs = k.value("max_give_backs", 0);         // journals before it: no limit
     engine::TrafficControllerConfig& t = s.core.traffic;
     t.speed = k.at("speed").get<double>();
     t.point_clearance = k.at("point_clearance").get<double>();

@@ -113,7 +113,19 @@ Result<Change> DispatchCore::PlanCancel(const std::string& order_id, const std::
 Change DispatchCore::PlanLoss(const std::string& id, const std::string& why, double now) {
   const BookRobot* r = robot(id);
   if (!r || !r->has_assignment || r->assignment.order_ids.empty()) return Change{now, {}, {}, {}, {}, 0, {}};
-  return PlanReleaseOf(r->assignment.order_ids, StateAfterRobotLoss, why, now);
+  const std::string at = id + "@" + std::to_string(r->robot.current_point);
+  const int max = options_.max_give_backs;
+  Change c = PlanReleaseOf(r->assignment.order_ids, StateAfterRobotLoss, why, now);
+  for (OrderChange& line : c.orders) {
+    if (line.to != OrderState::kAccepted) continue;
+    line.lost_at = at;
+    const BookOrder* o = order(line.order_id);
+    if (max <= 0 || o->lost_at != at || o->lost_there < max) continue;
+    line.to = OrderState::kFailed;
+    line.robots.reset();
+    line.detail = why + " (given back " + std::to_string(o->lost_there) + " times in a row by " + id + " there)";
+  }
+  return c;
 }
 
 Change DispatchCore::PlanReleaseOf(const std::vector<std::string>& order_ids,
@@ -316,7 +328,13 @@ void DispatchCore::ApplyOrder(const OrderChange& line) {
   copy->state = *line.to;
   b.order = std::move(copy);
   if (line.robots) b.robots = *line.robots;
-  if (*line.to == OrderState::kAccepted) allocation_due_ = true;  // back for re-allocation
+  if (*line.to == OrderState::kAccepted) {  // back for re-allocation
+    if (!line.lost_at.empty()) {
+      b.lost_there = b.lost_at == line.lost_at ? b.lost_there + 1 : 1;
+      b.lost_at = line.lost_at;
+    }
+    allocation_due_ = true;
+  }
   // A formation at its first pick: the next formation to that pick may be allocated (MakeRound).
   if (options_.one_formation_per_pick && *line.to == OrderState::kInProgress && b.order->formation) {
     allocation_due_ = true;

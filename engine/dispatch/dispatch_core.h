@@ -64,6 +64,13 @@ struct CoreOptions {
   // controller may block it again). A block is a traffic verdict, not a fault of the robot: it
   // still reports and drives. 0: it stays in fault until it says Hello again.
   double blocked_recovery = 60.0;
+  // Times in a row an order may go back to accepted from the same robot lost at the same
+  // point (PlanLoss: blocked, offline, out of service); the next such loss fails it, saying
+  // why. A jam the controller cannot clear would otherwise hand the order back to the robot
+  // nearest to it, which blocks there again, for ever (found on the Chu2024 burst through the
+  // service). Losses elsewhere do not count: on the dense grids orders given back a dozen
+  // times by different robots still complete. 0: no limit.
+  int max_give_backs = 3;
 };
 
 // An open order as the core dispatches it.
@@ -72,6 +79,8 @@ struct BookOrder {
   std::vector<std::string> robots;     // serving it, leader first; empty while accepted
   std::set<std::string> dropped_by;    // team members that reported the drop
   double distance = 0.0;               // metres driven for it so far
+  std::string lost_at;                 // "robot@point" of its last loss (PlanLoss)
+  int lost_there = 0;                  // losses in a row with that key
 };
 
 struct BookRobot {
@@ -97,6 +106,7 @@ struct OrderChange {
   std::string detail;                              // journaled; the reason when cancelled/failed
   std::optional<double> distance;                  // completed: metres driven for it
   std::size_t award = kNoAward;                    // assigned: index into the round's awards
+  std::string lost_at;                             // accepted by PlanLoss: "robot@point" lost at
   static constexpr std::size_t kNoAward = static_cast<std::size_t>(-1);
 };
 
@@ -227,7 +237,8 @@ class DispatchCore {
   // its robots go back to accepted.
   Result<Change> PlanCancel(const std::string& order_id, const std::string& reason, double now);
   // Gives back every order of a lost or blocked robot (started ones fail, the others are
-  // re-allocated, engine::StateAfterRobotLoss). Empty when it has none.
+  // re-allocated, engine::StateAfterRobotLoss; one lost by this robot at this point
+  // CoreOptions::max_give_backs times in a row already fails). Empty when it has none.
   Change PlanLoss(const std::string& robot, const std::string& why, double now);
 
   // --- Allocation rounds -----------------------------------------------------------------

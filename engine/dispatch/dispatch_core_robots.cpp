@@ -155,7 +155,7 @@ TaskOutcome DispatchCore::PlanTask(const std::string& id, const TaskReport& repo
   std::optional<OrderChange> start = StartLine(report.order_id, detail);
   if (start) c.orders.push_back(*start);
   if (!report.dropped) {
-    if (!start) c.orders.push_back({report.order_id, std::nullopt, std::nullopt, detail, std::nullopt, OrderChange::kNoAward});
+    if (!start) c.orders.push_back({report.order_id, std::nullopt, std::nullopt, detail, std::nullopt, OrderChange::kNoAward, {}});
     return out;
   }
   DropOutcome drop = PlanDrop(r->assignment, report.order_id, id, team, o->dropped_by);
@@ -164,7 +164,7 @@ TaskOutcome DispatchCore::PlanTask(const std::string& id, const TaskReport& repo
     c.plans.emplace(id, std::move(drop.plan));
   }
   c.dropped_by[report.order_id] = std::move(drop.dropped_by);
-  OrderChange line{report.order_id, std::nullopt, std::nullopt, detail, std::nullopt, OrderChange::kNoAward};
+  OrderChange line{report.order_id, std::nullopt, std::nullopt, detail, std::nullopt, OrderChange::kNoAward, {}};
   if (drop.complete) {
     line.to = OrderState::kCompleted;
     line.distance = o->distance;

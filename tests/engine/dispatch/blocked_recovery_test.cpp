@@ -1,6 +1,8 @@
 // DispatchCore's blocked robots (CoreOptions::blocked_recovery): a robot the traffic controller
 // blocks is in fault, an obstacle out of every auction, and its orders go back; after
 // blocked_recovery seconds it is in service again (0: it stays in fault until its next Hello).
+// An order given back CoreOptions::max_give_backs times in a row by the same robot at the same
+// point fails at its next loss there.
 #include <gtest/gtest.h>
 
 #include <functional>
@@ -24,10 +26,11 @@ class BlockedRecoveryTest : public ::testing::Test {
  protected:
   // R1 at a parking point gets an order whose pick an offline robot stands on: it waits there
   // with no alternative and is blocked after kBlockedAfter.
-  void Build(double recovery) {
+  void Build(double recovery, int max_give_backs = 3) {
     CoreOptions options;
     options.traffic.blocked_after = kBlockedAfter;
     options.blocked_recovery = recovery;
+    options.max_give_backs = max_give_backs;
     core_ = testing_util::Chu2024Core(options);
     rounds_ = testing_util::AuctionRounds();
 
@@ -80,7 +83,8 @@ class BlockedRecoveryTest : public ::testing::Test {
       StepOutcome step = core_->Step(now_);
       for (const auto& [id, why] : step.blocked) {
         blocked_at_ = now_;
-        (void)core_->Apply(core_->PlanLoss(id, "robot " + id + " blocked: " + why, now_));
+        last_loss_ = core_->PlanLoss(id, "robot " + id + " blocked: " + why, now_);
+        (void)core_->Apply(last_loss_);
       }
       if (until(step)) return;
     }
@@ -90,6 +94,7 @@ class BlockedRecoveryTest : public ::testing::Test {
   std::unique_ptr<RoundRunner> rounds_;
   double now_ = 0.0;
   std::optional<double> blocked_at_;
+  Change last_loss_;
 };
 
 TEST_F(BlockedRecoveryTest, ABlockedRobotIsBackInServiceAfterTheRecoveryTime) {
@@ -155,6 +160,39 @@ TEST_F(BlockedRecoveryTest, WithoutRecoveryABlockedRobotStaysInFaultUntilItsNext
   ASSERT_TRUE(blocked_at_.has_value()) << core_->gate()->Describe("R1");
   EXPECT_GE(*blocked_at_ - hello_at, kBlockedAfter);
   EXPECT_EQ(core_->order("O1")->order->state, OrderState::kAccepted);
+}
+
+TEST_F(BlockedRecoveryTest, AnOrderLostMaxTimesInARowAtOnePointFailsAtItsNextLossThere) {
+  // The pick stays taken for ever: without the limit R1 would get O1 back, block, and so on.
+  Build(10.0, /*max_give_backs=*/2);
+  for (int loss = 1; loss <= 3; ++loss) {
+    SCOPED_TRACE("loss " + std::to_string(loss));
+    blocked_at_.reset();
+    RunUntil(now_ + 100.0, [&](const StepOutcome&) { return blocked_at_.has_value(); });
+    ASSERT_TRUE(blocked_at_.has_value()) << core_->gate()->Describe("R1");
+    ASSERT_EQ(last_loss_.orders.size(), 1u);
+    const OrderChange& line = last_loss_.orders.front();
+    EXPECT_EQ(line.order_id, "O1");
+    if (loss == 3) {
+      EXPECT_EQ(line.to, OrderState::kFailed);
+      EXPECT_NE(line.detail.find("robot R1 blocked: "), std::string::npos) << line.detail;
+      EXPECT_NE(line.detail.find("(given back 2 times in a row by R1 there)"), std::string::npos) << line.detail;
+      EXPECT_EQ(core_->order("O1"), nullptr) << "a failed order leaves the book";
+      break;
+    }
+    EXPECT_EQ(line.to, OrderState::kAccepted);
+    EXPECT_EQ(core_->order("O1")->lost_there, loss);
+    // Back in service, R1 gets it again.
+    bool recovered = false;
+    RunUntil(now_ + 100.0, [&](const StepOutcome& step) {
+      for (const std::string& id : step.recovered) recovered = recovered || id == "R1";
+      return recovered;
+    });
+    ASSERT_TRUE(recovered);
+    ASSERT_TRUE(RunRound());
+    EXPECT_EQ(core_->order("O1")->robots, std::vector<std::string>{"R1"});
+  }
+  EXPECT_EQ(core_->robot("R1")->robot.state, RobotState::kFault);
 }
 
 }  // namespace
