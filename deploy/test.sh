@@ -5,8 +5,10 @@
 # DISPATCH_SANITIZERS=0 skips them too.
 set -euo pipefail
 cd "$(dirname "$0")/.."
-DISPATCH_TEST_DEPS=1 bash deploy/setup.sh build build -DCMAKE_BUILD_TYPE=RelWithDebInfo -DDISPATCH_BUILD_TESTS=ON \
-  -DDISPATCH_WERROR=ON
+# -O2 without debug information: the same code as RelWithDebInfo, compiled and linked faster
+# (the sanitizer builds keep -g1 for their reports).
+DISPATCH_TEST_DEPS=1 bash deploy/setup.sh build build -DCMAKE_BUILD_TYPE=RelWithDebInfo \
+  "-DCMAKE_CXX_FLAGS_RELWITHDEBINFO=-O2 -DNDEBUG" -DDISPATCH_BUILD_TESTS=ON -DDISPATCH_WERROR=ON
 ctest --test-dir build --output-on-failure -j "$(nproc)" "$@"
 if [ $# -eq 0 ] && [ "${DISPATCH_SANITIZERS:-1}" = 1 ]; then
   bash deploy/sanitizers.sh
