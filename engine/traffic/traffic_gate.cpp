@@ -264,7 +264,6 @@ void TrafficGate::Unblock(const std::string& robot, double t) {
   if (!b) return;
   b->blocked = false;
   if (b->team.empty() && impl_->OnFloor(*b)) impl_->ctl.RestartWaitClock(static_cast<std::size_t>(b->ctl), t);
-  if (b->unplaced_since >= 0.0) b->unplaced_since = t;
 }
 
 void TrafficGate::Reached(const std::string& robot, std::uint64_t sequence, double t,
@@ -336,7 +335,6 @@ bool TrafficGate::Paused(const std::string& robot) const {
 
 bool TrafficGate::Available(const std::string& robot) const {
   const GateBot* bot = impl_->Find(robot);
-  if (bot && bot->unplaced_blocked && !impl_->OnFloor(*bot)) return false;
   return !bot || bot->team.empty() || impl_->teams.count(bot->team) == 0 ||
          impl_->teams.at(bot->team).phase != GateTeam::Phase::kLeaving;
 }

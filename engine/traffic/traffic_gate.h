@@ -156,8 +156,7 @@ class TrafficGate {
   // Updates the minimum distance from the robots' last reported positions (O(robots)).
   void SampleDistances(double t);
 
-  // False while the robot still stands in a finished formation's slot, waiting to leave it,
-  // or stands off the floor where it was blocked for want of a free point near it.
+  // False while the robot still stands in a finished formation's slot, waiting to leave it.
   bool Available(const std::string& robot) const;
   // How many teams have ended while leaving their drop (their members Available again): the
   // owner runs an allocation round when it changes (nothing else says they may bid again).

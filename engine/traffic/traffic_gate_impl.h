@@ -66,10 +66,6 @@ struct GateBot {
   // and when it last tried (a try after a pause starts the clock again).
   std::string forming;
   double forming_since = 0.0, forming_last = 0.0;
-  // Since when it has stood off the floor with no point to be placed on (-1: on the floor),
-  // and whether it was blocked for it since (then it is not Available until placed).
-  double unplaced_since = -1.0;
-  bool unplaced_blocked = false;
   PointId home = kNoPoint;  // the parking point it first connected at
   std::string team;       // the formation order whose team it has joined ("": none)
   // The team it left (at point former_at), until it has driven out of the team's envelope.
@@ -230,9 +226,6 @@ struct GateImpl {
   void HoldPaused(GateBot& b, std::vector<GateEffect>& out);
   // Reports b blocked (once per blocked spell) and holds it: `why` names what it waits for.
   void Block(GateBot& b, const std::string& why, std::vector<GateEffect>& out);
-  // b stands off the floor and could not be placed at t: blocked once it has waited so for
-  // blocked_after while a team it is a member of has begun to form without it.
-  void TimeUnplaced(GateBot& b, double t, std::vector<GateEffect>& out);
 
   // Solo agents (traffic_gate_solo.cpp).
   bool OnFloor(const GateBot& b) const;

@@ -5,7 +5,6 @@
 #include <algorithm>
 #include <optional>
 #include <cmath>
-#include <cstdio>
 #include <limits>
 #include <numbers>
 #include <unordered_map>
@@ -93,9 +92,9 @@ void GateImpl::StepSolo(GateBot& b, double t, std::vector<GateEffect>& out) {
       if (RejoinTeam(b, inside->first, inside->second, t, out)) return;
     }
   }
-  if (!OnFloor(b) && !PlaceNear(b)) return TimeUnplaced(b, t, out);
-  b.unplaced_since = -1.0;
-  b.unplaced_blocked = false;
+  if (!OnFloor(b)) {
+    if (!PlaceNear(b)) return;
+  }
   const auto r = static_cast<std::size_t>(b.ctl);
   const auto& w = b.plan.waypoints;
   const long n = static_cast<long>(w.size());
@@ -255,31 +254,6 @@ void GateImpl::Block(GateBot& b, const std::string& why, std::vector<GateEffect>
     out.push_back(std::move(e));
   }
   Hold(b, "blocked: " + why, out);
-}
-
-// A stray (a broken-up team's member in its slot) that no point near it can take waits where
-// it stands, unseen by the controller's deadlock breaking; a formation that has it as a
-// member waits for it. Found on the burst through the service: a stray beside a dock whose
-// nearest points a former teammate and robots waiting on it held kept its next formation at
-// its pick for ever. Once such a team has begun to form without it, it is blocked after
-// blocked_after like any robot that cannot move on (its orders go back), and given nothing
-// more until it is placed (TrafficGate::Available): each new order would go back the same
-// way. Measured on 300 random orders with 30% formations, seeds 1-25 (`--max-time 3000`):
-// 7,075 completed and 147 open at the limit, 7,034 and 186 before; blocking every stray with
-// waypoints to reach, or keeping each out of the auctions, did worse.
-void GateImpl::TimeUnplaced(GateBot& b, double t, std::vector<GateEffect>& out) {
-  if (b.unplaced_since < 0.0) b.unplaced_since = t;
-  bool waited_for = false;  // a team it is a member of has begun to form without it
-  for (const auto& [order, team] : teams) {
-    waited_for = waited_for || (!team.joined.empty() && !team.joined.count(b.id) &&
-                                std::find(team.members.begin(), team.members.end(), b.id) != team.members.end());
-  }
-  if (!waited_for || !b.connected || !b.paused_by.empty() || t - b.unplaced_since < config.blocked_after) return;
-  char buf[128];
-  std::snprintf(buf, sizeof buf, "blocked after waiting %.0f s off the floor at (%.2f, %.2f): no free point near it",
-                t - b.unplaced_since, b.xy.x(), b.xy.y());
-  b.unplaced_blocked = true;
-  Block(b, buf, out);
 }
 
 // The controller changed a standing solo robot's route (detour, back-off, nudge): rewrite
