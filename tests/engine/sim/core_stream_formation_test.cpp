@@ -7,7 +7,6 @@
 #include <cstdio>
 #include <iterator>
 #include <map>
-#include <optional>
 #include <set>
 #include <string>
 #include <vector>
@@ -105,25 +104,6 @@ TEST(CoreStreamFormationTest, TablesOneAndTwoFormationsGatherAndMoveAsOneRigidAg
   }
 }
 
-// A stream run with the product's formation settings and the safety check: sane, and safe on
-// the robots' true positions (nullopt after a failed assertion).
-std::optional<StreamResult> RunSafeWithProductSettings(const World& w, const Stream& st, AllocationStrategy strategy,
-                                                       double max_time) {
-  StreamConfig c;
-  c.strategy = strategy;
-  c.max_time = max_time;
-  c.check_safety = true;
-  c.allocation.formation_max_queue = 1;
-  c.one_formation_per_pick = true;
-  auto r = SimulateOnCore(w.map, w.routes, st.robots, st.orders, c);
-  EXPECT_TRUE(r.ok()) << r.error().message;
-  if (!r.ok()) return std::nullopt;
-  ExpectSane(w, st.orders, *r, c);
-  EXPECT_TRUE(r->safety.has_value() && r->safety->ok())
-      << (r->safety && !r->safety->ok() ? r->safety->violations.front().Describe() : "no safety check");
-  return std::move(r).value();
-}
-
 // 200 random orders with 20% formation orders on the Chu2024 floor, 18 robots, seeds 1-3,
 // auction and greedy, with the product's formation settings: every run is safe on the robots'
 // true positions, every order that fails says it was blocked, a completed formation had three
@@ -135,8 +115,17 @@ TEST(CoreStreamFormationTest, RandomStreamsWithFormationsOnChu2024) {
     const Stream st = ChuStream(w, 200, seed, 0.2);
     for (AllocationStrategy strategy : {AllocationStrategy::kAuction, AllocationStrategy::kGreedy}) {
       SCOPED_TRACE("seed " + std::to_string(seed) + " " + AllocationStrategyName(strategy));
-      auto r = RunSafeWithProductSettings(w, st, strategy, 5000);
-      ASSERT_TRUE(r.has_value());
+      StreamConfig c;
+      c.strategy = strategy;
+      c.max_time = 5000;
+      c.check_safety = true;
+      c.allocation.formation_max_queue = 1;
+      c.one_formation_per_pick = true;
+      auto r = SimulateOnCore(w.map, w.routes, st.robots, st.orders, c);
+      ASSERT_TRUE(r.ok()) << r.error().message;
+      ExpectSane(w, st.orders, *r, c);
+      ASSERT_TRUE(r->safety.has_value());
+      EXPECT_TRUE(r->safety->ok()) << r->safety->violations.front().Describe();
       for (std::size_t i = 0; i < st.orders.size(); ++i) {
         const StreamOrderOutcome& o = r->orders[i];
         if (!o.completed) {
