@@ -36,8 +36,10 @@
 //  - routing = floyd: the rules planner's routes are the route table's. heat: each single-robot
 //    award's legs are routed again by Wang2019's heat-weighted Dijkstra over the lanes the
 //    round's plans use in the next heat_period = 60 s (the seed leaves δ open; a minute spans a
-//    few tasks on the Chu2024 floor). Bids keep the table's costs; the time-window planner
-//    keeps its own routes.
+//    few tasks on the Chu2024 floor). The bids price those routes: before its auction a round
+//    prices T_d and samples the traffic prediction along the heat-weighted routes of the plans
+//    it starts with (UseHeatRoutes, engine/dispatch/heat_awards.h). The time-window planners
+//    keep their own routes and the table's bids.
 //  - work_time_override: unset = every order's own t_w (Order::work_time, 5 s by default,
 //    see kDefaultWorkTime); set = one t_w for every order, as in the paper.
 // Plain value; validate with ValidateAllocationConfig. Thread-safe to share.

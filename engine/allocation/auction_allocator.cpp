@@ -216,7 +216,9 @@ double AuctionAllocator::FlowBound(const FleetState& state, std::size_t robot, P
 
 bool AuctionAllocator::CostsAreSampledTimes(const RouteTable& routes, double speed) {
   const RouteTableBuildInfo info = routes.build_info();
-  return info.method == "lazy" && !info.turn_expanded && info.speed == speed;
+  // A weighted table (routing = heat) costs the route its NextHop follows at the same arc
+  // times: the sampler's times too.
+  return (info.method == "lazy" || info.method == "weighted") && !info.turn_expanded && info.speed == speed;
 }
 
 RouteSampler& AuctionAllocator::Sampler(const FleetState& state) {

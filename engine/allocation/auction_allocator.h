@@ -55,9 +55,9 @@ class AuctionAllocator final : public Allocator {
   std::vector<Bid> ComputeReachBids(const FleetState& state, PointId first_pick,
                                     std::size_t keep = 0);
 
-  // True when the table's costs are exactly the sampler's travel times: a lazy table (double
-  // sums, from the destination outward as RouteSampler::TimeToTarget adds them), no turn
-  // penalty, the allocation's speed.
+  // True when the table's costs are exactly the sampler's travel times: a lazy table, plain or
+  // weighted (double sums, from the destination outward as RouteSampler::TimeToTarget adds
+  // them), no turn penalty, the allocation's speed.
   static bool CostsAreSampledTimes(const RouteTable& routes, double speed);
 
  private:

@@ -8,6 +8,16 @@
 
 namespace dispatch::engine {
 
+Status FleetState::UseRoutes(std::shared_ptr<const RouteTable> routes) {
+  if (!routes) return InvalidArgument("fleet state: null route table");
+  if (routes->point_count() != map_->point_count()) {
+    return InvalidArgument("fleet state: a route table of " + std::to_string(routes->point_count()) +
+                           " points for a map of " + std::to_string(map_->point_count()));
+  }
+  routes_ = std::move(routes);
+  return Ok();
+}
+
 Result<FleetState> FleetState::Create(std::shared_ptr<const WarehouseMap> map,
                                       std::shared_ptr<const RouteTable> routes,
                                       const std::vector<FleetRobot>& robots,

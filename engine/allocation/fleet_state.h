@@ -97,6 +97,9 @@ class FleetState {
 
   const WarehouseMap& map() const { return *map_; }
   const RouteTable& routes() const { return *routes_; }
+  // From now on plans and costs (bids) use `routes` (a round's heat-weighted table); the plans
+  // made so far stay as they are. kInvalidArgument for null or a table of another map size.
+  Status UseRoutes(std::shared_ptr<const RouteTable> routes);
   const AllocationConfig& config() const { return config_; }
   const TrafficPredictor& predictor() const { return *predictor_; }
   const std::shared_ptr<const ZoneIndex>& zone_index() const { return predictor_->zone_index(); }

@@ -70,6 +70,11 @@ RoundResult RoundRunner::Run(const RoundInput& input) {
     if (input.robots[i].has_queue()) ReplayQueue(state, i, input.robots[i], out.notes);
     state.Publish(i);
   }
+  if (config_.routing == RoutingKind::kHeat && config_.planner == PlannerKind::kRules && !input.pending.empty()) {
+    if (Status s = UseHeatRoutes(map_, config_, state, input.now); !s.ok()) {
+      out.notes.push_back("allocation: heat routes not used for the bids: " + s.error().message);
+    }
+  }
   RoundSegments segments;  // where each robot's new work begins (the time-window planner)
   segments.first_new.assign(input.robots.size(), static_cast<std::size_t>(-1));
   segments.in_formation.assign(input.robots.size(), false);

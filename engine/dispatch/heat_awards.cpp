@@ -28,6 +28,20 @@ std::vector<LaneUse> UsesOf(const WarehouseMap& map, const FleetState& fleet) {
 
 }  // namespace
 
+Status UseHeatRoutes(std::shared_ptr<const WarehouseMap> map, const AllocationConfig& config, FleetState& fleet,
+                     double now) {
+  const PathHeat heat = PathHeat::FromUses(*map, UsesOf(*map, fleet), now, config.heat_period);
+  bool hot = false;
+  for (std::size_t lane = 0; lane < heat.lanes() && !hot; ++lane) hot = heat.Weight(lane) != 1.0;
+  if (!hot) return Ok{};
+  RouteTableOptions options;
+  options.speed = config.speed;
+  options.turn_penalty_s = config.turn_time;
+  auto table = HeatRouteTable(std::move(map), heat, options);
+  if (!table.ok()) return table.error();
+  return fleet.UseRoutes(std::shared_ptr<const RouteTable>(std::move(table).value()));
+}
+
 void RouteAwardsByHeat(const WarehouseMap& map, const AllocationConfig& config, const FleetState& fleet,
                        const RoundSegments& segments, double now, std::vector<RoundAward>& awards,
                        std::vector<std::string>& notes) {

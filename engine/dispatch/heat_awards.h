@@ -6,6 +6,11 @@
 // §4.1), timed at the allocation's speed with the turns and the stops' work times. Formation
 // awards keep their routes (a member's next single-robot segment starts where its formation
 // segment ends). Pure; the awards are rewritten.
+//
+// Before the auction (UseHeatRoutes) the round's fleet state takes a heat-weighted route table
+// built from the plans the round starts with, so the bids price the routes the robots will
+// drive (T_d, and the traffic prediction's samples along them): issue 16 §1, "usable by the
+// auction's route costs".
 #pragma once
 
 #include <memory>
@@ -18,6 +23,12 @@
 #include "engine/dispatch/window_awards.h"
 
 namespace dispatch::engine {
+
+// From now on `fleet` plans and prices with the heat-weighted routes (HeatRouteTable) of the
+// lanes its plans use in [now, now + heat_period]; with no lane used it keeps its table.
+// Errors: those of HeatRouteTable and FleetState::UseRoutes (the fleet then keeps its table).
+Status UseHeatRoutes(std::shared_ptr<const WarehouseMap> map, const AllocationConfig& config, FleetState& fleet,
+                     double now);
 
 void RouteAwardsByHeat(const WarehouseMap& map, const AllocationConfig& config, const FleetState& fleet,
                        const RoundSegments& segments, double now, std::vector<RoundAward>& awards,

@@ -11,6 +11,7 @@
 #include <utility>
 
 #include "engine/routing/cost_graph.h"
+#include "engine/routing/lazy_route_table.h"
 
 namespace dispatch::engine {
 
@@ -111,6 +112,16 @@ Result<Route> HeatRoute(const WarehouseMap& map, const PathHeat& heat, PointId f
     last = a;
   }
   return r;
+}
+
+Result<std::unique_ptr<RouteTable>> HeatRouteTable(std::shared_ptr<const WarehouseMap> map, const PathHeat& heat,
+                                                   const RouteTableOptions& options) {
+  if (!map) return InvalidArgument("heat route table: null map");
+  std::vector<double> weight(map->arcs().size());
+  for (std::size_t a = 0; a < weight.size(); ++a) weight[a] = heat.ArcWeight(*map, static_cast<ArcId>(a));
+  auto table = LazyRouteTable::BuildWeighted(std::move(map), options, weight);
+  if (!table.ok()) return table.error();
+  return std::unique_ptr<RouteTable>(std::move(table).value());
 }
 
 }  // namespace dispatch::engine

@@ -14,6 +14,7 @@
 #pragma once
 
 #include <cstddef>
+#include <memory>
 #include <vector>
 
 #include "engine/common/result.h"
@@ -57,5 +58,12 @@ class PathHeat {
 // Route::length the metres. Errors: kNotFound (unknown point), kUnreachable.
 Result<Route> HeatRoute(const WarehouseMap& map, const PathHeat& heat, PointId from, PointId to, double speed,
                         double turn_s_per_90 = 0.0, ArcId arrived_by = -1);
+
+// Step 5 as a route table (a weighted LazyRouteTable: one reverse search per destination, on
+// demand): its routes are HeatRoute's for a robot standing (heading unknown), and Cost is their
+// unweighted time, what a robot driving them takes. For the auction's bids under routing =
+// heat (engine/dispatch/allocation_round.cpp). `options`: speed, turn_penalty_s, cache bound.
+Result<std::unique_ptr<RouteTable>> HeatRouteTable(std::shared_ptr<const WarehouseMap> map, const PathHeat& heat,
+                                                   const RouteTableOptions& options);
 
 }  // namespace dispatch::engine

@@ -12,6 +12,12 @@
 // its entry alive even if another thread evicts it. Each thread remembers the last entry it
 // looked up (per table), so a run of queries towards one destination (walking a route, a
 // bid's robots) takes the lock once.
+//
+// Weighted (BuildWeighted): the routes minimise the drive time of each map arc times its
+// weight (plus the turn penalties, unweighted), and Cost answers the unweighted time of that
+// route (what a robot driving it takes): Wang2019's heat-weighted Dijkstra (seed 004 §3.1
+// step 5) as a table, for the auction's bids (engine/planning/path_heat.h, HeatRouteTable).
+// method() is then "weighted".
 #pragma once
 
 #include <cstdint>
@@ -19,6 +25,7 @@
 #include <memory>
 #include <mutex>
 #include <unordered_map>
+#include <vector>
 
 #include "engine/routing/cost_graph.h"
 #include "engine/routing/route_table.h"
@@ -29,6 +36,11 @@ class LazyRouteTable final : public RouteTable {
  public:
   static Result<std::unique_ptr<LazyRouteTable>> Build(std::shared_ptr<const WarehouseMap> map,
                                                        const RouteTableOptions& options);
+  // `arc_weight`: one finite weight >= 1 per map arc (kInvalidArgument naming the arc
+  // otherwise, or for a vector of another size).
+  static Result<std::unique_ptr<LazyRouteTable>> BuildWeighted(std::shared_ptr<const WarehouseMap> map,
+                                                               const RouteTableOptions& options,
+                                                               const std::vector<double>& arc_weight);
 
   std::size_t point_count() const override { return graph_.point_count; }
   double Cost(PointId from, PointId to) const override;
@@ -36,7 +48,7 @@ class LazyRouteTable final : public RouteTable {
   Result<Route> Path(PointId from, PointId to) const override;
   void Prepare(PointId to) const override;
   const double* CostsTo(PointId to) const override;
-  std::string_view method() const override { return "lazy"; }
+  std::string_view method() const override { return weighted_ ? "weighted" : "lazy"; }
   RouteTableBuildInfo build_info() const override;
 
   // Cache statistics, for tests and monitoring.
@@ -47,6 +59,13 @@ class LazyRouteTable final : public RouteTable {
   struct Entry {
     std::vector<double> dist;       // per searched vertex: cost to the destination
     std::vector<std::int32_t> via;  // per searched vertex: first graph arc towards it, or -1
+    // Weighted tables: per searched vertex, the unweighted cost of its route (dist is the
+    // weighted one); empty otherwise.
+    std::vector<double> time;
+    std::size_t bytes() const {
+      return (dist.size() + time.size()) * sizeof(double) + via.size() * sizeof(std::int32_t);
+    }
+    const std::vector<double>& cost() const { return time.empty() ? dist : time; }
   };
   LazyRouteTable();
   bool Known(PointId p) const { return p >= 0 && static_cast<std::size_t>(p) < graph_.point_count; }
@@ -57,9 +76,14 @@ class LazyRouteTable final : public RouteTable {
   struct LastLookup;
   static LastLookup& Last();
   std::shared_ptr<const Entry> Find(PointId to) const;    // the cache, or a new search
+  std::vector<double> UnweightedCosts(const std::vector<double>& dist, const std::vector<std::int32_t>& via) const;
 
   std::shared_ptr<const WarehouseMap> map_;
   MapCostGraph graph_;
+  // Weighted tables: graph_'s arcs with the weighted costs the searches run on (graph_ keeps
+  // the unweighted ones, for Cost and Path).
+  bool weighted_ = false;
+  CostGraph search_graph_;
   std::size_t cache_bytes_ = 0;
   const std::uint64_t id_;  // unique per table ever built (the per-thread last entry's key)
 

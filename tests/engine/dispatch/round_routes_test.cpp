@@ -4,6 +4,9 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
+#include <memory>
+#include <utility>
 #include <map>
 #include <string>
 #include <vector>
@@ -11,6 +14,8 @@
 #include "engine/dispatch/heat_awards.h"
 #include "engine/dispatch/strategy.h"
 #include "engine/dispatch/window_awards.h"
+#include "engine/map/map_builder.h"
+#include "engine/planning/path_heat.h"
 #include "engine/planning/time_windows.h"
 #include "tests/engine/dispatch/dispatch_test_support.h"
 
@@ -164,6 +169,68 @@ TEST(RoundRoutes, PlannersInTheWindowsLeaveNoConflictAmongTheRoundsRoutes) {
       }
     }
   }
+}
+
+// Heat in the bids (issue 16 §1): under routing = heat a robot's bid prices the route it will
+// drive, Wang2019's step 5 over the lanes the plans use in the next heat_period. A floor with
+// two ways from S to T: the straight lanes S-M-T (2 m) and round by L (2.33 m). W's plan
+// drives S -> T -> S, so both straight lanes are hot (h = 2, b = 1: w = 1 + 2 * 2 / 4 = 2) and
+// the heat route from S to T goes round by L. B, idle at P beside S, bids for an order from T
+// to D: its T_d is 1 + 2.33 + 1 s at 1 m/s under heat (HeatRoute's times, recomputed here),
+// 4 s by the table's shortest routes.
+TEST(RoundRoutes, UnderHeatRoutingTheBidsPriceTheHeatRoutes) {
+  MapBuilder builder("two-ways");
+  builder.SetFloor({-2.0, -2.0}, {4.0, 1.0});
+  builder.AddRectZone("all", {-2.0, -2.0}, {4.0, 1.0});
+  builder.AddPoint("P", {-1.0, 0.0}, PointKind::kPark);
+  builder.AddPoint("S", {0.0, 0.0}, PointKind::kLane);
+  builder.AddPoint("M", {1.0, 0.0}, PointKind::kLane);
+  builder.AddPoint("L", {1.0, -0.6}, PointKind::kLane);
+  builder.AddPoint("T", {2.0, 0.0}, PointKind::kPick);
+  builder.AddPoint("D", {3.0, 0.0}, PointKind::kDrop);
+  for (const auto& [a, b] : std::vector<std::pair<std::string, std::string>>{
+           {"P", "S"}, {"S", "M"}, {"M", "T"}, {"S", "L"}, {"L", "T"}, {"T", "D"}}) {
+    builder.AddPath(a, b, std::nullopt, 0.0, true);
+  }
+  const auto map = std::make_shared<const WarehouseMap>(builder.Build().value());
+  auto at = [&](const char* name) { return *map->FindPoint(name); };
+  const std::shared_ptr<const RouteTable> table = MakeRouteTable(map, RouteTableOptions{}).value();
+  AllocationConfig config;
+  config.routing = RoutingKind::kHeat;
+  const std::vector<FleetRobot> robots = {{"B", at("P"), 0.0}, {"W", at("S"), 0.0}};
+  auto fleet = [&] {
+    FleetState f = FleetState::Create(map, table, robots, config).value();
+    EXPECT_TRUE(f.AssignSingle(1, "w", f.TaskOf({at("T")}, at("S"), 5.0)).ok());
+    return f;
+  };
+  FleetState plain = fleet(), hot = fleet();
+  ASSERT_TRUE(UseHeatRoutes(map, config, hot, 0.0).ok());
+  EXPECT_EQ(hot.routes().method(), "weighted");
+  const auto order = MakeOrder("o", at("T"), at("D"), 0.0);
+  const auto by_table = MakeAllocator("auction").value()->Allocate(*order, plain).value();
+  const auto by_heat = MakeAllocator("auction").value()->Allocate(*order, hot).value();
+  // The heat of W's plan, recomputed from its waypoints.
+  std::vector<LaneUse> uses;
+  const auto& w = plain.plan(1).waypoints;
+  for (std::size_t k = 1; k < w.size(); ++k) {
+    if (const auto a = map->FindArc(w[k - 1].point, w[k].point)) uses.push_back({*a, 1, w[k - 1].departure()});
+  }
+  const PathHeat heat = PathHeat::FromUses(*map, uses, 0.0, config.heat_period);
+  EXPECT_DOUBLE_EQ(heat.ArcWeight(*map, *map->FindArc(at("S"), at("M"))), 2.0);
+  const double round_by_l = 2.0 * std::hypot(1.0, 0.6);
+  EXPECT_NEAR(by_table.bids.at(0).t_d, 4.0, 1e-9);
+  EXPECT_NEAR(by_heat.bids.at(0).t_d, 2.0 + round_by_l, 1e-9);
+  EXPECT_NEAR(by_heat.bids.at(0).t_d,
+              HeatRoute(*map, heat, at("P"), at("T"), 1.0)->cost + HeatRoute(*map, heat, at("T"), at("D"), 1.0)->cost,
+              1e-9);
+  EXPECT_GE(by_heat.bids.at(1).t_d, by_table.bids.at(1).t_d - 1e-9);
+  // B's plan for the order goes round by L.
+  const auto& b = hot.plan(0).waypoints;
+  EXPECT_TRUE(std::any_of(b.begin(), b.end(), [&](const Waypoint& x) { return x.point == at("L"); }));
+  // Nothing planned: no lane is hot, the fleet keeps its table.
+  FleetState idle = FleetState::Create(map, table, robots, config).value();
+  ASSERT_TRUE(UseHeatRoutes(map, config, idle, 0.0).ok());
+  EXPECT_EQ(idle.routes().method(), table->method());
 }
 
 TEST(RoundRoutes, NamesRoundTripAndBadSettingsAreRefused) {

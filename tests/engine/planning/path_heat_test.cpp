@@ -111,5 +111,40 @@ TEST(PathHeatTest, TurningTimeMakesRoutesTurnOnce) {
   EXPECT_DOUBLE_EQ(slow_turns->cost, 7.0);  // unweighted: 2 s driving + 5 s turning
 }
 
+// The table form (the auction's costs under routing = heat): the cold one of two equal
+// routes, costed at its drive time; HeatRoute's routes wherever the heat sends them.
+TEST(PathHeatTest, TheHeatTableRoutesAsHeatRouteAndCostsTheDriveTime) {
+  const auto map = GridMap({"....", ".@..", "....", "..@."});
+  std::vector<LaneUse> uses;
+  for (int robot = 0; robot < 3; ++robot) {
+    uses.push_back({*map->FindArc(At(*map, 0, 0), At(*map, 0, 1)), robot, 1.0 + robot});
+    uses.push_back({*map->FindArc(At(*map, 3, 0), At(*map, 3, 1)), robot, 2.0});
+  }
+  const PathHeat heat = PathHeat::FromUses(*map, uses, 0.0, 60.0);
+  RouteTableOptions options;
+  const auto table = HeatRouteTable(map, heat, options).value();
+  EXPECT_EQ(table->method(), "weighted");
+  const auto south_first = table->Path(At(*map, 0, 0), At(*map, 2, 2)).value();
+  EXPECT_EQ(south_first.points[1], At(*map, 1, 0));
+  EXPECT_DOUBLE_EQ(table->Cost(At(*map, 0, 0), At(*map, 2, 2)), 4.0);
+  // Every pair: the weighted length of the table's route is HeatRoute's (the same optimum).
+  auto weighted = [&](const Route& r) {
+    double sum = 0.0;
+    for (ArcId a : r.arcs) sum += heat.ArcWeight(*map, a) * map->arc(a).length;
+    return sum;
+  };
+  for (PointId u = 0; u < static_cast<PointId>(map->point_count()); ++u) {
+    for (PointId v = 0; v < static_cast<PointId>(map->point_count()); ++v) {
+      const auto expected = HeatRoute(*map, heat, u, v, 1.0);
+      const auto got = table->Path(u, v);
+      ASSERT_EQ(expected.ok(), got.ok()) << u << "->" << v;
+      if (!got.ok()) continue;
+      EXPECT_NEAR(weighted(*got), weighted(*expected), 1e-9) << u << "->" << v;
+      EXPECT_DOUBLE_EQ(table->Cost(u, v), got->cost);
+      EXPECT_DOUBLE_EQ(got->cost, got->length);  // 1 m/s, no turning time
+    }
+  }
+}
+
 }  // namespace
 }  // namespace dispatch::engine

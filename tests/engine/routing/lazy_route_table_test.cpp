@@ -3,6 +3,10 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
+#include <limits>
+#include <numbers>
+#include <random>
 #include <thread>
 
 #include "engine/routing/floyd_route_table.h"
@@ -50,6 +54,49 @@ TEST_P(LazyRouteTableModelTest, SameAnswersAsTheDenseTableAndReference) {
     }
   }
   EXPECT_EQ(lazy->searches(), map->point_count());  // one search per destination
+}
+
+// Weighted (Wang2019's path heat as a table): the routes are the cheapest by weighted drive
+// time plus turns (the reference with the weights), and Cost is what driving them takes
+// (ExpectValidRoute recomputes it unweighted), never less than the shortest time.
+TEST_P(LazyRouteTableModelTest, WeightedRoutesAreTheCheapestWeightedAndCostTheirDriveTime) {
+  const LazyCase c = GetParam();
+  const auto map = RandomMap(c.seed, c.side);
+  RouteTableOptions options;
+  options.speed = 0.8;
+  options.turn_penalty_s = c.penalty;
+  std::mt19937 rng(c.seed);
+  std::uniform_real_distribution<double> heat(1.0, 3.0);
+  std::vector<double> weight(map->arcs().size());
+  for (double& w : weight) w = heat(rng);
+  const auto table = LazyRouteTable::BuildWeighted(map, options, weight).value();
+  EXPECT_EQ(table->method(), "weighted");
+  EXPECT_EQ(table->build_info().method, "weighted");
+  int longer = 0;
+  const auto n = static_cast<PointId>(map->point_count());
+  for (PointId u = 0; u < n; ++u) {
+    const std::vector<double> shortest = ReferenceCosts(*map, u, options.speed, c.penalty);
+    const std::vector<double> weighted = ReferenceCosts(*map, u, options.speed, c.penalty, &weight);
+    for (PointId v = 0; v < n; ++v) {
+      const auto vi = static_cast<std::size_t>(v);
+      ExpectValidRoute(*map, *table, u, v, options.speed, c.penalty);
+      if (::testing::Test::HasFatalFailure()) return;
+      ASSERT_EQ(std::isinf(table->Cost(u, v)), std::isinf(shortest[vi])) << u << "->" << v;
+      if (std::isinf(shortest[vi]) || u == v) continue;
+      const Route r = table->Path(u, v).value();
+      double w_sum = 0.0;
+      for (std::size_t i = 0; i < r.arcs.size(); ++i) {
+        const Arc& a = map->arc(r.arcs[i]);
+        w_sum += weight[static_cast<std::size_t>(r.arcs[i])] * a.length /
+                 (a.max_speed > 0 ? std::min(options.speed, a.max_speed) : options.speed);
+        if (i > 0) w_sum += c.penalty * TurnAngle(*map, r.arcs[i - 1], r.arcs[i]) / (std::numbers::pi / 2);
+      }
+      ASSERT_NEAR(w_sum, weighted[vi], 1e-9 * std::max(1.0, w_sum)) << u << "->" << v;
+      ASSERT_GE(table->Cost(u, v), shortest[vi] - 1e-9 * std::max(1.0, shortest[vi])) << u << "->" << v;
+      if (table->Cost(u, v) > shortest[vi] + 1e-6) ++longer;
+    }
+  }
+  EXPECT_GT(longer, 0);  // the weights send some routes round
 }
 
 INSTANTIATE_TEST_SUITE_P(RandomMaps, LazyRouteTableModelTest,
@@ -199,6 +246,27 @@ TEST(LazyRouteTableTest, ErrorsNameBothPoints) {
   EXPECT_EQ(lazy->NextHop(0, -3), kNoPoint);
   EXPECT_EQ(lazy->searches(), 0u);
   EXPECT_EQ(LazyRouteTable::Build(nullptr, {}).error().code, ErrorCode::kInvalidArgument);
+}
+
+TEST(LazyRouteTableTest, WeightsAreOnePerArcFiniteAndAtLeastOne) {
+  const auto map = RandomMap(5, 4);
+  const RouteTableOptions options;
+  const std::size_t arcs = map->arcs().size();
+  auto error = [&](std::vector<double> w) { return LazyRouteTable::BuildWeighted(map, options, w).error().message; };
+  EXPECT_NE(error(std::vector<double>(arcs + 1, 1.0)).find("arc weights for"), std::string::npos);
+  std::vector<double> w(arcs, 1.0);
+  w[2] = 0.5;
+  EXPECT_NE(error(w).find("arc 2 has weight"), std::string::npos);
+  w[2] = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_NE(error(w).find("arc 2"), std::string::npos);
+  // All weights 1: the plain table's costs.
+  const auto plain = LazyRouteTable::Build(map, options).value();
+  const auto ones = LazyRouteTable::BuildWeighted(map, options, std::vector<double>(arcs, 1.0)).value();
+  for (PointId u = 0; u < static_cast<PointId>(map->point_count()); ++u) {
+    for (PointId v = 0; v < static_cast<PointId>(map->point_count()); ++v) {
+      EXPECT_DOUBLE_EQ(plain->Cost(u, v), ones->Cost(u, v)) << u << "->" << v;
+    }
+  }
 }
 
 }  // namespace

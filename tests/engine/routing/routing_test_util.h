@@ -84,14 +84,15 @@ inline std::shared_ptr<const WarehouseMap> RandomMap(unsigned seed, int side) {
 }
 
 // Independent reference: per-source Dijkstra over (point, arrival arc) states, written without
-// the library's cost graph. Cost of an arc = length / min(speed, max_speed); turns cost
-// penalty * angle / 90 degrees.
+// the library's cost graph. Cost of an arc = length / min(speed, max_speed), times its
+// weight when `weight` (one per map arc) is given; turns cost penalty * angle / 90 degrees.
 inline std::vector<double> ReferenceCosts(const WarehouseMap& map, PointId source, double speed,
-                                          double penalty) {
+                                          double penalty, const std::vector<double>* weight = nullptr) {
   const std::size_t p = map.point_count();
   auto arc_cost = [&](ArcId a) {
     const Arc& arc = map.arc(a);
-    return arc.length / (arc.max_speed > 0 ? std::min(speed, arc.max_speed) : speed);
+    const double w = weight ? (*weight)[static_cast<std::size_t>(a)] : 1.0;
+    return w * arc.length / (arc.max_speed > 0 ? std::min(speed, arc.max_speed) : speed);
   };
   auto heading = [&](ArcId a) {
     const Arc& arc = map.arc(a);
