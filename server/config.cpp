@@ -59,6 +59,7 @@ std::vector<Key> Keys() {
       MakeKey("blocked_recovery", &ServerConfig::blocked_recovery),
       MakeKey("priority", &ServerConfig::priority),
       MakeKey("head_on_priority", &ServerConfig::head_on_priority),
+      MakeKey("head_on_give_way", &ServerConfig::head_on_give_way),
       MakeKey("route_cache_mb", &ServerConfig::route_cache_mb),
       MakeKey("finished_retained", &ServerConfig::finished_retained),
       MakeKey("journal_runs", &ServerConfig::journal_runs),
@@ -201,6 +202,9 @@ engine::Result<ParsedCommandLine> ParseCommandLine(int argc, char** argv) {
       ->capture_default_str();
   app.add_option("--head-on-priority", flags.head_on_priority,
                  "Give way at a free corridor to a higher-priority robot about to enter it (Wang2019 case 1)")
+      ->capture_default_str();
+  app.add_option("--head-on-give-way", flags.head_on_give_way,
+                 "A waiting robot met head-on by a higher-priority one drives off its way (Wang2019 case 2)")
       ->capture_default_str();
   app.add_option("--routing", flags.routing, "floyd | heat (Wang2019 path heat, rules planner)")->capture_default_str();
   app.add_option("--heat-period", flags.heat_period, "Path heat: the period δ the lanes' use is counted over, s")

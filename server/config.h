@@ -56,6 +56,9 @@ struct ServerConfig {
   // Wang2019 §3.3 case ①: at a free single-lane corridor a robot gives way to one of higher
   // priority about to enter it from the other end (TrafficControllerConfig::head_on_priority).
   bool head_on_priority = false;
+  // Wang2019 §3.3 case ②: a waiting robot met head-on by one of higher priority drives to the
+  // nearest free point off its way and waits there (TrafficControllerConfig::head_on_give_way).
+  bool head_on_give_way = false;
   // Bound of the lazy route table's per-destination cache (large grid floors, where a dense
   // all-pairs table does not fit), MiB. It should hold the destinations in use at once (every
   // robot's next stop): on a 38k-cell floor one destination takes 0.46 MB.

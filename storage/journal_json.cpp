@@ -158,7 +158,8 @@ Result<std::string> EncodeRunSetup(const RunSetup& s) {
                  {"intersection_grants", t.intersection_grants},
                  {"head_on", HeadOnName(t.head_on)},
                  {"priority_by_release", t.priority_by_release},
-                 {"head_on_priority", t.head_on_priority}};
+                 {"head_on_priority", t.head_on_priority},
+                 {"head_on_give_way", t.head_on_give_way}};
     j["route_cache_bytes"] = s.route_cache_bytes;
     j["time_scale"] = s.time_scale;
     return j.dump();
@@ -221,6 +222,7 @@ Result<RunSetup> DecodeRunSetup(const std::string& text) {
     t.intersection_grants = k.at("intersection_grants").get<bool>();
     t.priority_by_release = k.value("priority_by_release", false);  // journals before it: by index
     t.head_on_priority = k.value("head_on_priority", false);        // journals before it: first come
+    t.head_on_give_way = k.value("head_on_give_way", false);        // journals before it: no give-way
     const std::string head_on = k.at("head_on").get<std::string>();
     bool known = false;
     for (auto p : {engine::HeadOnPolicy::kChooseFaster, engine::HeadOnPolicy::kAlwaysWait,

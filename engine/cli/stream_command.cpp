@@ -105,6 +105,7 @@ StreamConfig ConfigOf(const StreamArgs& a, const std::string& strategy, double z
   c.allocation.heat_period = a.heat_period;
   c.traffic.priority_by_release = a.priority == "release";
   c.traffic.head_on_priority = a.head_on_priority;
+  c.traffic.head_on_give_way = a.head_on_give_way;
   c.one_formation_per_pick = a.one_formation_per_pick;
   c.blocked_recovery = a.blocked_recovery;
   c.check_safety = a.check_safety;
@@ -141,10 +142,10 @@ void PrintSummary(const std::string& label, const StreamResult& r) {
               label.c_str(), r.completed, r.orders.size(), r.makespan, r.throughput_per_hour,
               r.mean_completion);
   std::printf("  distance %.1f m, waiting %.1f s, stops %zu, re-plans %zu, grants %zu, "
-              "deadlocks resolved %zu, nudges %zu, head-on %zu, min distance %.3f m\n",
+              "deadlocks resolved %zu, nudges %zu, head-on %zu, give-ways %zu, min distance %.3f m\n",
               r.total_distance, r.total_waiting_time, r.stops, r.traffic.replans,
               r.traffic.grants, r.traffic.deadlocks_resolved, r.traffic.nudges,
-              r.traffic.head_on_conflicts, r.overall_min_distance);
+              r.traffic.head_on_conflicts, r.traffic.give_ways, r.overall_min_distance);
   if (!r.min_pair.empty()) std::printf("  closest: %s at %.1f s\n", r.min_pair.c_str(), r.min_time);
   if (r.safety) {
     std::printf("  safety check: %zu violations\n", r.safety->violations.size());
@@ -297,6 +298,9 @@ StreamCommands AddStreamCommands(CLI::App& app, StreamArgs& stream_args, StreamA
         ->capture_default_str()->check(CLI::IsMember({"index", "release"}));
     c->add_option("--head-on-priority", a.head_on_priority,
                   "Wang2019 case 1: give way at a free corridor to a higher-priority robot about to enter it (true|false)")
+        ->capture_default_str();
+    c->add_option("--head-on-give-way", a.head_on_give_way,
+                  "Wang2019 case 2: a waiting robot met head-on by a higher-priority one drives off its way (true|false)")
         ->capture_default_str();
     c->add_option("--heat-period", a.heat_period, "Path heat: the period δ the lanes' use is counted over, s")
         ->capture_default_str()->check(CLI::PositiveNumber);

@@ -34,6 +34,7 @@ struct StreamArgs {
   double heat_period = 60.0;               // path heat: δ, s
   std::string priority = "index";          // TrafficControllerConfig::priority_by_release
   bool head_on_priority = false;           // TrafficControllerConfig::head_on_priority
+  bool head_on_give_way = false;           // TrafficControllerConfig::head_on_give_way
 };
 
 struct StreamCommands {

@@ -82,6 +82,10 @@ struct TrafficControllerConfig {
   // or detours, as on a head-on) to a robot of higher priority that would enter it from the
   // other end before it is through; false: the corridor goes to whoever claims it first.
   bool head_on_priority = false;
+  // Wang2019 §3.3 case ②: of two robots head-on where one stands waiting, a waiting robot of
+  // lower priority drives to the nearest free point off the other's way and waits there until
+  // it has passed (at most T_w1); false: the wait-for cycle's detour or one-point back-off.
+  bool head_on_give_way = false;
   Status Validate() const;
 };
 
@@ -103,6 +107,7 @@ struct TrafficStats {
   std::size_t deadlocks_resolved = 0;  // wait-for cycles broken
   std::size_t nudges = 0;              // idle robots stepped aside
   std::size_t head_on_conflicts = 0;
+  std::size_t give_ways = 0;           // waiting robots moved off a higher one's way (case ②)
   std::vector<HeadOnRecord> head_on;   // first 1000 decisions
 };
 

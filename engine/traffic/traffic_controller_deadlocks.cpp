@@ -323,6 +323,9 @@ bool TrafficController::Impl::BreakCycle(const std::vector<std::size_t>& members
   for (std::size_t v : order) {
     RobotState& x = robots[v];
     if (x.working || x.next != kNoPoint || t < x.next_break_try) continue;
+    for (std::size_t u : members) {  // Wang2019 §3.3 case ②: it gives way to the one waiting for it
+      if (robots[u].waits_on == static_cast<int>(v) && MayGiveWay(v, u, t) && GiveWay(v, u, t)) return true;
+    }
     const PointId want = x.pos + 1 < x.route.size() ? x.route[x.pos + 1] : kNoPoint;
     const bool ok =
         x.wait == WaitKind::kCorridor ? TryDetour(v, kNoPoint, x.wait_corridor, -1, true)
@@ -351,6 +354,19 @@ std::size_t TrafficController::Impl::ResolveDeadlocks(double t) {
       path.push_back(static_cast<std::size_t>(v));
       const RobotState& x = robots[static_cast<std::size_t>(v)];
       v = x.wait != WaitKind::kNone ? x.waits_on : -1;
+    }
+    // Wang2019 §3.3 case ②: along the chain, a waiting robot that waits for another than the
+    // one waiting for it (those pairs are cycles, below) gives way to it when it may.
+    bool gave_way = false;
+    for (std::size_t i = 0; config.head_on_give_way && i + 1 < path.size() && !gave_way; ++i) {
+      const std::size_t w = path[i], h = path[i + 1];
+      if (robots[h].waits_on == static_cast<int>(w) || t < robots[h].next_break_try || !MayGiveWay(h, w, t)) continue;
+      gave_way = GiveWay(h, w, t);
+      if (!gave_way) robots[h].next_break_try = t + 1.0;
+    }
+    if (gave_way) {
+      ++broken;
+      continue;
     }
     if (v >= 0 && walk[static_cast<std::size_t>(v)] == walk_id) {
       auto it = std::find(path.begin(), path.end(), static_cast<std::size_t>(v));

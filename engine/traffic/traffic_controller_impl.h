@@ -57,6 +57,14 @@ struct RobotState {
   int wait_corridor = -1;
   int head_on_decided = -1;  // corridor whose head-on was decided in this wait
   std::string why;
+  // Giving way (Wang2019 §3.3 case ②, GiveWay): to this robot (-1: none), until then at most.
+  int give_way_to = -1;
+  double give_way_until = 0.0;
+  // The robot it last gave way to and when: it gives way to the same one again only after
+  // blocked_after (a second meeting soon after is left to the cycle breaking, else two robots
+  // meet, part and meet again for ever).
+  int gave_way_to = -1;
+  double gave_way_at = 0.0;
   // What `why` was formatted from when a keyed wait wrote it (WaitFor): the same key again
   // leaves the text as it is (a waiting robot asks every step); any other write clears it.
   WhyKey why_key;
@@ -273,6 +281,16 @@ struct TrafficController::Impl {
   bool MakeRoom(std::size_t h, const std::vector<PointId>& keep);
   bool StandingIdle(std::size_t r) const;
   bool BreakCycle(const std::vector<std::size_t>& members, double t);
+  // Wang2019 §3.3 case ② (traffic_controller_give_way.cpp): robot w waits for robot h and each
+  // one's route ahead passes where the other stands; h may give way to w (the option is on, h
+  // waits, stands, is alone and not at work, and has the lower priority); GiveWay moves it to
+  // the nearest free point off w's way (OnWayOf) with the route on to its goal from there;
+  // GivingWayTo: the robot r waits for, giving way, off its way (-1: none any more).
+  bool HeadOnPair(std::size_t w, std::size_t h) const;
+  bool OnWayOf(std::size_t w, PointId p, double clearance) const;
+  bool MayGiveWay(std::size_t h, std::size_t w, double t) const;
+  bool GiveWay(std::size_t h, std::size_t w, double t);
+  int GivingWayTo(std::size_t r, double t);
   std::size_t ResolveDeadlocks(double t);
 };
 

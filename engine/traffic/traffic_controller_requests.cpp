@@ -265,6 +265,11 @@ bool TrafficController::Impl::TurnOff(PointId p, PointId next) const {
 
 TrafficDecision TrafficController::Impl::Check(std::size_t r, PointId q, double t) {
   RobotState& x = robots[r];
+  if (const int w = GivingWayTo(r, t); w >= 0) {  // Wang2019 §3.3 case ②
+    x.wait_point = q;
+    return WaitFor(r, WaitKind::kPoint, w, t, WhyKey{5, q, w},
+                   [&] { return "giving way to " + robots[static_cast<std::size_t>(w)].id + " (head-on)"; });
+  }
   const int blocker = PointBlocker(q, r);
   if (blocker >= 0) {
     x.wait_point = q;
@@ -363,6 +368,7 @@ void TrafficController::Impl::Remove(std::size_t r) {
   for (int c : held) DropCorridor(c, r);
   ReleaseGuard(r);
   x.removed = true;
+  x.give_way_to = -1;
   ForgetProgress(x);
   x.route.clear();
   x.arcs.clear();

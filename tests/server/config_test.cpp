@@ -22,10 +22,11 @@ TEST(ServerConfigTest, FlagsSetTheConfig) {
                        "--time-scale", "10", "--bind", "127.0.0.1", "--ports-file", "p.json",
                        "--planner", "time-windows", "--turn-time", "1.5", "--routing", "heat",
                        "--heat-period", "30", "--priority", "release", "--formation-max-queue", "0",
-                       "--one-formation-per-pick", "false", "--head-on-priority", "true"});
+                       "--one-formation-per-pick", "false", "--head-on-priority", "true", "--head-on-give-way", "true"});
   ASSERT_TRUE(parsed.ok()) << parsed.error().message;
   const ServerConfig& c = parsed->config;
   EXPECT_TRUE(c.head_on_priority);
+  EXPECT_TRUE(c.head_on_give_way);
   EXPECT_EQ(c.grpc_port, 0);
   EXPECT_EQ(c.http_port, 8081);
   EXPECT_EQ(c.db, "x.db");

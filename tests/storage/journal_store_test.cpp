@@ -304,6 +304,7 @@ TEST(JournalStoreTest, ARunSetupRoundTrips) {
   s.core.traffic.head_on = engine::HeadOnPolicy::kAlwaysWait;
   s.core.traffic.priority_by_release = true;
   s.core.traffic.head_on_priority = true;
+  s.core.traffic.head_on_give_way = true;
   s.core.traffic_control = false;
   s.route_cache_bytes = 1 << 20;
   s.time_scale = 10;
@@ -324,6 +325,7 @@ TEST(JournalStoreTest, ARunSetupRoundTrips) {
   EXPECT_EQ(back->core.traffic.head_on, engine::HeadOnPolicy::kAlwaysWait);
   EXPECT_TRUE(back->core.traffic.priority_by_release);
   EXPECT_TRUE(back->core.traffic.head_on_priority);
+  EXPECT_TRUE(back->core.traffic.head_on_give_way);
   EXPECT_FALSE(back->core.traffic_control);
   EXPECT_EQ(back->route_cache_bytes, std::size_t{1} << 20);
   auto map = engine::ParseMapJson(back->map_json);
@@ -344,7 +346,9 @@ TEST(JournalStoreTest, ARunSetupRoundTrips) {
   old["core"].erase("priority_by_release");
   EXPECT_FALSE(DecodeRunSetup(old.dump()).value().core.traffic.priority_by_release);
   old["core"].erase("head_on_priority");  // first come, as before it
+  old["core"].erase("head_on_give_way");
   EXPECT_FALSE(DecodeRunSetup(old.dump()).value().core.traffic.head_on_priority);
+  EXPECT_FALSE(DecodeRunSetup(old.dump()).value().core.traffic.head_on_give_way);
   old["allocation"]["planner"] = "magic";
   EXPECT_FALSE(DecodeRunSetup(old.dump()).ok());
 }

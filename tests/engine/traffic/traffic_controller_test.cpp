@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cstdio>
 #include <memory>
 #include <set>
 #include <string>
@@ -208,6 +209,49 @@ TEST(TrafficControllerTest, TheLaterReleasedRobotGivesWayInADeadlock) {
     const bool a_moved = ctl.RemainingRoute(a) != route_a, b_moved = ctl.RemainingRoute(b) != route_b;
     EXPECT_EQ(a_moved, by_release);
     EXPECT_EQ(b_moved, !by_release);
+  }
+}
+
+// Wang2019 §3.3 case ②: A (released first) drives west down a lane from c5 to c0, B (released
+// later) east from c4 to c6; they meet head-on, each waiting for the other. With
+// head_on_give_way B, the waiting robot of lower priority, drives back to the nearest free
+// point off A's way - the pocket c8 below c1 - and waits there until A has passed; A drives on
+// and never backs. Without it (printed beside) B backs off one point and drives straight back
+// into A's way, again and again: neither is through after 60 steps.
+TEST(TrafficControllerTest, AWaitingRobotOfLowerPriorityGivesWayOffTheOthersWay) {
+  auto map = Grid({".......", "@.@@@@@"});
+  for (bool give_way : {false, true}) {
+    SCOPED_TRACE(give_way ? "give way" : "back off");
+    TrafficControllerConfig c;
+    c.priority_by_release = true;
+    c.head_on_give_way = give_way;
+    TrafficController ctl = Make(map, c);
+    const std::size_t a = *ctl.AddRobot("A", P(*map, "c5"));
+    const std::size_t b = *ctl.AddRobot("B", P(*map, "c4"));
+    ctl.SetRank(a, 10.0);
+    ctl.SetRank(b, 20.0);
+    ASSERT_TRUE(ctl.SetRoute(a, Route(*map, {"c5", "c4", "c3", "c2", "c1", "c0"})).ok());
+    ASSERT_TRUE(ctl.SetRoute(b, Route(*map, {"c4", "c5", "c6"})).ok());
+    double t = 0.0, a_done = -1.0, b_done = -1.0;
+    bool b_in_pocket = false, a_backed = false;
+    PointId a_was = ctl.At(a);
+    for (int i = 0; i < 60 && (a_done < 0 || b_done < 0); ++i) {
+      Step(ctl, t += 1.0);
+      b_in_pocket = b_in_pocket || ctl.At(b) == P(*map, "c8");
+      a_backed = a_backed || map->point(ctl.At(a)).position.x() > map->point(a_was).position.x();
+      a_was = ctl.At(a);
+      if (a_done < 0 && ctl.At(a) == P(*map, "c0") && !ctl.HasRoute(a) && ctl.Next(a) == kNoPoint) a_done = t;
+      if (b_done < 0 && ctl.At(b) == P(*map, "c6") && !ctl.HasRoute(b) && ctl.Next(b) == kNoPoint) b_done = t;
+    }
+    std::printf("%s: A at c0 after %.0f steps, B at c6 after %.0f (-1: not within 60), give-ways %zu, "
+                "cycles broken %zu\n", give_way ? "give way" : "back off", a_done, b_done, ctl.stats().give_ways,
+                ctl.stats().deadlocks_resolved);
+    if (!give_way) continue;
+    EXPECT_TRUE(b_in_pocket);
+    EXPECT_FALSE(a_backed);
+    EXPECT_EQ(ctl.stats().give_ways, 1u);
+    EXPECT_GT(a_done, 0.0);
+    EXPECT_GT(b_done, a_done);
   }
 }
 
