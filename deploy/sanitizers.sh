@@ -24,12 +24,14 @@ export ASAN_OPTIONS=${ASAN_OPTIONS:-abort_on_error=1:detect_leaks=1:strict_strin
 export UBSAN_OPTIONS=${UBSAN_OPTIONS:-halt_on_error=1:print_stacktrace=1}
 export LSAN_OPTIONS=${LSAN_OPTIONS:-suppressions=$PWD/deploy/sanitizers/lsan.supp}
 export TSAN_OPTIONS=${TSAN_OPTIONS:-halt_on_error=1:second_deadlock_stack=1}
+# New build folders use Ninja (deploy/setup.sh says why); an existing one keeps its generator.
+generator() { [ -f "$1/CMakeCache.txt" ] || echo "-GNinja"; }
 flags=(-DCMAKE_BUILD_TYPE=None "-DCMAKE_CXX_FLAGS=-O1 -g1" -DDISPATCH_BUILD_TESTS=ON)
 for run in "${runs[@]}"; do
   start=$(date +%s)
   case "$run" in
     asan)
-      cmake -S . -B build-asan -DCMAKE_BUILD_TYPE=None "-DCMAKE_CXX_FLAGS=-O0 -g1" \
+      cmake -S . -B build-asan $(generator build-asan) -DCMAKE_BUILD_TYPE=None "-DCMAKE_CXX_FLAGS=-O0 -g1" \
         -DDISPATCH_ENGINE_CXX_FLAGS=-O1 -DDISPATCH_BUILD_TESTS=ON -DDISPATCH_SANITIZE=address,undefined >/dev/null
       # Only what the run executes: every GoogleTest program (with the tools some of them start,
       # their declared dependencies) and the fuzz replays; not the clients nor the tools the
@@ -42,7 +44,7 @@ for run in "${runs[@]}"; do
       ctest --test-dir build-asan --output-on-failure -j "$jobs" -LE e2e
       ;;
     tsan)
-      cmake -S . -B build-tsan "${flags[@]}" -DDISPATCH_SANITIZE=thread >/dev/null
+      cmake -S . -B build-tsan $(generator build-tsan) "${flags[@]}" -DDISPATCH_SANITIZE=thread >/dev/null
       mapfile -t targets < <(sed -nE 's/^dispatch_add_test\(([a-z_]+) .*/\1/p' tests/engine/dispatch/CMakeLists.txt)
       targets+=(server_dispatcher_parts_test server_worker_thread_test server_order_replies_test
                 server_robot_protocol_test server_auth_test server_config_test server_explanation_test)

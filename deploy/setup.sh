@@ -10,7 +10,7 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 
 PACKAGES=(
-  g++ cmake make pkg-config
+  g++ cmake make ninja-build pkg-config
   libeigen3-dev nlohmann-json3-dev libcli11-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   libgrpc++-dev protobuf-compiler-grpc libprotobuf-dev protobuf-compiler
@@ -38,9 +38,15 @@ install_packages() {
   DEBIAN_FRONTEND=noninteractive "${sudo[@]}" apt-get install -y -qq --no-install-recommends "${missing[@]}"
 }
 
+# A new build folder is configured for Ninja: it keeps both cores busy across targets, where
+# Make compiles none of a target's files before its libraries are built (the ASan build of
+# deploy/sanitizers.sh: 15 min with Ninja, 21.5 with Make, measured 2026-12-06). A folder
+# configured before keeps its generator.
+generator() { [ -f "$1/CMakeCache.txt" ] || echo "-GNinja"; }
+
 build() {
   local dir=$1; shift
-  cmake -S . -B "$dir" "$@" >/dev/null
+  cmake -S . -B "$dir" $(generator "$dir") "$@" >/dev/null
   cmake --build "$dir" -j "$(nproc)"
 }
 
