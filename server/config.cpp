@@ -191,7 +191,7 @@ engine::Result<ParsedCommandLine> ParseCommandLine(int argc, char** argv) {
   app.add_option("--http-port", flags.http_port, "REST port (0 = any free port)")->capture_default_str();
   app.add_option("--db", flags.db, "SQLite database file")->capture_default_str();
   app.add_option("--map", flags.map, "chu2024 | wang2019 | map.json | MovingAI .map")->capture_default_str();
-  app.add_option("--strategy", flags.strategy, "auction | greedy")->capture_default_str();
+  app.add_option("--strategy", flags.strategy, "auction | greedy | psoga")->capture_default_str();
   app.add_option("--zeta", flags.zeta, "Traffic weight (Chu2024 eq. 5)")->capture_default_str();
   app.add_option("--planner", flags.planner,
                  "rules | time-windows (Wang2019) | conflict-elimination (BIT2024 step 7)")

@@ -18,7 +18,7 @@ struct ServerConfig {
   int http_port = 8080;           // 0 = pick a free port
   std::string db = "dispatch.db"; // SQLite file
   std::string map = "chu2024";    // chu2024 | wang2019 | <file>.json | <file>.map
-  std::string strategy = "auction";  // auction | greedy
+  std::string strategy = "auction";  // auction | greedy | psoga (MakeAllocator)
   // Orders a robot may hold and still bid for another (0: no limit, the paper's auction), and
   // for a formation order (0: no limit), and one formation at a time heading for a first
   // pick: see AllocationConfig::max_queue, formation_max_queue and

@@ -78,7 +78,7 @@ namespace dispatch::server {
 
 struct DispatcherOptions {
   engine::AllocationConfig allocation;
-  std::string strategy = "auction";  // auction | greedy
+  std::string strategy = "auction";  // auction | greedy | psoga (MakeAllocator)
   double time_scale = 1.0;           // dispatcher seconds per wall second
   double heartbeat_interval = 1.0;   // wall seconds
   double heartbeat_timeout = 5.0;    // wall seconds

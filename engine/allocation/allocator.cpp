@@ -4,6 +4,7 @@
 #include <cmath>
 #include <functional>
 #include <tuple>
+#include <utility>
 
 namespace dispatch::engine {
 
@@ -53,10 +54,19 @@ std::vector<OrderAllocation> AllocateAll(Allocator& allocator, std::vector<Order
     return std::make_tuple(-a.priority, a.created_time, std::cref(a.id)) <
            std::make_tuple(-b.priority, b.created_time, std::cref(b.id));
   });
+  std::vector<const Order*> batch;
+  for (const Order& o : orders) batch.push_back(&o);
   std::vector<OrderAllocation> out;
   out.reserve(orders.size());
-  for (const Order& o : orders) out.push_back({o.id, allocator.Allocate(o, state)});
+  allocator.AllocateBatch(batch, state, [&](const Order& o, Result<AwardExplanation> award) {
+    out.push_back({o.id, std::move(award)});
+  });
   return out;
+}
+
+void Allocator::AllocateBatch(const std::vector<const Order*>& orders, FleetState& state,
+                              const AwardSink& sink) {
+  for (const Order* o : orders) sink(*o, Allocate(*o, state));
 }
 
 }  // namespace dispatch::engine

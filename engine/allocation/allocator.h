@@ -7,6 +7,7 @@
 // Not thread-safe: an Allocator and its FleetState are used by one thread at a time.
 #pragma once
 
+#include <functional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -18,11 +19,20 @@
 
 namespace dispatch::engine {
 
+// Receives each order's award (or why it was not allocated) of a batch as soon as it is
+// committed to the FleetState, before the next one is made.
+using AwardSink = std::function<void(const Order& order, Result<AwardExplanation> award)>;
+
 class Allocator {
  public:
   virtual ~Allocator() = default;
   virtual std::string_view name() const = 0;
   virtual Result<AwardExplanation> Allocate(const Order& order, FleetState& state) = 0;
+  // A batch (an allocation round's orders, in priority-then-arrival order). By default one
+  // order at a time in the given order; a batch strategy (PSO-GA) decides them jointly and
+  // may commit them in another order. Every order reaches `sink` exactly once.
+  virtual void AllocateBatch(const std::vector<const Order*>& orders, FleetState& state,
+                             const AwardSink& sink);
 };
 
 // Checks that `order` can be allocated at all and returns its task (t_w per the config).
@@ -37,8 +47,8 @@ struct OrderAllocation {
   Result<AwardExplanation> award;
 };
 
-// Sorts the orders by (priority descending, created_time, id) and allocates them one at a
-// time, continuing after errors. Results in allocation order.
+// Sorts the orders by (priority descending, created_time, id) and allocates them as one
+// batch (Allocator::AllocateBatch), continuing after errors. Results in allocation order.
 std::vector<OrderAllocation> AllocateAll(Allocator& allocator, std::vector<Order> orders,
                                          FleetState& state);
 

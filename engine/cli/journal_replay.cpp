@@ -255,7 +255,7 @@ int RunReplay(const ReplayArgs& a) {
     StreamConfig c;
     c.time_step = a.dt;
     c.max_time = a.max_time;
-    c.strategy = name == "greedy" ? AllocationStrategy::kGreedy : AllocationStrategy::kAuction;
+    c.strategy = ParseAllocationStrategy(name).value_or(AllocationStrategy::kAuction);  // checked above
     c.allocation = loaded->setup.allocation;
     c.allocation.zeta = zeta;
     c.traffic = loaded->setup.core.traffic;

@@ -95,7 +95,7 @@ StreamConfig ConfigOf(const StreamArgs& a, const std::string& strategy, double z
   StreamConfig c;
   c.time_step = a.dt;
   c.max_time = a.max_time;
-  c.strategy = strategy == "greedy" ? AllocationStrategy::kGreedy : AllocationStrategy::kAuction;
+  c.strategy = ParseAllocationStrategy(strategy).value_or(AllocationStrategy::kAuction);  // checked by CLI11
   c.allocation.zeta = zeta;
   c.allocation.max_queue = a.max_queue;
   c.allocation.formation_max_queue = a.formation_max_queue;
@@ -242,7 +242,8 @@ int RunCompare(StreamArgs a) {
   if (a.planners.empty() && a.routings.empty()) {
     columns = {{"auction zeta=100", "auction", 100.0, a.planner, a.routing},
                {"auction zeta=0", "auction", 0.0, a.planner, a.routing},
-               {"greedy", "greedy", 0.0, a.planner, a.routing}};
+               {"greedy", "greedy", 0.0, a.planner, a.routing},
+               {"psoga", "psoga", 100.0, a.planner, a.routing}};
   } else {
     const std::vector<std::string> planners = a.planners.empty() ? std::vector<std::string>{a.planner} : a.planners;
     const std::vector<std::string> routings = a.routings.empty() ? std::vector<std::string>{a.routing} : a.routings;
@@ -326,13 +327,13 @@ StreamCommands AddStreamCommands(CLI::App& app, StreamArgs& stream_args, StreamA
   };
   CLI::App* s = app.add_subcommand("stream", "Order stream under the online traffic controller");
   add_stream(s, stream_args);
-  s->add_option("--strategy", stream_args.strategy, "auction or greedy")->capture_default_str()
+  s->add_option("--strategy", stream_args.strategy, "auction, greedy or psoga")->capture_default_str()
       ->check(CLI::IsMember(AllocatorNames()));
   s->add_option("--zeta", stream_args.zeta, "Traffic weight of the auction")->capture_default_str();
   s->add_option("--orders-csv", stream_args.orders_csv, "Write per-order results here");
   s->add_option("--journal", stream_args.journal,
                 "Journal the core's calls as a run of this SQLite file (dispatch-sim replay --db, SQL)");
-  CLI::App* c = app.add_subcommand("compare", "Auction zeta=100 / zeta=0 / greedy on one stream, or planners");
+  CLI::App* c = app.add_subcommand("compare", "Auction zeta=100 / zeta=0 / greedy / PSO-GA on one stream, or planners");
   add_stream(c, compare_args);
   c->add_option("--planners", compare_args.planners, "Compare these planners (comma-separated: " + PlannerList() +
                                                     ") with --strategy and --zeta, instead of the strategies")

@@ -80,17 +80,22 @@ RoundResult RoundRunner::Run(const RoundInput& input) {
   segments.in_formation.assign(input.robots.size(), false);
   std::vector<bool> queued(input.robots.size());  // has orders (before or from this round)
   for (std::size_t i = 0; i < input.robots.size(); ++i) queued[i] = input.robots[i].has_queue();
+  // The round's orders as one batch; each award is recorded as the strategy commits it, with
+  // the part of each winner's plan it added.
+  std::vector<const Order*> batch;
   for (const auto& pending : input.pending) {
-    const Order& order = *pending;
-    if (static_cast<std::size_t>(order.team_size()) > input.robots.size()) continue;
-    std::vector<std::size_t> old_sizes;
-    for (std::size_t i = 0; i < state.robot_count(); ++i) old_sizes.push_back(state.plan(i).waypoints.size());
-    const double start = stopwatch_ ? stopwatch_() : 0.0;
-    auto award = allocator_->Allocate(order, state);
-    const double seconds = stopwatch_ ? stopwatch_() - start : 0.0;
+    if (static_cast<std::size_t>(pending->team_size()) <= input.robots.size()) batch.push_back(pending.get());
+  }
+  std::vector<std::size_t> sizes;  // each robot's plan size before the next award
+  for (std::size_t i = 0; i < state.robot_count(); ++i) sizes.push_back(state.plan(i).waypoints.size());
+  double start = stopwatch_ ? stopwatch_() : 0.0;
+  allocator_->AllocateBatch(batch, state, [&](const Order& order, Result<AwardExplanation> award) {
+    const double now = stopwatch_ ? stopwatch_() : 0.0;
+    const double seconds = now - start;
+    start = now;
     if (!award.ok()) {
       out.notes.push_back("order " + order.id + " not allocated (stays accepted): " + award.error().message);
-      continue;
+      return;
     }
     RoundAward a;
     a.order_id = order.id;
@@ -99,8 +104,9 @@ RoundResult RoundRunner::Run(const RoundInput& input) {
       const std::size_t i = *state.FindRobot(w);
       const auto& fp = state.plan(i).waypoints;
       // A robot without a queue gets the whole plan (its start waypoint included).
-      const std::size_t from = queued[i] ? old_sizes[i] : 0;
+      const std::size_t from = queued[i] ? sizes[i] : 0;
       queued[i] = true;
+      sizes[i] = fp.size();
       segments.first_new[i] = std::min(segments.first_new[i], from);
       if (award->winners.size() > 1) segments.in_formation[i] = true;
       a.segments.emplace_back(fp.begin() + static_cast<std::ptrdiff_t>(std::min(from, fp.size())), fp.end());
@@ -108,7 +114,7 @@ RoundResult RoundRunner::Run(const RoundInput& input) {
     }
     a.award = std::move(award).value();
     out.awards.push_back(std::move(a));
-  }
+  });
   if (config_.planner == PlannerKind::kTimeWindows && !out.awards.empty()) {
     PlanAwardsInWindows(map_, *routes_, config_, state, segments, input.now, out.awards, out.notes);
   } else if (config_.planner == PlannerKind::kConflictElimination && !out.awards.empty()) {

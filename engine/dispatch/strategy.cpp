@@ -2,10 +2,11 @@
 
 #include "engine/allocation/auction_allocator.h"
 #include "engine/allocation/greedy_allocator.h"
+#include "engine/allocation/swarm_allocator.h"
 
 namespace dispatch::engine {
 
-std::vector<std::string> AllocatorNames() { return {"auction", "greedy"}; }
+std::vector<std::string> AllocatorNames() { return {"auction", "greedy", "psoga"}; }
 
 Result<std::unique_ptr<Allocator>> MakeAllocator(std::string_view name) {
   std::unique_ptr<Allocator> allocator;
@@ -13,6 +14,8 @@ Result<std::unique_ptr<Allocator>> MakeAllocator(std::string_view name) {
     allocator = std::make_unique<AuctionAllocator>();
   } else if (name == "greedy") {
     allocator = std::make_unique<GreedyAllocator>();
+  } else if (name == "psoga") {
+    allocator = std::make_unique<SwarmAllocator>();
   } else {
     std::string known;
     for (const auto& n : AllocatorNames()) known += (known.empty() ? "" : " | ") + n;

@@ -14,8 +14,9 @@ namespace dispatch::engine {
 
 // The names MakeAllocator knows, in the order help texts list them.
 std::vector<std::string> AllocatorNames();
-// A fresh strategy: "auction" (Chu2024 §2, bids with traffic prediction) or "greedy" (nearest
-// idle robot). kInvalidArgument naming the known ones for any other name.
+// A fresh strategy: "auction" (Chu2024 §2, bids with traffic prediction), "greedy" (nearest
+// idle robot) or "psoga" (BIT2024's PSO-GA over each round's single orders as one batch,
+// formations by the auction). kInvalidArgument naming the known ones for any other name.
 Result<std::unique_ptr<Allocator>> MakeAllocator(std::string_view name);
 
 }  // namespace dispatch::engine

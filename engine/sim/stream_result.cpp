@@ -6,8 +6,16 @@ const char* AllocationStrategyName(AllocationStrategy strategy) {
   switch (strategy) {
     case AllocationStrategy::kAuction: return "auction";
     case AllocationStrategy::kGreedy: return "greedy";
+    case AllocationStrategy::kPsoGa: return "psoga";
   }
   return "?";
+}
+
+std::optional<AllocationStrategy> ParseAllocationStrategy(std::string_view name) {
+  for (AllocationStrategy s : {AllocationStrategy::kAuction, AllocationStrategy::kGreedy, AllocationStrategy::kPsoGa}) {
+    if (name == AllocationStrategyName(s)) return s;
+  }
+  return std::nullopt;
 }
 
 }  // namespace dispatch::engine

@@ -7,6 +7,7 @@
 #include <limits>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "engine/allocation/allocation_config.h"
@@ -15,8 +16,10 @@
 
 namespace dispatch::engine {
 
-enum class AllocationStrategy { kAuction, kGreedy };
-const char* AllocationStrategyName(AllocationStrategy strategy);  // "auction", "greedy"
+// MakeAllocator's strategies (engine/dispatch/strategy.h), by value.
+enum class AllocationStrategy { kAuction, kGreedy, kPsoGa };
+const char* AllocationStrategyName(AllocationStrategy strategy);  // "auction", "greedy", "psoga"
+std::optional<AllocationStrategy> ParseAllocationStrategy(std::string_view name);
 
 struct StreamConfig {
   double time_step = 0.1;     // s (> 0)

@@ -5,11 +5,18 @@
 //
 //   BM_Auction/R          R robots on a 100 x 100 grid floor (1 m cells, 10 x 10 m zones,
 //                         lazy route table), each robot starting with 2 queued tasks;
-//   BM_AuctionChu2024     the 18 robots of the Chu2024 floor, each with 2 queued tasks.
+//   BM_AuctionChu2024     the 18 robots of the Chu2024 floor, each with 2 queued tasks;
+//   BM_PsoGa/50x18        BIT2024's PSO-GA (seed 003 steps 1-5) on a batch of 50 random
+//                         single orders for the 18 robots of the Chu2024 floor (6,000 fitness
+//                         evaluations, 30 particles), beside plain PSO and GA on the same
+//                         budget; counters: eq. (1)'s fitness of each, and of the auction's
+//                         allocation of the same batch (its queues measured by eq. (1)).
 // Orders are drawn from a fixed set of picks and drops, so the lazy route table's
 // per-destination searches are warmed up before timing starts.
 #include <benchmark/benchmark.h>
 
+#include <algorithm>
+#include <limits>
 #include <memory>
 #include <optional>
 #include <random>
@@ -17,6 +24,7 @@
 #include <string>
 
 #include "engine/allocation/auction_allocator.h"
+#include "engine/allocation/swarm_allocation.h"
 #include "engine/io/movingai_map.h"
 #include "engine/map/chu2024_floor.h"
 #include "engine/routing/route_table.h"
@@ -165,6 +173,84 @@ void BM_AuctionChu2024(benchmark::State& state) {
   RunAuctions(state, s, robots);
 }
 BENCHMARK(BM_AuctionChu2024)->Unit(benchmark::kMillisecond);
+
+// The batch of BM_PsoGa: 50 random single orders (pick to drop) and the 18 robots of the
+// Chu2024 floor at their stations; distances are the route table's drive times.
+struct SwarmBatch {
+  Scenario s = Chu2024Scenario();
+  std::vector<FleetRobot> robots;
+  std::vector<Order> orders;
+  SwarmProblem problem;
+};
+
+const SwarmBatch& Batch() {
+  static const SwarmBatch batch = [] {
+    SwarmBatch b;
+    for (std::size_t i = 0; i < b.s.map->stations().size(); ++i) {
+      b.robots.push_back({"R" + std::to_string(i + 1), b.s.map->stations()[i].point, 0.0});
+      b.problem.robots.push_back({b.s.map->stations()[i].point, 0.0});
+    }
+    std::mt19937 rng(17);
+    for (int k = 0; k < 50; ++k) {
+      b.orders.push_back(RandomOrder(b.s, rng, k));
+      const Order& o = b.orders.back();
+      b.problem.tasks.push_back({o.picks.front(), 0.0, o.drop, b.s.routes->Cost(o.picks.front(), o.drop)});
+    }
+    const RouteTable* routes = b.s.routes.get();
+    b.problem.distance = [routes](PointId from, PointId to) { return routes->Cost(from, to); };
+    return b;
+  }();
+  return batch;
+}
+
+// Eq. (1) of the auction's allocation of the same batch: each robot's queue in its order.
+double AuctionFitness(const SwarmBatch& b, std::size_t* allocated) {
+  auto fleet = FleetState::Create(b.s.map, b.s.routes, b.robots).value();
+  AuctionAllocator auction;
+  *allocated = 0;
+  for (const auto& a : AllocateAll(auction, b.orders, fleet)) *allocated += a.award.ok();
+  double f_min = std::numeric_limits<double>::infinity(), f_all = 0.0;
+  for (std::size_t r = 0; r < fleet.robot_count(); ++r) {
+    PointId at = b.robots[r].start;
+    double travel = 0.0;
+    for (const QueuedTask& q : fleet.queue(r)) {
+      travel += b.s.routes->Cost(at, q.task.picks.front()) + b.s.routes->Cost(q.task.picks.front(), q.task.drop);
+      at = q.task.drop;
+    }
+    f_min = std::min(f_min, travel);
+    f_all += travel;
+  }
+  return b.problem.a1 * f_min + b.problem.a2 * f_all;  // headings all 0: no f_switch
+}
+
+void RunSwarm(benchmark::State& state, SwarmMethod method) {
+  const SwarmBatch& b = Batch();
+  SwarmOptions options;
+  options.method = method;
+  double fitness = 0.0;
+  std::size_t evaluations = 0;
+  for (auto _ : state) {
+    auto plan = PlanSwarm(b.problem, options);
+    if (!plan.ok()) {
+      state.SkipWithError(plan.error().message.c_str());
+      return;
+    }
+    fitness = plan->fitness;
+    evaluations = plan->evaluations;
+    benchmark::DoNotOptimize(plan->sequences.data());
+  }
+  std::size_t allocated = 0;
+  state.counters["fitness"] = fitness;
+  state.counters["evaluations"] = static_cast<double>(evaluations);
+  state.counters["auction_fitness"] = AuctionFitness(b, &allocated);
+  state.counters["auction_allocated"] = static_cast<double>(allocated);
+}
+void BM_PsoGa(benchmark::State& state) { RunSwarm(state, SwarmMethod::kPsoGa); }
+BENCHMARK(BM_PsoGa)->Name("BM_PsoGa/50x18")->Unit(benchmark::kMillisecond);
+void BM_Pso(benchmark::State& state) { RunSwarm(state, SwarmMethod::kPso); }
+BENCHMARK(BM_Pso)->Name("BM_Pso/50x18")->Unit(benchmark::kMillisecond);
+void BM_Ga(benchmark::State& state) { RunSwarm(state, SwarmMethod::kGa); }
+BENCHMARK(BM_Ga)->Name("BM_Ga/50x18")->Unit(benchmark::kMillisecond);
 
 }  // namespace
 }  // namespace dispatch::engine

@@ -4,6 +4,10 @@
 
 #include <gtest/gtest.h>
 
+#include <map>
+#include <string>
+#include <vector>
+
 #include "engine/dispatch/strategy.h"
 #include "tests/engine/dispatch/dispatch_test_support.h"
 
@@ -105,6 +109,52 @@ TEST(AllocationRound, QueuesAreReplayedFromStoredPlansAndNewWorkFollowsThem) {
   EXPECT_EQ(first_new, static_cast<std::uint64_t>(book.plan.waypoints.at(SegmentStart(book, 1)).seq));
   EXPECT_EQ(book.order_ids, (std::vector<std::string>{"o1", "o2"}));
   EXPECT_GE(book.plan.waypoints.at(SegmentStart(book, 1)).eta, book.plan.waypoints.at(SegmentStart(book, 1) - 1).departure());
+}
+
+// A batch strategy (PSO-GA) commits a round's orders jointly, a robot's several orders in one
+// round: each award still holds exactly the part of its robot's plan it added (the first a
+// whole plan from the robot's start, each later one after the previous one's last departure).
+TEST(AllocationRound, UnderPsoGaEachAwardHoldsThePartOfThePlanItAdded) {
+  const auto& map = *Chu2024();
+  const auto parks = PointsOfKind(map, PointKind::kPark);
+  const auto picks = PointsOfKind(map, PointKind::kPick);
+  const auto drops = PointsOfKind(map, PointKind::kDrop);
+  RoundInput input;
+  input.now = 10.0;
+  for (int i = 0; i < 2; ++i) input.robots.push_back({"R" + std::to_string(i + 1), parks.at(static_cast<std::size_t>(i) * 9), {}, 0, {}});
+  for (int k = 0; k < 5; ++k) {
+    const auto u = static_cast<std::size_t>(k);
+    input.pending.push_back(MakeOrder("o" + std::to_string(k), picks.at(7 * u + 2), drops.at(u % drops.size()), k));
+  }
+  RoundRunner runner = Runner("psoga");
+  const RoundResult result = runner.Run(input);
+  EXPECT_TRUE(result.notes.empty()) << result.notes.front();
+  ASSERT_EQ(result.awards.size(), 5u);
+  std::map<std::string, std::vector<const RoundAward*>> by_robot;
+  for (const RoundAward& a : result.awards) {
+    EXPECT_EQ(a.award.strategy, "psoga");
+    ASSERT_EQ(a.award.winners.size(), 1u);
+    by_robot[a.award.winners[0]].push_back(&a);
+  }
+  for (const auto& [robot, awards] : by_robot) {
+    const RoundRobot& r = input.robots.at(robot == "R1" ? 0 : 1);
+    Assignment book;
+    book.robot_id = robot;
+    for (std::size_t k = 0; k < awards.size(); ++k) {
+      const RoundAward& a = *awards[k];
+      ASSERT_FALSE(a.segments[0].empty());
+      if (k == 0) {
+        EXPECT_EQ(a.segments[0].front().point, r.start);
+        EXPECT_EQ(a.after_departure[0], 0.0);
+      } else {
+        EXPECT_EQ(a.after_departure[0], awards[k - 1]->segments[0].back().departure()) << a.order_id;
+        EXPECT_NE(a.segments[0].front().action, WaypointAction::kDrop);  // no waypoint twice
+      }
+      EXPECT_EQ(a.segments[0].back().action, WaypointAction::kDrop);
+      AppendOrder(book, a.order_id, a.segments[0], a.after_departure[0], k == 0, input.now);
+    }
+    EXPECT_EQ(book.order_ids.size(), awards.size());
+  }
 }
 
 TEST(AllocationRound, AQueueThatCannotBeReplayedIsNamed) {
