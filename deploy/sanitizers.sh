@@ -25,7 +25,7 @@ export UBSAN_OPTIONS=${UBSAN_OPTIONS:-halt_on_error=1:print_stacktrace=1}
 export LSAN_OPTIONS=${LSAN_OPTIONS:-suppressions=$PWD/deploy/sanitizers/lsan.supp}
 export TSAN_OPTIONS=${TSAN_OPTIONS:-halt_on_error=1:second_deadlock_stack=1}
 # New build folders use Ninja (deploy/setup.sh says why); an existing one keeps its generator.
-generator() { [ -f "$1/CMakeCache.txt" ] || echo "-GNinja"; }
+generator() { [ -f "$1/CMakeCache.txt" ] || ! command -v ninja >/dev/null || echo "-GNinja"; }
 flags=(-DCMAKE_BUILD_TYPE=None "-DCMAKE_CXX_FLAGS=-O1 -g1" -DDISPATCH_BUILD_TESTS=ON)
 for run in "${runs[@]}"; do
   start=$(date +%s)

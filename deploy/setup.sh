@@ -42,7 +42,7 @@ install_packages() {
 # Make compiles none of a target's files before its libraries are built (the ASan build of
 # deploy/sanitizers.sh: 15 min with Ninja, 21.5 with Make, measured 2026-12-06). A folder
 # configured before keeps its generator.
-generator() { [ -f "$1/CMakeCache.txt" ] || echo "-GNinja"; }
+generator() { [ -f "$1/CMakeCache.txt" ] || ! command -v ninja >/dev/null || echo "-GNinja"; }
 
 build() {
   local dir=$1; shift

@@ -54,7 +54,7 @@ class Search {
   void Update(Particle& x, const std::vector<std::size_t>& gbest, double w, double c1, double c2);
   std::vector<std::size_t> Child(const std::vector<std::size_t>& a, const std::vector<std::size_t>& b);
   void Offer(const std::vector<std::size_t>& pos, double fit) {
-    if (fit < gbest_fit_) {
+    if (gbest_.empty() || fit < gbest_fit_) {  // the first, even at +infinity: gbest is a plan
       gbest_fit_ = fit;
       gbest_ = pos;
     }

@@ -37,13 +37,14 @@ void SwarmAllocator::AllocateBatch(const std::vector<const Order*>& orders, Flee
     singles.push_back(o);
     tasks.push_back(std::move(task).value());
   }
-  if (singles.empty()) return;
-
   // The robots searched: for each order the `candidates_` with room that can start it soonest.
+  // An order no robot with room reaches goes to the auction, which says why.
   const RouteTable& routes = state.routes();
   std::set<std::size_t> chosen;
   std::vector<std::pair<double, std::size_t>> ranked;
-  for (const PlanTask& task : tasks) {
+  std::size_t kept = 0;
+  for (std::size_t j = 0; j < singles.size(); ++j) {
+    const PlanTask& task = tasks[j];
     ranked.clear();
     for (std::size_t i = 0; i < state.robot_count(); ++i) {
       if (!state.HasRoom(i)) continue;
@@ -51,15 +52,20 @@ void SwarmAllocator::AllocateBatch(const std::vector<const Order*>& orders, Flee
       const double start = s.end_time + routes.Cost(s.end_point, task.picks.front());
       if (std::isfinite(start)) ranked.emplace_back(start, i);
     }
+    if (ranked.empty()) {
+      sink(*singles[j], auction_.Allocate(*singles[j], state));
+      continue;
+    }
     const std::size_t keep = std::min(candidates_, ranked.size());
     std::partial_sort(ranked.begin(), ranked.begin() + static_cast<std::ptrdiff_t>(keep), ranked.end());
     for (std::size_t k = 0; k < keep; ++k) chosen.insert(ranked[k].second);
+    singles[kept] = singles[j];
+    tasks[kept++] = tasks[j];
   }
+  singles.resize(kept);
+  tasks.resize(kept);
+  if (singles.empty()) return;
   const std::vector<std::size_t> robots(chosen.begin(), chosen.end());
-  if (robots.empty()) {  // no robot with room reaches any: the auction says why, order by order
-    for (const Order* o : singles) sink(*o, auction_.Allocate(*o, state));
-    return;
-  }
 
   SwarmProblem problem;
   for (std::size_t i : robots) problem.robots.push_back({state.summary(i).end_point, 0.0});
@@ -72,6 +78,10 @@ void SwarmAllocator::AllocateBatch(const std::vector<const Order*>& orders, Flee
   Result<SwarmPlan> plan = PlanSwarm(problem, options);
   if (!plan.ok()) {
     for (const Order* o : singles) sink(*o, plan.error());
+    return;
+  }
+  if (!std::isfinite(plan->fitness)) {  // no plan of the encoding chains every order (one-way lanes)
+    for (const Order* o : singles) sink(*o, auction_.Allocate(*o, state));
     return;
   }
 

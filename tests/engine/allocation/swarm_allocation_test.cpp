@@ -144,7 +144,7 @@ TEST(SwarmAllocationTest, OnTinyBatchesPsoGaReachesTheExactOptimumMostOfTheTime)
 // moves task numbers arithmetically, and a value between two task numbers is an unrelated
 // task, so the swarm step scrambles the particles the genetic step then ranks; the README's
 // allocation section has the figures.
-TEST(SwarmAllocationTest, PsoGaIsAtLeastAsGoodAsPsoAndGaOnTheSameBudget) {
+TEST(SwarmAllocationTest, PsoGaIsAtLeastAsGoodAsPsoOnTheSameBudget) {
   double mean[3] = {0.0, 0.0, 0.0};
   const SwarmMethod methods[3] = {SwarmMethod::kPsoGa, SwarmMethod::kPso, SwarmMethod::kGa};
   for (std::uint64_t seed = 1; seed <= 20; ++seed) {

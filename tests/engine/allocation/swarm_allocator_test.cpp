@@ -4,6 +4,9 @@
 
 #include <gtest/gtest.h>
 
+#include <limits>
+#include <map>
+#include <optional>
 #include <set>
 #include <string>
 #include <vector>
@@ -110,6 +113,47 @@ TEST_F(SwarmAllocatorTest, AnOrderThatCannotBeAllocatedIsNamedTheOthersAre) {
   const auto one = allocator.Allocate(MakeOrder("one", {P("7,7")}, P("9,9")), fleet);
   ASSERT_TRUE(one.ok()) << one.error().message;
   EXPECT_EQ(one->winners, std::vector<std::string>{"R2"});
+}
+
+// An order on an island no robot reaches: the auction says why; the others are allocated (the
+// search never sees it, and a search whose every plan is infinite still returns a plan).
+TEST(SwarmAllocatorIsland, AnOrderNoRobotReachesGoesToTheAuction) {
+  MapBuilder b("island");
+  b.SetFloor({-1.0, -1.0}, {10.0, 1.0});
+  b.AddRectZone("z", {-1.0, -1.0}, {10.0, 1.0});
+  b.AddPoint("a", {0.0, 0.0}, PointKind::kLane);
+  b.AddPoint("p", {1.0, 0.0}, PointKind::kPick);
+  b.AddPoint("d", {2.0, 0.0}, PointKind::kDrop);
+  b.AddPoint("q", {6.0, 0.0}, PointKind::kPick);  // the island: q <-> e
+  b.AddPoint("e", {7.0, 0.0}, PointKind::kDrop);
+  b.AddPath("a", "p", std::nullopt, 0.0, true);
+  b.AddPath("p", "d", std::nullopt, 0.0, true);
+  b.AddPath("q", "e", std::nullopt, 0.0, true);
+  MapBuildOptions options;
+  options.check_service_connectivity = false;
+  auto map = testing_util::Share(b.Build(options));
+  FleetState fleet = MakeFleet(map, Routes(map), {{"R1", Pt(*map, "a"), 0.0}});
+  const std::vector<Order> orders = {MakeOrder("island", {Pt(*map, "q")}, Pt(*map, "e")),
+                                     MakeOrder("ok", {Pt(*map, "p")}, Pt(*map, "d"))};
+  std::vector<const Order*> batch = {&orders[0], &orders[1]};
+  std::map<std::string, Result<AwardExplanation>> got;
+  SwarmAllocator allocator;
+  allocator.AllocateBatch(batch, fleet, [&](const Order& o, Result<AwardExplanation> a) { got.emplace(o.id, std::move(a)); });
+  ASSERT_EQ(got.size(), 2u);
+  ASSERT_FALSE(got.at("island").ok());
+  EXPECT_EQ(got.at("island").error().code, ErrorCode::kUnreachable) << got.at("island").error().message;
+  ASSERT_TRUE(got.at("ok").ok()) << got.at("ok").error().message;
+  EXPECT_EQ(got.at("ok")->winners, std::vector<std::string>{"R1"});
+
+  SwarmProblem p;  // every plan infinite
+  p.robots = {{0, 0.0}};
+  p.tasks = {{1, 0.0}, {2, 0.0}};
+  p.distance = [](PointId, PointId) { return std::numeric_limits<double>::infinity(); };
+  const auto plan = PlanSwarm(p, SwarmOptions{});
+  ASSERT_TRUE(plan.ok()) << plan.error().message;
+  EXPECT_EQ(plan->fitness, std::numeric_limits<double>::infinity());
+  ASSERT_EQ(plan->sequences.size(), 1u);
+  EXPECT_EQ(plan->sequences[0].size(), 2u);
 }
 
 }  // namespace
