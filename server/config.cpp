@@ -38,6 +38,7 @@ std::vector<Key> Keys() {
       MakeKey("db", &ServerConfig::db),
       MakeKey("map", &ServerConfig::map),
       MakeKey("strategy", &ServerConfig::strategy),
+      MakeKey("batch_window", &ServerConfig::batch_window),
       MakeKey("max_queue", &ServerConfig::max_queue),
       MakeKey("formation_max_queue", &ServerConfig::formation_max_queue),
       MakeKey("one_formation_per_pick", &ServerConfig::one_formation_per_pick),
@@ -150,6 +151,7 @@ engine::Status ValidateServerConfig(const ServerConfig& c) {
     return InvalidArgument("routing must be floyd or heat, got '" + c.routing + "'");
   }
   if (!std::isfinite(c.heat_period) || c.heat_period <= 0) return InvalidArgument("heat_period must be > 0 seconds");
+  if (!std::isfinite(c.batch_window) || c.batch_window < 0) return InvalidArgument("batch_window must be >= 0 seconds");
   for (auto [name, v] : {std::pair{"zeta", c.zeta}, {"alpha", c.alpha}, {"beta", c.beta}, {"turn_time", c.turn_time}}) {
     if (!std::isfinite(v) || v < 0) return InvalidArgument(std::string(name) + " must be finite and >= 0");
   }
@@ -191,7 +193,10 @@ engine::Result<ParsedCommandLine> ParseCommandLine(int argc, char** argv) {
   app.add_option("--http-port", flags.http_port, "REST port (0 = any free port)")->capture_default_str();
   app.add_option("--db", flags.db, "SQLite database file")->capture_default_str();
   app.add_option("--map", flags.map, "chu2024 | wang2019 | map.json | MovingAI .map")->capture_default_str();
-  app.add_option("--strategy", flags.strategy, "auction | greedy | psoga")->capture_default_str();
+  app.add_option("--strategy", flags.strategy, "auction | greedy | exact | psoga")->capture_default_str();
+  app.add_option("--batch-window", flags.batch_window,
+                 "Dispatcher s between allocation rounds at least (0: a round as soon as one is due)")
+      ->capture_default_str();
   app.add_option("--zeta", flags.zeta, "Traffic weight (Chu2024 eq. 5)")->capture_default_str();
   app.add_option("--planner", flags.planner,
                  "rules | time-windows (Wang2019) | conflict-elimination (BIT2024 step 7)")

@@ -18,7 +18,11 @@ struct ServerConfig {
   int http_port = 8080;           // 0 = pick a free port
   std::string db = "dispatch.db"; // SQLite file
   std::string map = "chu2024";    // chu2024 | wang2019 | <file>.json | <file>.map
-  std::string strategy = "auction";  // auction | greedy | psoga (MakeAllocator)
+  std::string strategy = "auction";  // auction | greedy | exact | psoga (MakeAllocator)
+  // Dispatcher seconds between the starts of two allocation rounds at least (0: a round as soon
+  // as one is due): orders arriving meanwhile are allocated together, one batch for the batch
+  // strategies (exact, psoga).
+  double batch_window = 0.0;
   // Orders a robot may hold and still bid for another (0: no limit, the paper's auction), and
   // for a formation order (0: no limit), and one formation at a time heading for a first
   // pick: see AllocationConfig::max_queue, formation_max_queue and

@@ -7,6 +7,7 @@
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
+#include <cmath>
 
 #include "engine/dispatch/strategy.h"
 #include "server/snapshot_builder.h"
@@ -35,6 +36,9 @@ engine::Result<std::unique_ptr<Dispatcher>> Dispatcher::Create(
   if (!map || !routes) return engine::InvalidArgument("dispatcher: null map or route table");
   if (auto valid = engine::ValidateAllocationConfig(options.allocation); !valid.ok()) {
     return valid.error();
+  }
+  if (!std::isfinite(options.batch_window) || options.batch_window < 0) {
+    return engine::InvalidArgument("dispatcher: batch_window must be >= 0 seconds");
   }
   auto allocator = engine::MakeAllocator(options.strategy);
   if (!allocator.ok()) return allocator.error();
@@ -68,6 +72,7 @@ Dispatcher::Dispatcher(std::shared_ptr<const engine::WarehouseMap> map,
       // Below the loop's priority: traffic control first when the cores are busy.
       route_worker_(std::make_unique<WorkerThread>(kWorkerNice)),
       round_worker_(std::move(rounds), options_.allocation, kWorkerNice) {
+  rounds_due_.SetWindow(options_.batch_window);
   if (options_.journal) {
     journal_writer_ = std::make_unique<CoreJournalWriter>(*options_.journal, options_.journal_run,
                                                           options_.journal_max_bytes, kWorkerNice);
@@ -144,6 +149,8 @@ void Dispatcher::Loop() {
       const auto wall = Clock::now();
       if (at < clock_.At(wall) + tick_s * options_.time_scale) wake = std::min(wake, clock_.WallAt(at, wall));
     }
+    // A round waiting for the batch window starts when it ends.
+    if (rounds_due_.Waiting(Now())) wake = std::min(wake, clock_.WallAt(rounds_due_.not_before(), Clock::now()));
     CommandQueue::Batch batch = queue_.Take(wake);
     for (auto& command : batch.commands) command();
     if (Clock::now() >= next_tick) {
@@ -155,7 +162,7 @@ void Dispatcher::Loop() {
     // Allocation runs once per batch, after the batch's replies are out: an order is
     // acknowledged when it is committed, and the orders of a burst are auctioned together.
     if (core_->TakeAllocationDue()) rounds_due_.MarkDue();
-    if (rounds_due_.due()) {
+    if (rounds_due_.due() && !rounds_due_.Waiting(Now())) {
       AllocatePending();
       StepTraffic();
       Flush();

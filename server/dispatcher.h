@@ -78,7 +78,8 @@ namespace dispatch::server {
 
 struct DispatcherOptions {
   engine::AllocationConfig allocation;
-  std::string strategy = "auction";  // auction | greedy | psoga (MakeAllocator)
+  std::string strategy = "auction";  // auction | greedy | exact | psoga (MakeAllocator)
+  double batch_window = 0.0;         // dispatcher s between round starts at least (RoundSchedule)
   double time_scale = 1.0;           // dispatcher seconds per wall second
   double heartbeat_interval = 1.0;   // wall seconds
   double heartbeat_timeout = 5.0;    // wall seconds

@@ -16,9 +16,10 @@ constexpr std::size_t kCommitChunk = 4;
 void Dispatcher::AllocatePending() {
   if (!rounds_due_.Begin()) return;  // after the running round is committed
   engine::RoundCommit keys;
-  std::optional<engine::RoundInput> made = core_->MakeRound(Now(), keys);
+  const double now = Now();
+  std::optional<engine::RoundInput> made = core_->MakeRound(now, keys);
   if (!made) return;
-  rounds_due_.Started();
+  rounds_due_.Started(now);
   round_worker_.Run(std::move(*made), std::move(keys), [this](std::shared_ptr<ServerRound> round, bool cancelled) {
     Post([this, round, cancelled] {
       core_->RoundResult(round->commit, cancelled);

@@ -192,6 +192,7 @@ engine::Result<std::unique_ptr<DispatchServer>> DispatchServer::Start(const Serv
   DispatcherOptions options;
   options.allocation = allocation;
   options.strategy = config.strategy;
+  options.batch_window = config.batch_window;
   options.time_scale = config.time_scale;
   options.heartbeat_interval = config.heartbeat_interval;
   options.heartbeat_timeout = config.heartbeat_timeout;

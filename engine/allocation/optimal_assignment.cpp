@@ -1,5 +1,6 @@
 #include "engine/allocation/optimal_assignment.h"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
@@ -31,12 +32,14 @@ Result<std::vector<BatchTask>> Prepare(const FleetState& state, const std::vecto
   return tasks;
 }
 
-// Sum over robots of eq. (1) for the final queues.
+// Sum over robots (all, or `only`) of eq. (1) for the final queues.
 double Total(const FleetState& state, const std::vector<BatchTask>& tasks,
-             const std::vector<std::size_t>& robot_of_order) {
+             const std::vector<std::size_t>& robot_of_order, const std::vector<std::size_t>* only) {
   const AllocationConfig& c = state.config();
   double total = 0.0;
-  for (std::size_t r = 0; r < state.robot_count(); ++r) {
+  const std::size_t count = only ? only->size() : state.robot_count();
+  for (std::size_t i = 0; i < count; ++i) {
+    const std::size_t r = only ? (*only)[i] : i;
     const QueueSummary& s = state.summary(r);
     double travel = s.travel_time;
     double work = s.work_time;
@@ -65,7 +68,7 @@ Result<double> BatchCost(const FleetState& state, const std::vector<Order>& orde
   }
   Result<std::vector<BatchTask>> tasks = Prepare(state, orders);
   if (!tasks.ok()) return tasks.error();
-  return Total(state, *tasks, robot_of_order);
+  return Total(state, *tasks, robot_of_order, nullptr);
 }
 
 Result<BatchAssignment> BruteForceAssignment(const FleetState& state,
@@ -73,7 +76,19 @@ Result<BatchAssignment> BruteForceAssignment(const FleetState& state,
                                              const OptimalAssignmentOptions& options) {
   Result<std::vector<BatchTask>> tasks = Prepare(state, orders);
   if (!tasks.ok()) return tasks.error();
-  const std::size_t m = state.robot_count();
+  std::vector<std::size_t> robots = options.robots;
+  if (robots.empty()) {
+    for (std::size_t r = 0; r < state.robot_count(); ++r) robots.push_back(r);
+  }
+  for (std::size_t k = 0; k < robots.size(); ++k) {
+    if (robots[k] >= state.robot_count()) {
+      return NotFound("brute force: unknown robot index " + std::to_string(robots[k]));
+    }
+    if (k > 0 && robots[k] <= robots[k - 1]) {
+      return InvalidArgument("brute force: the robot subset must be ascending without repeats");
+    }
+  }
+  const std::size_t m = robots.size();
   const std::size_t n = orders.size();
   if (m == 0 && n > 0) return Error{ErrorCode::kFailedPrecondition, "brute force: no robots"};
   double maps = 1.0;
@@ -83,29 +98,52 @@ Result<BatchAssignment> BruteForceAssignment(const FleetState& state,
                  "brute force: " + std::to_string(m) + "^" + std::to_string(n) +
                      " maps exceed the limit of " + std::to_string(options.max_maps)};
   }
+  // Places left per robot of the subset (one per order when injective).
+  std::vector<std::size_t> room(m, n);
+  for (std::size_t i = 0; i < m; ++i) {
+    if (options.one_order_per_robot) room[i] = 1;
+    const std::size_t max_queue = state.config().max_queue;
+    if (options.respect_queue_room && max_queue != 0) {
+      const std::size_t held = state.queue(robots[i]).size();
+      room[i] = std::min(room[i], held >= max_queue ? 0 : max_queue - held);
+    }
+  }
+  // The robots outside the subset add the same constant to every map: only the subset's
+  // queues are compared, the winner's full BatchCost is reported.
   BatchAssignment best{{}, kInf};
   std::vector<std::size_t> map(n, 0);
-  std::vector<bool> used(m, false);
+  std::size_t visited = 0;
+  bool stopped = false;
   // Lexicographic enumeration: order 0's robot varies slowest.
   auto visit = [&](auto&& self, std::size_t k) -> void {
+    if (stopped) return;
     if (k == n) {
-      const double cost = Total(state, *tasks, map);
+      if (options.stop && (++visited & 4095u) == 0 && options.stop()) {
+        stopped = true;
+        return;
+      }
+      const double cost = Total(state, *tasks, map, &robots);
       if (cost < best.cost) best = {map, cost};
       return;
     }
-    for (std::size_t r = 0; r < m; ++r) {
-      if (options.one_order_per_robot && used[r]) continue;
-      map[k] = r;
-      used[r] = true;
+    for (std::size_t i = 0; i < m; ++i) {
+      if (room[i] == 0) continue;
+      map[k] = robots[i];
+      --room[i];
       self(self, k + 1);
-      used[r] = false;
+      ++room[i];
     }
   };
   visit(visit, 0);
+  if (stopped) {
+    return Error{ErrorCode::kFailedPrecondition,
+                 "brute force: stopped after " + std::to_string(visited) + " maps"};
+  }
   if (!std::isfinite(best.cost)) {
     return Unreachable("brute force: no assignment of the " + std::to_string(n) +
                        " orders has a finite cost");
   }
+  best.cost = Total(state, *tasks, best.robot_of_order, nullptr);
   return best;
 }
 
@@ -178,7 +216,7 @@ Result<BatchAssignment> HungarianAssignment(const FleetState& state,
   for (std::size_t j = 1; j <= m; ++j) {
     if (p[j] != 0) result.robot_of_order[p[j] - 1] = j - 1;
   }
-  result.cost = Total(state, *tasks, result.robot_of_order);
+  result.cost = Total(state, *tasks, result.robot_of_order, nullptr);
   if (!std::isfinite(result.cost)) {
     return Unreachable("hungarian: no one-order-per-robot assignment of the " +
                        std::to_string(n) + " orders has a finite cost");

@@ -8,7 +8,8 @@
 // without new orders contribute their current queue's constant cost.
 //
 //  - BruteForceAssignment: the minimum over all robot_count^order_count maps (optionally only
-//    injective ones); ties go to the first map in lexicographic order of robot indices.
+//    injective ones, only onto a subset of the robots, only within each robot's free queue
+//    places); ties go to the first map in lexicographic order of robot indices.
 //  - HungarianAssignment: the one-order-per-robot case (orders <= robots) in O(n^2 m) on the
 //    marginal cost matrix; equals BruteForceAssignment with one_order_per_robot.
 // Formation orders are rejected (kInvalidArgument). Pure functions of the FleetState (read
@@ -16,6 +17,7 @@
 #pragma once
 
 #include <cstddef>
+#include <functional>
 #include <vector>
 
 #include "engine/allocation/fleet_state.h"
@@ -31,8 +33,15 @@ struct BatchAssignment {
 
 struct OptimalAssignmentOptions {
   bool one_order_per_robot = false;
+  // The robots orders may go to (indices, ascending, no repeats); empty: all of them.
+  std::vector<std::size_t> robots;
+  // Give a robot no more orders than its queue has free places (AllocationConfig::max_queue).
+  bool respect_queue_room = false;
   // Brute force refuses (kFailedPrecondition) batches with more maps than this.
   std::size_t max_maps = 1'000'000;
+  // Polled every 4,096 maps; true ends the search with kFailedPrecondition (a deadline or a
+  // cancel: PlanLimits' DeadlineCheck builds one).
+  std::function<bool()> stop;
 };
 
 // The batch cost of `robot_of_order` (+infinity if some robot cannot reach its order).

@@ -103,7 +103,7 @@ int Main(int argc, char** argv) {
   app.add_option("--map", source, "chu2024, a .json map file or a MovingAI .map file")
       ->capture_default_str();
   app.add_option("--table", table, "Task table CSV (seed format)")->required();
-  app.add_option("--strategy", strategy, "auction, greedy or psoga")->capture_default_str()
+  app.add_option("--strategy", strategy, "auction, greedy, exact or psoga")->capture_default_str()
       ->check(CLI::IsMember(AllocatorNames()));
   app.add_option("--zeta", zetas, "Traffic weights to compare (eq. 5)")->capture_default_str();
   app.add_option("--alpha", config.alpha, "Weight of T_t (eq. 1)")->capture_default_str()

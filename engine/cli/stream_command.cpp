@@ -243,6 +243,7 @@ int RunCompare(StreamArgs a) {
     columns = {{"auction zeta=100", "auction", 100.0, a.planner, a.routing},
                {"auction zeta=0", "auction", 0.0, a.planner, a.routing},
                {"greedy", "greedy", 0.0, a.planner, a.routing},
+               {"exact", "exact", 100.0, a.planner, a.routing},
                {"psoga", "psoga", 100.0, a.planner, a.routing}};
   } else {
     const std::vector<std::string> planners = a.planners.empty() ? std::vector<std::string>{a.planner} : a.planners;
@@ -327,7 +328,7 @@ StreamCommands AddStreamCommands(CLI::App& app, StreamArgs& stream_args, StreamA
   };
   CLI::App* s = app.add_subcommand("stream", "Order stream under the online traffic controller");
   add_stream(s, stream_args);
-  s->add_option("--strategy", stream_args.strategy, "auction, greedy or psoga")->capture_default_str()
+  s->add_option("--strategy", stream_args.strategy, "auction, greedy, exact or psoga")->capture_default_str()
       ->check(CLI::IsMember(AllocatorNames()));
   s->add_option("--zeta", stream_args.zeta, "Traffic weight of the auction")->capture_default_str();
   s->add_option("--orders-csv", stream_args.orders_csv, "Write per-order results here");

@@ -1,12 +1,13 @@
 #include "engine/dispatch/strategy.h"
 
 #include "engine/allocation/auction_allocator.h"
+#include "engine/allocation/exact_allocator.h"
 #include "engine/allocation/greedy_allocator.h"
 #include "engine/allocation/swarm_allocator.h"
 
 namespace dispatch::engine {
 
-std::vector<std::string> AllocatorNames() { return {"auction", "greedy", "psoga"}; }
+std::vector<std::string> AllocatorNames() { return {"auction", "greedy", "exact", "psoga"}; }
 
 Result<std::unique_ptr<Allocator>> MakeAllocator(std::string_view name) {
   std::unique_ptr<Allocator> allocator;
@@ -14,6 +15,8 @@ Result<std::unique_ptr<Allocator>> MakeAllocator(std::string_view name) {
     allocator = std::make_unique<AuctionAllocator>();
   } else if (name == "greedy") {
     allocator = std::make_unique<GreedyAllocator>();
+  } else if (name == "exact") {
+    allocator = std::make_unique<ExactAllocator>();
   } else if (name == "psoga") {
     allocator = std::make_unique<SwarmAllocator>();
   } else {

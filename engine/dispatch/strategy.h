@@ -15,8 +15,9 @@ namespace dispatch::engine {
 // The names MakeAllocator knows, in the order help texts list them.
 std::vector<std::string> AllocatorNames();
 // A fresh strategy: "auction" (Chu2024 §2, bids with traffic prediction), "greedy" (nearest
-// idle robot) or "psoga" (BIT2024's PSO-GA over each round's single orders as one batch,
-// formations by the auction). kInvalidArgument naming the known ones for any other name.
+// idle robot), "exact" (the minimum batch cost over every map of each round's single orders, in
+// chunks of bounded size, exact_allocator.h) or "psoga" (BIT2024's PSO-GA over each round's
+// single orders as one batch); the batch strategies leave formations to the auction. kInvalidArgument naming the known ones for any other name.
 Result<std::unique_ptr<Allocator>> MakeAllocator(std::string_view name);
 
 }  // namespace dispatch::engine

@@ -17,8 +17,8 @@
 namespace dispatch::engine {
 
 // MakeAllocator's strategies (engine/dispatch/strategy.h), by value.
-enum class AllocationStrategy { kAuction, kGreedy, kPsoGa };
-const char* AllocationStrategyName(AllocationStrategy strategy);  // "auction", "greedy", "psoga"
+enum class AllocationStrategy { kAuction, kGreedy, kExact, kPsoGa };
+const char* AllocationStrategyName(AllocationStrategy strategy);  // "auction", "greedy", "exact", "psoga"
 std::optional<AllocationStrategy> ParseAllocationStrategy(std::string_view name);
 
 struct StreamConfig {

@@ -18,7 +18,7 @@ engine::Result<ParsedCommandLine> Parse(std::vector<std::string> args) {
 
 TEST(ServerConfigTest, FlagsSetTheConfig) {
   auto parsed = Parse({"--grpc-port", "0", "--http-port", "8081", "--db", "x.db", "--map", "chu2024",
-                       "--strategy", "greedy", "--zeta", "0", "--alpha", "0.3", "--beta", "0.7",
+                       "--strategy", "exact", "--batch-window", "2.5", "--zeta", "0", "--alpha", "0.3", "--beta", "0.7",
                        "--time-scale", "10", "--bind", "127.0.0.1", "--ports-file", "p.json",
                        "--planner", "time-windows", "--turn-time", "1.5", "--routing", "heat",
                        "--heat-period", "30", "--priority", "release", "--formation-max-queue", "0",
@@ -30,7 +30,8 @@ TEST(ServerConfigTest, FlagsSetTheConfig) {
   EXPECT_EQ(c.grpc_port, 0);
   EXPECT_EQ(c.http_port, 8081);
   EXPECT_EQ(c.db, "x.db");
-  EXPECT_EQ(c.strategy, "greedy");
+  EXPECT_EQ(c.strategy, "exact");
+  EXPECT_DOUBLE_EQ(c.batch_window, 2.5);
   EXPECT_DOUBLE_EQ(c.zeta, 0.0);
   EXPECT_DOUBLE_EQ(c.alpha, 0.3);
   EXPECT_DOUBLE_EQ(c.beta, 0.7);
@@ -57,6 +58,7 @@ TEST(ServerConfigTest, FileKeysApplyAndFlagsWin) {
   EXPECT_EQ(parsed->config.db, "file.db");
   EXPECT_DOUBLE_EQ(parsed->config.zeta, 50.0);
   EXPECT_EQ(parsed->config.strategy, "auction");
+  EXPECT_DOUBLE_EQ(parsed->config.batch_window, 0.0);
   EXPECT_EQ(parsed->config.planner, "rules");
   // Formations by default: members with nothing queued, one team at a time per first pick.
   EXPECT_EQ(parsed->config.formation_max_queue, 1);
@@ -77,6 +79,9 @@ TEST(ServerConfigTest, BadValuesAreNamed) {
   ASSERT_FALSE(planner.ok());
   EXPECT_NE(planner.error().message.find("planner must be one of rules, time-windows, conflict-elimination, got 'cbs'"), std::string::npos);
   EXPECT_FALSE(Parse({"--turn-time", "-1"}).ok());
+  auto window = Parse({"--batch-window", "-1"});
+  ASSERT_FALSE(window.ok());
+  EXPECT_EQ(window.error().message, "batch_window must be >= 0 seconds");
   auto routing = Parse({"--routing", "astar"});
   ASSERT_FALSE(routing.ok());
   EXPECT_NE(routing.error().message.find("routing must be floyd or heat, got 'astar'"), std::string::npos);

@@ -323,7 +323,7 @@ TEST(RoundScheduleTest, OneRoundAtATimeAndWhatBecameDueMeanwhileRunsAfterIt) {
   rounds.MarkDue();
   ASSERT_TRUE(rounds.Begin());
   EXPECT_FALSE(rounds.due());
-  rounds.Started();
+  rounds.Started(0.0);
   // Due again while the round runs: not now, once it is committed.
   rounds.MarkDue();
   EXPECT_FALSE(rounds.Begin());
@@ -336,7 +336,7 @@ TEST(RoundScheduleTest, OneRoundAtATimeAndWhatBecameDueMeanwhileRunsAfterIt) {
   EXPECT_FALSE(rounds.due());
   // An award that did not hold: another round after this one.
   ASSERT_TRUE(rounds.Begin());
-  rounds.Started();
+  rounds.Started(0.0);
   rounds.Again();
   rounds.Finished();
   EXPECT_TRUE(rounds.due());
@@ -348,6 +348,29 @@ TEST(RoundScheduleTest, OneRoundAtATimeAndWhatBecameDueMeanwhileRunsAfterIt) {
   ASSERT_TRUE(rounds.Begin());
   rounds.Tick();
   EXPECT_FALSE(rounds.due());
+}
+
+TEST(RoundScheduleTest, ABatchWindowHoldsADueRoundUntilItEnds) {
+  RoundSchedule rounds;
+  rounds.MarkDue();
+  EXPECT_FALSE(rounds.Waiting(0.0));  // no window: never waits
+  rounds.SetWindow(2.0);
+  EXPECT_FALSE(rounds.Waiting(0.0));  // no round yet: the first one starts at once
+  ASSERT_TRUE(rounds.Begin());
+  rounds.Started(10.0);
+  rounds.Finished();
+  EXPECT_FALSE(rounds.Waiting(10.5));  // nothing due
+  rounds.MarkDue();
+  EXPECT_TRUE(rounds.Waiting(10.5));
+  EXPECT_TRUE(rounds.Waiting(11.99));
+  EXPECT_DOUBLE_EQ(rounds.not_before(), 12.0);
+  EXPECT_TRUE(rounds.due());  // still due while it waits
+  EXPECT_FALSE(rounds.Waiting(12.0));
+  ASSERT_TRUE(rounds.Begin());
+  // A round with nothing to allocate does not start a window.
+  rounds.Finished();
+  rounds.MarkDue();
+  EXPECT_FALSE(rounds.Waiting(12.5));
 }
 
 TEST(DistanceWatchTest, SamplesAtMostEveryFiftyMillisecondsAndTellsAChange) {

@@ -268,6 +268,46 @@ TEST_F(OrderFlowTest, EveryConnectedRobotBidsAndTheLowestBidWins) {
   EXPECT_DOUBLE_EQ(why.bids(1).work_time(), 10.0);
 }
 
+// A batch window (--batch-window) with a batch strategy: the first order is allocated at once;
+// the two submitted next wait for the window's end and are allocated together, one exact
+// assignment over both.
+TEST_F(OrderFlowTest, ABatchWindowAllocatesTheOrdersArrivingInItTogether) {
+  config_.time_scale = 1.0;
+  config_.strategy = "exact";
+  config_.batch_window = 2.0;
+  StartServer();
+  OrderWatcher watcher(channel_);
+  FakeRobot r1(channel_, "R1"), r2(channel_, "R2");
+  r1.Connect(kP1x, kP1y);
+  r2.Connect(kP2x, kP2y);
+  ASSERT_TRUE(r1.WaitFor(pb::ServerMessage::kWelcome));
+  ASSERT_TRUE(r2.WaitFor(pb::ServerMessage::kWelcome));
+  auto explain = [&](const std::string& id) {
+    grpc::ClientContext ctx;
+    pb::ExplainAllocationRequest request;
+    request.set_order_id(id);
+    pb::AllocationExplanation why;
+    EXPECT_TRUE(orders_->ExplainAllocation(WithDeadline(ctx), request, &why).ok());
+    return why;
+  };
+  pb::SubmitOrderResponse first, b, c;
+  ASSERT_TRUE(Submit(OrderRequest("first", {"K1-1-1N"}, "D-B1"), &first).ok());
+  ASSERT_TRUE(watcher.WaitForState(first.order().id(), pb::ORDER_STATE_ASSIGNED));
+  ASSERT_TRUE(Submit(OrderRequest("b", {"K3-6-1N"}, "D-R1"), &b).ok());
+  ASSERT_TRUE(Submit(OrderRequest("c", {"K3-2-3N"}, "D-B2"), &c).ok());
+  ASSERT_TRUE(watcher.WaitForState(b.order().id(), pb::ORDER_STATE_ASSIGNED));
+  ASSERT_TRUE(watcher.WaitForState(c.order().id(), pb::ORDER_STATE_ASSIGNED));
+  const pb::AllocationExplanation why_first = explain(first.order().id());
+  const pb::AllocationExplanation why_b = explain(b.order().id());
+  const pb::AllocationExplanation why_c = explain(c.order().id());
+  EXPECT_EQ(why_first.strategy(), "exact");
+  EXPECT_EQ(why_first.reason().rfind("exact over 1 orders", 0), 0u) << why_first.reason();
+  EXPECT_EQ(why_b.reason().rfind("exact over 2 orders", 0), 0u) << why_b.reason();
+  EXPECT_EQ(why_c.reason().rfind("exact over 2 orders", 0), 0u) << why_c.reason();
+  EXPECT_DOUBLE_EQ(why_b.time(), why_c.time());  // one round
+  EXPECT_GE(why_b.time() - why_first.time(), 2.0 - 1e-6);  // not before the window ended
+}
+
 TEST_F(OrderFlowTest, OrdersWaitAcceptedUntilARobotConnects) {
   StartServer();
   OrderWatcher watcher(channel_);

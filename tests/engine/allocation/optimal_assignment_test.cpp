@@ -141,5 +141,52 @@ TEST(OptimalAssignmentTest, RejectsFormationsAndHugeBatches) {
   EXPECT_EQ(big.error().code, ErrorCode::kFailedPrecondition);
 }
 
+TEST(OptimalAssignmentTest, ARobotSubsetQueueRoomAndAStopBoundTheSearch) {
+  auto map = Grid(5, 1, 1.0, 5, {{1, 0}, {3, 0}}, {{4, 0}});
+  auto routes = Routes(map);
+  AllocationConfig c;
+  c.max_queue = 2;
+  FleetState s = MakeFleet(map, routes, {{"R0", Pt(*map, "1,0"), 0.0}, {"R1", Pt(*map, "3,0"), 0.0},
+                                         {"R2", Pt(*map, "0,0"), 0.0}}, c);
+  const std::vector<Order> orders = {MakeOrder("a", {Pt(*map, "1,0")}, Pt(*map, "4,0")),
+                                     MakeOrder("b", {Pt(*map, "3,0")}, Pt(*map, "4,0")),
+                                     MakeOrder("c", {Pt(*map, "3,0")}, Pt(*map, "4,0"))};
+  OptimalAssignmentOptions only;
+  only.robots = {0, 2};  // not R1, which stands at b's and c's pick
+  Result<BatchAssignment> sub = BruteForceAssignment(s, orders, only);
+  ASSERT_TRUE(sub.ok()) << sub.error().message;
+  for (std::size_t r : sub->robot_of_order) EXPECT_NE(r, 1u);
+  Result<double> full = BatchCost(s, orders, sub->robot_of_order);
+  ASSERT_TRUE(full.ok());
+  EXPECT_DOUBLE_EQ(sub->cost, *full);  // the whole fleet's cost, not the subset's
+
+  OptimalAssignmentOptions one_robot;
+  one_robot.robots = {1};
+  one_robot.respect_queue_room = true;  // R1 has two places for three orders
+  Result<BatchAssignment> none = BruteForceAssignment(s, orders, one_robot);
+  ASSERT_FALSE(none.ok());
+  EXPECT_EQ(none.error().code, ErrorCode::kUnreachable);
+  one_robot.respect_queue_room = false;
+  EXPECT_TRUE(BruteForceAssignment(s, orders, one_robot).ok());
+
+  OptimalAssignmentOptions bad;
+  bad.robots = {2, 0};
+  EXPECT_EQ(BruteForceAssignment(s, orders, bad).error().code, ErrorCode::kInvalidArgument);
+  bad.robots = {7};
+  EXPECT_EQ(BruteForceAssignment(s, orders, bad).error().code, ErrorCode::kNotFound);
+
+  // 12^6 maps within the limit, a stop that is already true: ends after the first 4,096.
+  std::vector<FleetRobot> many;
+  for (int i = 0; i < 12; ++i) many.push_back({"R" + std::to_string(i), Pt(*map, "0,0"), 0.0});
+  FleetState big = MakeFleet(map, routes, many);
+  std::vector<Order> six(6, orders[0]);
+  OptimalAssignmentOptions stopped;
+  stopped.max_maps = 3'000'000;
+  stopped.stop = [] { return true; };
+  Result<BatchAssignment> cut = BruteForceAssignment(big, six, stopped);
+  ASSERT_FALSE(cut.ok());
+  EXPECT_EQ(cut.error().message, "brute force: stopped after 4096 maps");
+}
+
 }  // namespace
 }  // namespace dispatch::engine

@@ -111,10 +111,13 @@ TEST(AllocationRound, QueuesAreReplayedFromStoredPlansAndNewWorkFollowsThem) {
   EXPECT_GE(book.plan.waypoints.at(SegmentStart(book, 1)).eta, book.plan.waypoints.at(SegmentStart(book, 1) - 1).departure());
 }
 
-// A batch strategy (PSO-GA) commits a round's orders jointly, a robot's several orders in one
-// round: each award still holds exactly the part of its robot's plan it added (the first a
-// whole plan from the robot's start, each later one after the previous one's last departure).
-TEST(AllocationRound, UnderPsoGaEachAwardHoldsThePartOfThePlanItAdded) {
+// A batch strategy (PSO-GA, the exact assignment) commits a round's orders jointly, a robot's
+// several orders in one round: each award still holds exactly the part of its robot's plan it
+// added (the first a whole plan from the robot's start, each later one after the previous
+// one's last departure).
+class BatchStrategyRound : public ::testing::TestWithParam<const char*> {};
+
+TEST_P(BatchStrategyRound, EachAwardHoldsThePartOfThePlanItAdded) {
   const auto& map = *Chu2024();
   const auto parks = PointsOfKind(map, PointKind::kPark);
   const auto picks = PointsOfKind(map, PointKind::kPick);
@@ -126,13 +129,13 @@ TEST(AllocationRound, UnderPsoGaEachAwardHoldsThePartOfThePlanItAdded) {
     const auto u = static_cast<std::size_t>(k);
     input.pending.push_back(MakeOrder("o" + std::to_string(k), picks.at(7 * u + 2), drops.at(u % drops.size()), k));
   }
-  RoundRunner runner = Runner("psoga");
+  RoundRunner runner = Runner(GetParam());
   const RoundResult result = runner.Run(input);
   EXPECT_TRUE(result.notes.empty()) << result.notes.front();
   ASSERT_EQ(result.awards.size(), 5u);
   std::map<std::string, std::vector<const RoundAward*>> by_robot;
   for (const RoundAward& a : result.awards) {
-    EXPECT_EQ(a.award.strategy, "psoga");
+    EXPECT_EQ(a.award.strategy, GetParam());
     ASSERT_EQ(a.award.winners.size(), 1u);
     by_robot[a.award.winners[0]].push_back(&a);
   }
@@ -156,6 +159,8 @@ TEST(AllocationRound, UnderPsoGaEachAwardHoldsThePartOfThePlanItAdded) {
     EXPECT_EQ(book.order_ids.size(), awards.size());
   }
 }
+
+INSTANTIATE_TEST_SUITE_P(AllocationRound, BatchStrategyRound, ::testing::Values("psoga", "exact"));
 
 TEST(AllocationRound, AQueueThatCannotBeReplayedIsNamed) {
   const auto& map = *Chu2024();

@@ -83,7 +83,7 @@ TEST(Strategy, MakesTheKnownStrategiesAndNamesThemForOthers) {
   }
   auto unknown = MakeAllocator("pso-ga");
   ASSERT_FALSE(unknown.ok());
-  EXPECT_EQ(unknown.error().message, "unknown strategy 'pso-ga' (auction | greedy | psoga)");
+  EXPECT_EQ(unknown.error().message, "unknown strategy 'pso-ga' (auction | greedy | exact | psoga)");
 }
 
 }  // namespace

@@ -1,0 +1,149 @@
+#include "engine/allocation/exact_allocator.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <optional>
+#include <set>
+#include <string>
+#include <utility>
+
+#include "engine/allocation/optimal_assignment.h"
+#include "engine/planning/plan_limits.h"
+
+namespace dispatch::engine {
+namespace {
+
+// The `count` robots with room that can start `task` soonest, ascending by index.
+std::vector<std::size_t> Candidates(const FleetState& state, const PlanTask& task, std::size_t count) {
+  std::vector<std::pair<double, std::size_t>> ranked;
+  for (std::size_t i = 0; i < state.robot_count(); ++i) {
+    if (!state.HasRoom(i)) continue;
+    const QueueSummary& s = state.summary(i);
+    const double start = s.end_time + state.routes().Cost(s.end_point, task.picks.front());
+    if (std::isfinite(start)) ranked.emplace_back(start, i);
+  }
+  const std::size_t keep = std::min(count, ranked.size());
+  std::partial_sort(ranked.begin(), ranked.begin() + static_cast<std::ptrdiff_t>(keep), ranked.end());
+  std::vector<std::size_t> out;
+  for (std::size_t k = 0; k < keep; ++k) out.push_back(ranked[k].second);
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
+// The free queue places of `robots` (AllocationConfig::max_queue; unbounded without a limit).
+std::size_t FreePlaces(const FleetState& state, const std::set<std::size_t>& robots) {
+  const std::size_t max_queue = state.config().max_queue;
+  if (max_queue == 0) return std::numeric_limits<std::size_t>::max();
+  std::size_t free = 0;
+  for (std::size_t r : robots) free += max_queue - std::min(max_queue, state.queue(r).size());
+  return free;
+}
+
+// robots ^ orders, saturating at well above any limit.
+double MapCount(std::size_t robots, std::size_t orders) {
+  return std::pow(static_cast<double>(robots), static_cast<double>(orders));
+}
+
+}  // namespace
+
+ExactAllocator::ExactAllocator(ExactOptions options) : options_(options) {
+  options_.candidates = std::max<std::size_t>(1, options_.candidates);
+  options_.max_maps = std::max(options_.max_maps, options_.candidates);
+}
+
+Result<AwardExplanation> ExactAllocator::Allocate(const Order& order, FleetState& state) {
+  std::optional<Result<AwardExplanation>> out;
+  AllocateBatch({&order}, state, [&](const Order&, Result<AwardExplanation> award) { out.emplace(std::move(award)); });
+  return std::move(*out);  // every order of a batch reaches the sink once
+}
+
+void ExactAllocator::AllocateBatch(const std::vector<const Order*>& orders, FleetState& state,
+                                   const AwardSink& sink) {
+  std::vector<const Order*> singles;
+  std::vector<PlanTask> tasks;
+  for (const Order* o : orders) {
+    if (o->formation) {
+      sink(*o, auction_.Allocate(*o, state));
+      continue;
+    }
+    Result<PlanTask> task = PrepareOrder(*o, state);
+    if (!task.ok()) {
+      sink(*o, task.error());
+      continue;
+    }
+    singles.push_back(o);
+    tasks.push_back(std::move(task).value());
+  }
+  const std::function<bool()> stop = DeadlineCheck(options_.budget);
+  std::size_t next = 0;
+  while (next < singles.size()) {
+    if (stop()) {  // the budget is spent: the rest one at a time
+      for (; next < singles.size(); ++next) sink(*singles[next], auction_.Allocate(*singles[next], state));
+      return;
+    }
+    // The next chunk: orders in batch order while robots ^ orders stays within max_maps.
+    std::vector<std::size_t> chunk;
+    std::set<std::size_t> robots;
+    while (next < singles.size()) {
+      const std::vector<std::size_t> mine = Candidates(state, tasks[next], options_.candidates);
+      if (mine.empty()) {  // no robot with room reaches it: the auction says why
+        if (!chunk.empty()) break;  // after the chunk is committed (its robots may fill up)
+        sink(*singles[next], auction_.Allocate(*singles[next], state));
+        ++next;
+        continue;
+      }
+      std::set<std::size_t> merged = robots;
+      merged.insert(mine.begin(), mine.end());
+      if (!chunk.empty() && (MapCount(merged.size(), chunk.size() + 1) > static_cast<double>(options_.max_maps) ||
+                             FreePlaces(state, merged) < chunk.size() + 1)) {
+        break;
+      }
+      robots = std::move(merged);
+      chunk.push_back(next++);
+    }
+    if (chunk.empty()) continue;
+
+    std::vector<Order> batch;
+    for (std::size_t k : chunk) batch.push_back(*singles[k]);
+    OptimalAssignmentOptions search;
+    search.robots.assign(robots.begin(), robots.end());
+    search.respect_queue_room = true;
+    search.max_maps = options_.max_maps;
+    search.stop = stop;
+    Result<BatchAssignment> best = BruteForceAssignment(state, batch, search);
+    if (!best.ok()) {  // no finite map, or the budget ran out: the auction, order by order
+      for (std::size_t k : chunk) sink(*singles[k], auction_.Allocate(*singles[k], state));
+      continue;
+    }
+    char buf[160];
+    for (std::size_t c = 0; c < chunk.size(); ++c) {
+      const Order& order = *singles[chunk[c]];
+      const PlanTask& task = tasks[chunk[c]];
+      const std::size_t robot = best->robot_of_order[c];
+      const QueueSummary before = state.summary(robot);
+      if (Status s = state.AssignSingle(robot, order.id, task); !s.ok()) {
+        sink(order, s.error());
+        continue;
+      }
+      AwardExplanation ex;
+      ex.order_id = order.id;
+      ex.strategy = std::string(name());
+      Bid bid;
+      bid.robot = state.robot_id(robot);
+      bid.ready_time = before.end_time;
+      bid.t_d = state.routes().Cost(before.end_point, task.picks.front());
+      bid.bid = bid.t_d;
+      ex.bids.push_back(bid);
+      ex.winners.push_back(bid.robot);
+      std::snprintf(buf, sizeof(buf),
+                    "exact over %zu orders and %zu robots: %s (batch cost, eq. (1) over the queues, %.2f)",
+                    chunk.size(), robots.size(), bid.robot.c_str(), best->cost);
+      ex.reason = buf;
+      sink(order, std::move(ex));
+    }
+  }
+}
+
+}  // namespace dispatch::engine

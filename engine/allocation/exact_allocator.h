@@ -1,0 +1,52 @@
+// The exact assignment as an allocation strategy ("exact", issue 17 §1, SPEC §3.2 "an exact
+// optimal assignment for small batches"): the single orders of a batch (an allocation round's
+// pending orders) go to the robots by the minimum of BatchCost (optimal_assignment.h: Chu2024
+// eq. (1) summed over the robots' final queues, each robot serving its new orders after its
+// queue in batch order), found by enumerating every map.
+//
+// Exact within stated bounds, so that a round stays small whatever the fleet:
+// - The robots an order may go to are its `candidates` with room that can start it soonest
+//   (their queue's end time plus the drive to its first pick), as for PSO-GA.
+// - The batch is cut, in its order, into chunks whose maps (robots of the chunk ^ orders of
+//   the chunk) stay within `max_maps` and whose robots have a free queue place for each of
+//   its orders (AllocationConfig::max_queue); each chunk is the exact optimum over its robots given
+//   the chunks committed before it. A batch that fits one chunk, in a fleet no larger than
+//   `candidates`, gets the global optimum of BatchCost.
+// - Formation orders, orders no robot with room reaches, a chunk with no finite map (full
+//   queues, one-way lanes) and, once `budget` is spent, the rest of the batch go to the
+//   auction, which says why.
+// The traffic term of the auction's bids is not part of BatchCost. Deterministic unless the
+// budget runs out. Not thread-safe, like every Allocator.
+#pragma once
+
+#include <chrono>
+#include <cstddef>
+#include <string_view>
+#include <vector>
+
+#include "engine/allocation/allocator.h"
+#include "engine/allocation/auction_allocator.h"
+
+namespace dispatch::engine {
+
+struct ExactOptions {
+  std::size_t candidates = 4;                          // robots per order (>= 1)
+  std::size_t max_maps = 50'000;                       // maps per chunk (>= candidates)
+  std::chrono::milliseconds budget{1000};              // per batch
+};
+
+class ExactAllocator : public Allocator {
+ public:
+  explicit ExactAllocator(ExactOptions options = {});
+  std::string_view name() const override { return "exact"; }
+  // A batch of one order.
+  Result<AwardExplanation> Allocate(const Order& order, FleetState& state) override;
+  void AllocateBatch(const std::vector<const Order*>& orders, FleetState& state,
+                     const AwardSink& sink) override;
+
+ private:
+  ExactOptions options_;
+  AuctionAllocator auction_;
+};
+
+}  // namespace dispatch::engine
