@@ -9,7 +9,6 @@
 #include <string>
 #include <utility>
 
-#include "engine/allocation/optimal_assignment.h"
 #include "engine/planning/plan_limits.h"
 
 namespace dispatch::engine {
@@ -108,6 +107,7 @@ void ExactAllocator::AllocateBatch(const std::vector<const Order*>& orders, Flee
     std::vector<Order> batch;
     for (std::size_t k : chunk) batch.push_back(*singles[k]);
     OptimalAssignmentOptions search;
+    search.objective = options_.objective;
     search.robots.assign(robots.begin(), robots.end());
     search.respect_queue_room = true;
     search.max_maps = options_.max_maps;
@@ -130,16 +130,20 @@ void ExactAllocator::AllocateBatch(const std::vector<const Order*>& orders, Flee
       AwardExplanation ex;
       ex.order_id = order.id;
       ex.strategy = std::string(name());
+      // The winner's terms as the auction would state them (its queue up to this order).
+      const QueueSummary& after = state.summary(robot);
       Bid bid;
       bid.robot = state.robot_id(robot);
       bid.ready_time = before.end_time;
-      bid.t_d = state.routes().Cost(before.end_point, task.picks.front());
-      bid.bid = bid.t_d;
+      bid.t_d = after.travel_time;
+      bid.t_w = after.work_time;
+      bid.t_t = bid.t_d + bid.t_w;
+      bid.bid = BidValue(state.config().alpha, state.config().beta, bid.t_t, bid.t_d, 0.0);
       ex.bids.push_back(bid);
       ex.winners.push_back(bid.robot);
-      std::snprintf(buf, sizeof(buf),
-                    "exact over %zu orders and %zu robots: %s (batch cost, eq. (1) over the queues, %.2f)",
-                    chunk.size(), robots.size(), bid.robot.c_str(), best->cost);
+      std::snprintf(buf, sizeof(buf), "exact over %zu orders and %zu robots: %s (B=%.2f; %s %.2f)",
+                    chunk.size(), robots.size(), bid.robot.c_str(), bid.bid,
+                    options_.objective == BatchObjective::kBidSum ? "bid sum" : "queue totals", best->cost);
       ex.reason = buf;
       sink(order, std::move(ex));
     }

@@ -1,8 +1,12 @@
 // The exact assignment as an allocation strategy ("exact", issue 17 §1, SPEC §3.2 "an exact
 // optimal assignment for small batches"): the single orders of a batch (an allocation round's
-// pending orders) go to the robots by the minimum of BatchCost (optimal_assignment.h: Chu2024
-// eq. (1) summed over the robots' final queues, each robot serving its new orders after its
-// queue in batch order), found by enumerating every map.
+// pending orders) go to the robots by the minimum of a batch cost (optimal_assignment.h), found
+// by enumerating every map; each robot serves its new orders after its queue in batch order.
+// The cost is by default the bid sum: for every order, Chu2024 eq. (1) of its robot's queue up
+// to it, the auction's bid without the traffic term, so the strategy is the auction's criterion
+// optimised over the whole batch instead of order by order. (The queue totals, the yardstick of
+// the auction's tests, measure distance driven and work and nothing of waiting: on bursts they
+// pile orders on a few robots.)
 //
 // Exact within stated bounds, so that a round stays small whatever the fleet:
 // - The robots an order may go to are its `candidates` with room that can start it soonest
@@ -26,10 +30,12 @@
 
 #include "engine/allocation/allocator.h"
 #include "engine/allocation/auction_allocator.h"
+#include "engine/allocation/optimal_assignment.h"
 
 namespace dispatch::engine {
 
 struct ExactOptions {
+  BatchObjective objective = BatchObjective::kBidSum;
   std::size_t candidates = 4;                          // robots per order (>= 1)
   std::size_t max_maps = 50'000;                       // maps per chunk (>= candidates)
   std::chrono::milliseconds budget{1000};              // per batch

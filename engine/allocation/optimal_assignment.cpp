@@ -32,9 +32,11 @@ Result<std::vector<BatchTask>> Prepare(const FleetState& state, const std::vecto
   return tasks;
 }
 
-// Sum over robots (all, or `only`) of eq. (1) for the final queues.
+// Over the robots (all, or `only`): eq. (1) of each final queue, or of each queue up to every
+// order of the batch it takes (the bid sum).
 double Total(const FleetState& state, const std::vector<BatchTask>& tasks,
-             const std::vector<std::size_t>& robot_of_order, const std::vector<std::size_t>* only) {
+             const std::vector<std::size_t>& robot_of_order, const std::vector<std::size_t>* only,
+             BatchObjective objective) {
   const AllocationConfig& c = state.config();
   double total = 0.0;
   const std::size_t count = only ? only->size() : state.robot_count();
@@ -49,8 +51,11 @@ double Total(const FleetState& state, const std::vector<BatchTask>& tasks,
       travel += state.routes().Cost(at, tasks[k].first) + tasks[k].travel;
       work += tasks[k].work;
       at = tasks[k].drop;
+      if (objective == BatchObjective::kBidSum) total += c.alpha * (travel + work) + c.beta * travel;
     }
-    total += c.alpha * (travel + work) + c.beta * travel;  // Chu2024 eqs. (1)-(3)
+    if (objective == BatchObjective::kQueueTotals) {
+      total += c.alpha * (travel + work) + c.beta * travel;  // Chu2024 eqs. (1)-(3)
+    }
   }
   return total;
 }
@@ -58,7 +63,7 @@ double Total(const FleetState& state, const std::vector<BatchTask>& tasks,
 }  // namespace
 
 Result<double> BatchCost(const FleetState& state, const std::vector<Order>& orders,
-                         const std::vector<std::size_t>& robot_of_order) {
+                         const std::vector<std::size_t>& robot_of_order, BatchObjective objective) {
   if (robot_of_order.size() != orders.size()) {
     return InvalidArgument("batch cost: " + std::to_string(orders.size()) + " orders but " +
                            std::to_string(robot_of_order.size()) + " robot indices");
@@ -68,7 +73,7 @@ Result<double> BatchCost(const FleetState& state, const std::vector<Order>& orde
   }
   Result<std::vector<BatchTask>> tasks = Prepare(state, orders);
   if (!tasks.ok()) return tasks.error();
-  return Total(state, *tasks, robot_of_order, nullptr);
+  return Total(state, *tasks, robot_of_order, nullptr, objective);
 }
 
 Result<BatchAssignment> BruteForceAssignment(const FleetState& state,
@@ -122,7 +127,7 @@ Result<BatchAssignment> BruteForceAssignment(const FleetState& state,
         stopped = true;
         return;
       }
-      const double cost = Total(state, *tasks, map, &robots);
+      const double cost = Total(state, *tasks, map, &robots, options.objective);
       if (cost < best.cost) best = {map, cost};
       return;
     }
@@ -143,7 +148,7 @@ Result<BatchAssignment> BruteForceAssignment(const FleetState& state,
     return Unreachable("brute force: no assignment of the " + std::to_string(n) +
                        " orders has a finite cost");
   }
-  best.cost = Total(state, *tasks, best.robot_of_order, nullptr);
+  best.cost = Total(state, *tasks, best.robot_of_order, nullptr, options.objective);
   return best;
 }
 
@@ -216,7 +221,7 @@ Result<BatchAssignment> HungarianAssignment(const FleetState& state,
   for (std::size_t j = 1; j <= m; ++j) {
     if (p[j] != 0) result.robot_of_order[p[j] - 1] = j - 1;
   }
-  result.cost = Total(state, *tasks, result.robot_of_order, nullptr);
+  result.cost = Total(state, *tasks, result.robot_of_order, nullptr, BatchObjective::kQueueTotals);
   if (!std::isfinite(result.cost)) {
     return Unreachable("hungarian: no one-order-per-robot assignment of the " +
                        std::to_string(n) + " orders has a finite cost");

@@ -7,6 +7,12 @@
 // T_w = n_c * t_w exactly as the auction's bids (the traffic term is not part of it). Robots
 // without new orders contribute their current queue's constant cost.
 //
+// The bid sum (BatchObjective::kBidSum) instead adds, for every order of the batch, the bid
+// the auction would see for it in that map: eq. (1) of its robot's queue up to and including
+// it (again without the traffic term). It counts a robot's earlier orders again for every
+// order queued behind them, so, like the auction's bids, it spreads orders over the robots
+// (the queue totals are lowest when the fewest robots drive).
+//
 //  - BruteForceAssignment: the minimum over all robot_count^order_count maps (optionally only
 //    injective ones, only onto a subset of the robots, only within each robot's free queue
 //    places); ties go to the first map in lexicographic order of robot indices.
@@ -26,12 +32,15 @@
 
 namespace dispatch::engine {
 
+enum class BatchObjective { kQueueTotals, kBidSum };
+
 struct BatchAssignment {
   std::vector<std::size_t> robot_of_order;  // per order, in batch order: a robot index
-  double cost = 0.0;                        // BatchCost of that map
+  double cost = 0.0;                        // BatchCost of that map (the objective's)
 };
 
 struct OptimalAssignmentOptions {
+  BatchObjective objective = BatchObjective::kQueueTotals;
   bool one_order_per_robot = false;
   // The robots orders may go to (indices, ascending, no repeats); empty: all of them.
   std::vector<std::size_t> robots;
@@ -47,7 +56,8 @@ struct OptimalAssignmentOptions {
 // The batch cost of `robot_of_order` (+infinity if some robot cannot reach its order).
 // Errors: bad orders (see PrepareOrder), formation orders, size mismatch, unknown robot.
 Result<double> BatchCost(const FleetState& state, const std::vector<Order>& orders,
-                         const std::vector<std::size_t>& robot_of_order);
+                         const std::vector<std::size_t>& robot_of_order,
+                         BatchObjective objective = BatchObjective::kQueueTotals);
 
 // Errors as BatchCost, plus kUnreachable when no map has a finite cost.
 Result<BatchAssignment> BruteForceAssignment(const FleetState& state,

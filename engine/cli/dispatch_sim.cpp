@@ -3,7 +3,7 @@
 //       allocate a task table with the auction on the Chu2024 floor (R1..R18), execute the
 //       timed plans with the Chu2024 rules off and/or on (seed 000 Fig. 8, Tables 3-4).
 //   dispatch-sim stream --map chu2024 --robots 18 (--orders FILE... [--repeat N] | --random 200 --seed 1
-//       [--formations 0.2]) [--strategy auction|greedy|exact|psoga] [--zeta 100]
+//       [--formations 0.2]) [--strategy auction|greedy|exact|psoga] [--zeta 100] [--batch-window S]
 //       [--orders-csv out.csv] [--check-safety] [--journal run.db] [--max-queue N]
 //       [--formation-max-queue N] [--one-formation-per-pick true|false] [--trace R1,R2 [--trace-from T] [--trace-to T]]
 //       [--planner rules|time-windows|conflict-elimination] [--routing floyd|heat [--heat-period S]] [--turn-time S]

@@ -95,6 +95,7 @@ StreamConfig ConfigOf(const StreamArgs& a, const std::string& strategy, double z
   StreamConfig c;
   c.time_step = a.dt;
   c.max_time = a.max_time;
+  c.allocation_period = a.batch_window;
   c.strategy = ParseAllocationStrategy(strategy).value_or(AllocationStrategy::kAuction);  // checked by CLI11
   c.allocation.zeta = zeta;
   c.allocation.max_queue = a.max_queue;
@@ -290,6 +291,9 @@ StreamCommands AddStreamCommands(CLI::App& app, StreamArgs& stream_args, StreamA
         ->capture_default_str()->check(CLI::Range(0.0, 1.0));
     c->add_option("--dt", a.dt, "Time step, s")->capture_default_str()->check(CLI::PositiveNumber);
     c->add_option("--max-time", a.max_time, "Simulated seconds before giving up")->capture_default_str();
+    c->add_option("--batch-window", a.batch_window,
+                  "Seconds between allocation rounds at least (0: a round as soon as one is due)")
+        ->capture_default_str()->check(CLI::NonNegativeNumber);
     c->add_option("--planner", a.planner, "How awards get their routes: " + PlannerList())
         ->capture_default_str();
     c->add_option("--turn-time", a.turn_s, "Turning time per 90 degrees, s (plans, route costs, robots)")

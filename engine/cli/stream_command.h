@@ -24,6 +24,7 @@ struct StreamArgs {
   double interval = 2.0, zeta = 100.0, dt = 0.1, max_time = 36000.0, formations = 0.0;
   bool check_safety = false, one_formation_per_pick = true;
   double blocked_recovery = 60.0;  // CoreOptions::blocked_recovery
+  double batch_window = 0.0;       // StreamConfig::allocation_period
   std::vector<std::string> trace;  // robots to trace
   double trace_from = 0.0, trace_to = std::numeric_limits<double>::infinity();
   std::string planner = "rules";           // AllocationConfig::planner

@@ -16,7 +16,11 @@
 //   BM_SimulatePlannerTimeWindows/R, BM_SimulatePlannerConflictElimination/R,
 //   BM_SimulatePlannerHeat/R   BM_SimulateOnCore's stream with AllocationConfig::planner =
 //                   time-windows / conflict-elimination / routing = heat (issue 16).
-// Counter `speedup` = simulated seconds per wall second (target: R = 500 at >= 100x).
+//   BM_SimulateStrategyPsoGa/R, BM_SimulateStrategyExact/R   BM_SimulateOnCore's stream allocated
+//                   by PSO-GA / the exact assignment (issue 17 §1): each round's pending orders
+//                   (10 s of them) as one batch.
+// Counter `speedup` = simulated seconds per wall second (target: R = 500 at >= 100x);
+// `distance` metres driven, `alloc_s` wall seconds in allocation rounds.
 // The map, the route table (warmed on every pick and drop) and the orders are built once,
 // outside the timing. Run from a Release build:
 //   cmake --build build-rel --target sim_bench && build-rel/tests/benchmarks/sim_bench
@@ -63,7 +67,8 @@ const Floor& LargeFloor() {
 }
 
 void Simulate(benchmark::State& state, double formation_share, PlannerKind planner = PlannerKind::kRules,
-              RoutingKind routing = RoutingKind::kFloyd) {
+              RoutingKind routing = RoutingKind::kFloyd,
+              AllocationStrategy strategy = AllocationStrategy::kAuction) {
   const Floor& f = LargeFloor();
   const auto robots_count = static_cast<std::size_t>(state.range(0));
   auto robots = PlaceRobots(*f.map, robots_count);
@@ -78,11 +83,12 @@ void Simulate(benchmark::State& state, double formation_share, PlannerKind plann
   StreamConfig config;
   config.max_time = kHorizon;
   config.allocation_period = 10.0;
+  config.strategy = strategy;
   config.allocation.planner = planner;
   config.allocation.routing = routing;
   double simulated = 0;
   std::size_t completed = 0, total = 0, deadlocks = 0, replans = 0, blocked = 0;
-  double waiting = 0.0, completion = 0.0, recovered = 0.0, head_on = 0.0;
+  double waiting = 0.0, completion = 0.0, recovered = 0.0, head_on = 0.0, distance = 0.0, planning = 0.0;
   for (auto _ : state) {
     auto r = SimulateOnCore(f.map, f.routes, *robots, *orders, config);
     if (!r.ok()) throw std::runtime_error(r.error().message);
@@ -96,6 +102,8 @@ void Simulate(benchmark::State& state, double formation_share, PlannerKind plann
     completion += r->mean_completion;
     recovered += static_cast<double>(r->recovered.size());
     head_on += static_cast<double>(r->traffic.head_on_conflicts);
+    distance += r->total_distance;
+    planning += r->planning_seconds;
   }
   state.counters["speedup"] = benchmark::Counter(simulated, benchmark::Counter::kIsRate);
   state.counters["completed"] = static_cast<double>(completed) / static_cast<double>(state.iterations());
@@ -108,6 +116,9 @@ void Simulate(benchmark::State& state, double formation_share, PlannerKind plann
   state.counters["mean_done"] = completion / static_cast<double>(state.iterations());
   state.counters["head_on"] = head_on / static_cast<double>(state.iterations());
   state.counters["recovered"] = recovered / static_cast<double>(state.iterations());
+  // Metres driven, and wall seconds spent in allocation rounds (strategy and planner).
+  state.counters["distance"] = distance / static_cast<double>(state.iterations());
+  state.counters["alloc_s"] = planning / static_cast<double>(state.iterations());
 }
 
 void BM_SimulateOnCore(benchmark::State& state) { Simulate(state, 0.0); }
@@ -117,6 +128,12 @@ void BM_SimulatePlannerConflictElimination(benchmark::State& state) {
   Simulate(state, 0.0, PlannerKind::kConflictElimination);
 }
 void BM_SimulatePlannerHeat(benchmark::State& state) { Simulate(state, 0.0, PlannerKind::kRules, RoutingKind::kHeat); }
+void BM_SimulateStrategyPsoGa(benchmark::State& state) {
+  Simulate(state, 0.0, PlannerKind::kRules, RoutingKind::kFloyd, AllocationStrategy::kPsoGa);
+}
+void BM_SimulateStrategyExact(benchmark::State& state) {
+  Simulate(state, 0.0, PlannerKind::kRules, RoutingKind::kFloyd, AllocationStrategy::kExact);
+}
 BENCHMARK(BM_SimulateOnCore)->Arg(18)->Arg(100)->Arg(500)->Unit(benchmark::kMillisecond)
     ->UseRealTime()->Iterations(2);
 BENCHMARK(BM_SimulateFormationsOnCore)->Arg(100)->Arg(500)->Unit(benchmark::kMillisecond)
@@ -126,6 +143,10 @@ BENCHMARK(BM_SimulatePlannerTimeWindows)->Arg(100)->Arg(500)->Unit(benchmark::kM
 BENCHMARK(BM_SimulatePlannerConflictElimination)->Arg(100)->Arg(500)->Unit(benchmark::kMillisecond)
     ->UseRealTime()->Iterations(2);
 BENCHMARK(BM_SimulatePlannerHeat)->Arg(100)->Arg(500)->Unit(benchmark::kMillisecond)
+    ->UseRealTime()->Iterations(2);
+BENCHMARK(BM_SimulateStrategyPsoGa)->Arg(100)->Arg(500)->Unit(benchmark::kMillisecond)
+    ->UseRealTime()->Iterations(2);
+BENCHMARK(BM_SimulateStrategyExact)->Arg(100)->Arg(500)->Unit(benchmark::kMillisecond)
     ->UseRealTime()->Iterations(2);
 
 }  // namespace

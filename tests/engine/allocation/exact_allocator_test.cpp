@@ -29,6 +29,7 @@ using testing_util::Routes;
 struct Awarded {
   std::string order, strategy, reason, error;
   std::vector<std::string> winners;
+  double bid = 0.0;  // the winner's B
 };
 
 std::vector<Awarded> RunBatch(ExactAllocator& allocator, const std::vector<Order>& orders, FleetState& fleet) {
@@ -36,22 +37,15 @@ std::vector<Awarded> RunBatch(ExactAllocator& allocator, const std::vector<Order
   for (const Order& o : orders) batch.push_back(&o);
   std::vector<Awarded> out;
   allocator.AllocateBatch(batch, fleet, [&](const Order& o, Result<AwardExplanation> a) {
-    out.push_back(a.ok() ? Awarded{o.id, a->strategy, a->reason, "", a->winners}
-                         : Awarded{o.id, "", "", a.error().message, {}});
+    out.push_back(a.ok() ? Awarded{o.id, a->strategy, a->reason, "", a->winners, a->bids.empty() ? 0.0 : a->bids[0].bid}
+                         : Awarded{o.id, "", "", a.error().message, {}, 0.0});
   });
   return out;
 }
 
-// Chu2024 eq. (1) summed over the fleet's queues as they are.
-double QueuesCost(const FleetState& s) {
-  double total = 0.0;
-  for (std::size_t r = 0; r < s.robot_count(); ++r) {
-    const QueueSummary& q = s.summary(r);
-    total += s.config().alpha * (q.travel_time + q.work_time) + s.config().beta * q.travel_time;
-  }
-  return total;
-}
-
+// The bid sum is the auction's own criterion: on the auction's awards (zeta = 0: no traffic
+// term) it is the sum of the winning bids; the exact assignment's is never above it, and is the
+// minimum over every map. The queue totals objective is BatchCost's yardstick.
 TEST(ExactAllocatorTest, OnSmallBatchesItIsTheOptimumAndNeverAboveTheAuction) {
   auto map = Grid(6, 6, 1.0, 6, {{0, 5}, {5, 5}, {2, 2}, {5, 0}, {3, 4}}, {{0, 0}, {2, 5}});
   auto routes = Routes(map);
@@ -78,7 +72,9 @@ TEST(ExactAllocatorTest, OnSmallBatchesItIsTheOptimumAndNeverAboveTheAuction) {
       orders.push_back(o);
     }
     FleetState fleet = MakeFleet(map, routes, robots, c);
-    Result<BatchAssignment> best = BruteForceAssignment(fleet, orders);
+    OptimalAssignmentOptions bid_sum;
+    bid_sum.objective = BatchObjective::kBidSum;
+    Result<BatchAssignment> best = BruteForceAssignment(fleet, orders, bid_sum);
     ASSERT_TRUE(best.ok()) << best.error().message;
 
     ExactAllocator exact;
@@ -90,13 +86,41 @@ TEST(ExactAllocatorTest, OnSmallBatchesItIsTheOptimumAndNeverAboveTheAuction) {
       EXPECT_EQ(awards[k].strategy, "exact");
       EXPECT_EQ(awards[k].winners[0], fleet.robot_id(best->robot_of_order[k])) << "seed " << seed;
     }
-    EXPECT_NEAR(QueuesCost(fleet), best->cost, 1e-6) << "seed " << seed;
+    double winning = 0.0;  // the awards' own B, summed
+    for (const Awarded& a : awards) winning += a.bid;
+    EXPECT_NEAR(winning, best->cost, 1e-6) << "seed " << seed;
 
     FleetState by_auction = MakeFleet(map, routes, robots, c);
     AuctionAllocator auction;
-    for (const OrderAllocation& a : AllocateAll(auction, orders, by_auction)) ASSERT_TRUE(a.award.ok());
-    EXPECT_GE(QueuesCost(by_auction), best->cost - 1e-9) << "seed " << seed;
-    if (QueuesCost(by_auction) > best->cost + 1e-9) ++below_auction;
+    std::vector<std::size_t> auction_map;
+    double auction_bids = 0.0;
+    for (const OrderAllocation& a : AllocateAll(auction, orders, by_auction)) {
+      ASSERT_TRUE(a.award.ok());
+      auction_map.push_back(*by_auction.FindRobot(a.award->winners[0]));
+      for (const Bid& b : a.award->bids) {
+        if (b.robot == a.award->winners[0]) auction_bids += b.bid;
+      }
+    }
+    FleetState before = MakeFleet(map, routes, robots, c);
+    Result<double> auction_cost = BatchCost(before, orders, auction_map, BatchObjective::kBidSum);
+    ASSERT_TRUE(auction_cost.ok());
+    EXPECT_NEAR(*auction_cost, auction_bids, 1e-6) << "seed " << seed;  // the same criterion
+    EXPECT_GE(auction_bids, best->cost - 1e-9) << "seed " << seed;
+    if (auction_bids > best->cost + 1e-9) ++below_auction;
+
+    ExactOptions totals;
+    totals.objective = BatchObjective::kQueueTotals;
+    ExactAllocator yardstick(totals);
+    FleetState again = MakeFleet(map, routes, robots, c);
+    const std::vector<Awarded> by_totals = RunBatch(yardstick, orders, again);
+    ASSERT_EQ(by_totals.size(), orders.size());
+    FleetState fresh = MakeFleet(map, routes, robots, c);
+    Result<BatchAssignment> optimum = BruteForceAssignment(fresh, orders);
+    ASSERT_TRUE(optimum.ok());
+    for (std::size_t k = 0; k < by_totals.size(); ++k) {
+      ASSERT_EQ(by_totals[k].winners.size(), 1u);
+      EXPECT_EQ(by_totals[k].winners[0], fresh.robot_id(optimum->robot_of_order[k])) << "seed " << seed;
+    }
   }
   EXPECT_GT(below_auction, 0);  // the instances are not all ones the auction already solves
 }

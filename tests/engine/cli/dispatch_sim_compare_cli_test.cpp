@@ -57,6 +57,21 @@ TEST(DispatchSimCompareCliTest, OrdersLeftAtTheTimeLimitAreCountedAsWaiting) {
   EXPECT_EQ(row[12], "-") << run.output;
 }
 
+// Without --planners a column per strategy, the batch strategies included; a batch window
+// applies to every column, and a negative one is refused.
+TEST(DispatchSimCompareCliTest, StrategiesSideBySideWithABatchWindow) {
+  const auto run = Compare("--random 20 --seed 3 --interval 0.3 --batch-window 4");
+  ASSERT_EQ(run.status, 0) << run.output;
+  for (const char* strategy : {"greedy", "exact", "psoga"}) {
+    const std::vector<std::string> row = Row(run.output, strategy);
+    ASSERT_EQ(row.size(), 14u) << strategy << "\n" << run.output;
+    EXPECT_EQ(row[1], "20/20") << run.output;
+  }
+  const auto bad = Compare("--random 5 --batch-window -1");
+  EXPECT_NE(bad.status, 0) << bad.output;
+  EXPECT_NE(bad.output.find("--batch-window"), std::string::npos) << bad.output;
+}
+
 // The order-stream model is gone: the option that chose it is refused.
 TEST(DispatchSimCompareCliTest, ThereIsNoModelToChoose) {
   const auto run = Compare("--random 5 --model stream");
