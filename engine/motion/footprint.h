@@ -1,16 +1,16 @@
 // A rectangular robot footprint and its collision check against an OccupancyGrid (SPEC §3.7).
 //
 // The rectangle is `length` along the heading and `width` across it, centred on the pose,
-// grown by `margin` on every side. A pose collides when a sample point of the rectangle lies
-// in an occupied (or out-of-grid) cell. The samples form a lattice with spacing at most half a
-// cell over the rectangle, boundary included, so every cell the rectangle covers entirely
-// holds a sample (a square of side `resolution` always contains a point of a lattice of
-// spacing resolution / 2) and cells crossed by an edge are caught down to slivers of about
-// a quarter cell. `margin` covers that slack when it matters.
+// grown by `margin` on every side. A pose collides when the rectangle overlaps the interior
+// of an occupied (or out-of-grid) cell: exact, by rows — for each grid row the rectangle
+// spans, the x-extent of the rectangle clipped to that row's strip, and a per-row prefix sum
+// of occupied cells says in O(1) whether any lies in it (about ten rows for a 0.8 m robot on
+// 0.1 m cells). Touching a cell's edge is no overlap.
 // Fast path: a pose whose cell's clearance exceeds the rectangle's circumradius plus two
-// cells cannot collide and is accepted without sampling.
+// cells cannot collide and is accepted at once.
 // The fast path needs the grid's clearance (OccupancyGrid::ComputeClearance); without it every
-// pose is sampled. The checker holds a reference to the grid, which must outlive it; it is
+// pose takes the row scan. The checker holds a reference to the grid, which must outlive it
+// and not change after the checker is made (the prefix sums are the checker's); it is
 // immutable: safe to share between threads.
 #pragma once
 
@@ -43,7 +43,9 @@ class FootprintChecker {
   const OccupancyGrid& grid_;
   Footprint footprint_;
   double circumradius_ = 0.0;
-  std::vector<Eigen::Vector2d> samples_;  // in the robot frame, x along the heading
+  double half_length_ = 0.0;
+  double half_width_ = 0.0;
+  std::vector<int> row_prefix_;  // row iy: occupied cells among [0, ix) at iy * (width + 1) + ix
 };
 
 }  // namespace dispatch::engine

@@ -69,8 +69,48 @@ class Search {
   double F(const MotionPose& p, double g) const {
     const double dx = goal_.x - p.x;
     const double dy = goal_.y - p.y;
-    const double h = std::abs(dx) + std::abs(dy) + o_.heading_weight * std::abs(WrapHeading(goal_.theta - p.theta));
+    double h_o = std::abs(dx) + std::abs(dy);
+    if (!steps_to_goal_.empty()) {
+      const OccupancyGrid& grid = checker_.grid();
+      const int ix = grid.CellX(p.x);
+      const int iy = grid.CellY(p.y);
+      if (grid.InBounds(ix, iy)) {
+        const int steps = steps_to_goal_[static_cast<std::size_t>(iy) * grid.width() + ix];
+        if (steps >= 0) h_o = steps * grid.resolution();
+      }
+    }
+    const double h = h_o + o_.heading_weight * std::abs(WrapHeading(goal_.theta - p.theta));
     return g + HeuristicWeight(o_, std::hypot(dx, dy)) * h;
+  }
+
+  // The Manhattan distance through the grid's free cells (h_o, see the header): breadth-first
+  // from the goal's cell, 4-connected.
+  void SweepFromGoal() {
+    const OccupancyGrid& grid = checker_.grid();
+    const int w = grid.width();
+    const double min_clearance = checker_.footprint().width / 2.0 - grid.resolution() / 2.0;
+    auto passable = [&](int ix, int iy) {
+      return !grid.Occupied(ix, iy) && (!grid.has_clearance() || grid.Clearance(ix, iy) >= min_clearance);
+    };
+    steps_to_goal_.assign(static_cast<std::size_t>(w) * grid.height(), -1);
+    const int gx = grid.CellX(goal_.x);
+    const int gy = grid.CellY(goal_.y);
+    if (!grid.InBounds(gx, gy)) return;
+    std::vector<int> queue{gy * w + gx};
+    steps_to_goal_[queue[0]] = 0;
+    for (std::size_t head = 0; head < queue.size(); ++head) {
+      const int cell = queue[head];
+      const int cx = cell % w;
+      const int cy = cell / w;
+      const int next_steps = steps_to_goal_[cell] + 1;
+      for (const auto& [dx, dy] : {std::pair{1, 0}, std::pair{-1, 0}, std::pair{0, 1}, std::pair{0, -1}}) {
+        const int nx = cx + dx;
+        const int ny = cy + dy;
+        if (!passable(nx, ny) || steps_to_goal_[ny * w + nx] >= 0) continue;
+        steps_to_goal_[ny * w + nx] = next_steps;
+        queue.push_back(ny * w + nx);
+      }
+    }
   }
 
   std::int64_t Key(const MotionPose& p) const {
@@ -129,6 +169,7 @@ class Search {
   double spin_spacing_;
   std::vector<Move> moves_;
   std::vector<Node> nodes_;
+  std::vector<int> steps_to_goal_;  // per cell, -1: not reached (empty: plain Manhattan)
 };
 
 bool Search::Analytic(int i, MotionPath& tail, std::string& kind) const {
@@ -185,6 +226,7 @@ MotionPath Search::Reconstruct(int last) const {
 }
 
 Result<MotionPath> Search::Run() {
+  if (o_.manhattan_through_free_cells) SweepFromGoal();
   using Entry = std::tuple<double, int>;  // f, node index (creation order breaks ties)
   std::priority_queue<Entry, std::vector<Entry>, std::greater<>> open;
   std::unordered_map<std::int64_t, int> best;  // state key -> node with the least g

@@ -12,8 +12,14 @@
 //   straight, reverse, crab, spin and steer"). A switch is a change of DriveClass
 //   (motion_path.h): steering on the move is priced by lambda_turn, not as a switch. For a
 //   spin, dist = angle * spin_radius (metres swept at `spin_radius` from the centre).
-// Heuristic (eq. (5)): h = |dx| + |dy| (h_o, Manhattan) + heading_weight * |theta_goal - theta|
-//   (h_h). Not admissible; the search is weighted anyway.
+// Heuristic (eq. (5)): h = h_o + h_h, h_h = heading_weight * |theta_goal - theta|. h_o is the
+//   Manhattan distance to the goal. With `manhattan_through_free_cells` (default) it is
+//   measured through the grid: the 4-connected step count from the goal's cell over cells
+//   where the robot's centre may stand (clearance >= half the footprint width less half a
+//   cell), times the resolution — the same |dx| + |dy| where nothing is in the way, but it
+//   sends the search around walls instead of into them (one breadth-first sweep per query).
+//   Cells the sweep does not reach fall back to |dx| + |dy|. false: the seed's plain
+//   |dx| + |dy|. Not admissible either way; the search is weighted anyway.
 // Priority (eq. (6)): f = g + xi * h, xi by the Euclidean distance to the goal: the first band
 //   whose `from` the distance reaches (bands sorted by `from` descending), so xi shrinks as the
 //   robot nears the goal; `adaptive_xi = false` uses `fixed_xi` everywhere.
@@ -58,6 +64,7 @@ struct HybridAStarOptions {
   double lambda_turn = 0.3;        // eq. (4)
   double lambda_switch = 2.0;      // eq. (4)
   double heading_weight = 0.3;     // eq. (5), metres per radian
+  bool manhattan_through_free_cells = true;  // eq. (5) h_o, see above
   bool adaptive_xi = true;         // eq. (6)
   std::vector<XiBand> xi_bands = {{8.0, 2.0}, {4.0, 1.6}, {2.0, 1.3}, {0.0, 1.0}};
   double fixed_xi = 1.0;
