@@ -66,7 +66,9 @@ struct HybridAStarOptions {
   double heading_weight = 0.3;     // eq. (5), metres per radian
   bool manhattan_through_free_cells = true;  // eq. (5) h_o, see above
   bool adaptive_xi = true;         // eq. (6)
-  std::vector<XiBand> xi_bands = {{8.0, 2.0}, {4.0, 1.6}, {2.0, 1.3}, {0.0, 1.0}};
+  // Beyond 6 m 1.5, 3-6 m 1.2, within 3 m (the analytic range) 1.0. Steeper bands (up to 2.0)
+  // made the search greedier into walls on the narrow floor (narrow_floor.md, measurements).
+  std::vector<XiBand> xi_bands = {{6.0, 1.5}, {3.0, 1.2}, {0.0, 1.0}};
   double fixed_xi = 1.0;
   double analytic_range = 3.0;     // metres
   int rs_candidates = 4;

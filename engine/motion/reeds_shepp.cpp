@@ -122,6 +122,21 @@ bool LpRmSmRm(double x, double y, double phi, double& t, double& u, double& v) {
   return t >= -kEps && u <= kEps && v <= kEps;
 }
 
+// (8.11) L+R-(pi/2)S-L-(pi/2)R+: lengths t, -pi/2, u, -pi/2, v
+bool LpRmSLmRp(double x, double y, double phi, double& t, double& u, double& v) {
+  const double xi = x + std::sin(phi);
+  const double eta = y - 1.0 - std::cos(phi);
+  double rho = 0.0;
+  double theta = 0.0;
+  Polar(xi, eta, rho, theta);
+  if (rho < 2.0) return false;
+  u = 4.0 - std::sqrt(rho * rho - 4.0);
+  if (u > kEps) return false;
+  t = WrapHeading(std::atan2((4.0 - u) * xi - 2.0 * eta, -2.0 * xi + (u - 4.0) * eta));
+  v = WrapHeading(t - phi);
+  return t >= -kEps && v >= -kEps;
+}
+
 Word Make(std::initializer_list<char> types, std::initializer_list<double> lens) {
   Word w;
   auto ti = types.begin();
@@ -183,6 +198,9 @@ std::vector<Word> AllWords(double x, double y, double phi) {
                [](double t, double u, double v) { return Make({'L', 'S', 'R', 'L'}, {v, u, -h, t}); }, words);
   AddSymmetric(LpRmSmRm, xb, yb, phi,
                [](double t, double u, double v) { return Make({'R', 'S', 'R', 'L'}, {v, u, -h, t}); }, words);
+  // C|C(pi/2)SC(pi/2)|C
+  AddSymmetric(LpRmSLmRp, x, y, phi,
+               [](double t, double u, double v) { return Make({'L', 'R', 'S', 'L', 'R'}, {t, -h, u, -h, v}); }, words);
   return words;
 }
 

@@ -3,16 +3,17 @@
 // from arcs of radius r (L, R) and straight segments (S). Used by the hybrid A*'s analytic
 // expansion near the goal (BIT2024 step 6).
 //
-// Families implemented, each with the paper's time-flip and reflection symmetries and, where
-// the paper uses it, the backwards (reversed-order) form — 40 of the 48 words:
-//   CSC    (8.1, 8.2):  L+S+L+, L+S+R+                                      -> 8 words
-//   C|C|C  (8.3):       L+R-L+, with backwards                              -> 8 words
-//   CC|CC  (8.7, 8.8):  L+R+L-R-, L+R-L-R+                                  -> 8 words
-//   C|CSC  (8.9, 8.10): L+R-(pi/2)S-L-, L+R-(pi/2)S-R-, with backwards      -> 16 words
-// Not implemented: C|C(pi/2)SC(pi/2)|C (8.11, 4 words) and the C|CC / CC|C forms that the
-// paper lists apart from C|C|C (they coincide with its backwards and time-flipped forms as
-// generated here). Missing words only make some returned paths longer than optimal, never
-// wrong: every candidate is integrated and kept only when it ends at the goal (1e-6).
+// Families implemented (formula numbers of the paper's §8, as the common formulation and OMPL
+// number them), each with the time-flip and reflection symmetries and, where marked, the
+// backwards (reversed-order) form — 44 candidate words per query:
+//   CSC          (8.1, 8.2):   L+S+L+, L+S+R+                                   8 words
+//   C|C|C        (8.3):        L+R-L+, with backwards                           8 words
+//   CC|CC        (8.7, 8.8):   L+R+L-R-, L+R-L-R+                               8 words
+//   C|CSC, CSC|C (8.9, 8.10):  L+R-(pi/2)S-L-, L+R-(pi/2)S-R-, with backwards  16 words
+//   C|CSC|C      (8.11):       L+R-(pi/2)S-L-(pi/2)R+                           4 words
+// Reeds & Shepp's table has 48 words; the C|CC and CC|C forms are not generated on their own
+// here, so for some goals the returned "shortest" may be longer than the true optimum. It is
+// never wrong: every candidate is integrated and kept only when it ends at the goal (1e-6).
 // Pure functions; thread-safe.
 #pragma once
 
@@ -37,8 +38,8 @@ struct RsPath {
 // Empty segments (|length| < 1e-9) are dropped.
 std::vector<RsPath> ReedsSheppPaths(const MotionPose& start, const MotionPose& goal, double radius);
 
-// The shortest of them (a path always exists for these families: CSC alone covers every
-// goal); nullopt-free: returns an empty path when start == goal.
+// The shortest of them; an empty path when there is none (start == goal; never seen
+// otherwise: the random-query test finds a path for every one of its 500 queries).
 RsPath ShortestReedsShepp(const MotionPose& start, const MotionPose& goal, double radius);
 
 // The motion mode of a segment: S+ forward, S- reverse, L+ arc_forward_left, L- arc_reverse_left, ...

@@ -138,10 +138,11 @@ TEST_F(NarrowFloorTest, CollidingStartOrGoalIsInvalid) {
 
 TEST(HybridAStarTest, AdaptiveXiShrinksTowardsTheGoal) {
   HybridAStarOptions o;
-  EXPECT_EQ(HeuristicWeight(o, 12.0), 2.0);
-  EXPECT_EQ(HeuristicWeight(o, 5.0), 1.6);
-  EXPECT_EQ(HeuristicWeight(o, 3.0), 1.3);
-  EXPECT_EQ(HeuristicWeight(o, 0.5), 1.0);
+  EXPECT_EQ(HeuristicWeight(o, 12.0), 1.5);
+  EXPECT_EQ(HeuristicWeight(o, 6.0), 1.5);
+  EXPECT_EQ(HeuristicWeight(o, 5.0), 1.2);
+  EXPECT_EQ(HeuristicWeight(o, 2.9), 1.0);
+  EXPECT_EQ(HeuristicWeight(o, 0.0), 1.0);
   o.adaptive_xi = false;
   o.fixed_xi = 1.5;
   EXPECT_EQ(HeuristicWeight(o, 12.0), 1.5);

@@ -2,6 +2,8 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <map>
+#include <string>
 #include <numbers>
 #include <random>
 
@@ -87,6 +89,25 @@ TEST(ReedsSheppTest, RandomQueriesEndAtGoalAndAreSymmetric) {
     EXPECT_NEAR(ShortestReedsShepp({0, 0, 0}, {x, -y, -phi}, 0.8).length, len, 1e-7);
     EXPECT_NEAR(ShortestReedsShepp({0, 0, 0}, {-x, y, -phi}, 0.8).length, len, 1e-7);
     EXPECT_NEAR(ShortestReedsShepp({0, 0, 0}, {2 * x, 2 * y, phi}, 1.6).length, 2 * len, 1e-6);
+  }
+}
+
+// Every family's formulas produce valid paths (candidates that miss the goal are dropped, so
+// a wrong formula would show as a family that never appears).
+TEST(ReedsSheppTest, EveryFamilyYieldsPaths) {
+  std::mt19937 rng(9);
+  std::uniform_real_distribution<double> pos(-3.0, 3.0);
+  std::uniform_real_distribution<double> ang(-kPi, kPi);
+  std::map<std::string, int> seen;
+  for (int k = 0; k < 2000; ++k) {
+    for (const RsPath& p : ReedsSheppPaths({0, 0, 0}, {pos(rng), pos(rng), ang(rng)}, 1.0)) {
+      std::string word;
+      for (const RsSegment& seg : p.segments) word += seg.type == 'S' ? 'S' : 'C';
+      ++seen[word];
+    }
+  }
+  for (const char* family : {"CSC", "CCC", "CCCC", "CCSC", "CSCC", "CCSCC"}) {
+    EXPECT_GT(seen[family], 0) << family;
   }
 }
 
