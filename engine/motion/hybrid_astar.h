@@ -62,7 +62,7 @@ struct HybridAStarOptions {
   bool allow_crab = true;
   bool allow_spin = true;
   double lambda_turn = 0.3;        // eq. (4)
-  double lambda_switch = 2.0;      // eq. (4)
+  double lambda_switch = 5.0;      // eq. (4): at step 0.2 m a switch costs 1 m of travel
   double heading_weight = 0.3;     // eq. (5), metres per radian
   bool manhattan_through_free_cells = true;  // eq. (5) h_o, see above
   bool adaptive_xi = true;         // eq. (6)

@@ -86,6 +86,19 @@ TEST_F(NarrowFloorTest, DeadEndAisleIsLeftBySpinningOrReversing) {
   EXPECT_FALSE(Uses(*car, {MotionMode::kSpinLeft, MotionMode::kSpinRight, MotionMode::kCrabLeft, MotionMode::kCrabRight}));
 }
 
+// Eq. (5) with the seed's plain |dx| + |dy| still finds valid paths (with many more
+// expansions on the cross-floor query: the corridor's west end is a local minimum of it).
+TEST_F(NarrowFloorTest, PlainManhattanHeuristicAlsoWorks) {
+  HybridAStarOptions plain = options_;
+  plain.manhattan_through_free_cells = false;
+  const Result<MotionPath> path = PlanHybridAStar(checker_, floor_.cross_start, floor_.cross_goal, plain);
+  ASSERT_TRUE(path.ok()) << path.error().message;
+  ExpectValid(*path, floor_.cross_start, floor_.cross_goal);
+  const Result<MotionPath> informed = PlanHybridAStar(checker_, floor_.cross_start, floor_.cross_goal, options_);
+  ASSERT_TRUE(informed.ok()) << informed.error().message;
+  EXPECT_LT(informed->nodes_expanded * 10, path->nodes_expanded);
+}
+
 TEST_F(NarrowFloorTest, ZeroDeadlineStops) {
   options_.limits.stop = DeadlineCheck(std::chrono::nanoseconds(0));
   const Result<MotionPath> path = PlanHybridAStar(checker_, floor_.cross_start, floor_.cross_goal, options_);
