@@ -57,12 +57,16 @@ class Search {
  private:
   double Dist(const Move& m) const { return IsSpin(m.mode) ? m.amount * o_.spin_radius : m.amount; }
 
-  // Eq. (4): the cost of `m` after a move in `previous` (nullopt at the start).
+  // Eq. (4): the cost of `m` after a move in `previous` (nullopt at the start). A search move
+  // is one step, so its switch penalty is lambda_switch * dist; a longer analytic segment
+  // pays it on its first step's worth only (as if driven in steps), not on its whole length.
   double StepCost(const Move& m, std::optional<MotionMode> previous) const {
-    double factor = 1.0;
-    if (IsArc(m.mode)) factor += o_.lambda_turn;
-    if (previous && DriveClassOf(*previous) != DriveClassOf(m.mode)) factor += o_.lambda_switch;
-    return Dist(m) * factor;
+    const double dist = Dist(m);
+    double cost = dist * (1.0 + (IsArc(m.mode) ? o_.lambda_turn : 0.0));
+    if (previous && DriveClassOf(*previous) != DriveClassOf(m.mode)) {
+      cost += o_.lambda_switch * std::min(dist, IsSpin(m.mode) ? Dist({m.mode, o_.spin_bins * bin_width_}) : o_.step);
+    }
+    return cost;
   }
 
   // Eq. (5) h and eq. (6) f.

@@ -11,7 +11,9 @@
 //   left / right, backward left / right state", the switch penalty "when it switches between
 //   straight, reverse, crab, spin and steer"). A switch is a change of DriveClass
 //   (motion_path.h): steering on the move is priced by lambda_turn, not as a switch. For a
-//   spin, dist = angle * spin_radius (metres swept at `spin_radius` from the centre).
+//   spin, dist = angle * spin_radius (metres swept at `spin_radius` from the centre). The
+//   analytic tails below are priced the same way as if driven in search steps: a tail segment
+//   pays the switch penalty on its first step only.
 // Heuristic (eq. (5)): h = h_o + h_h, h_h = heading_weight * |theta_goal - theta|. h_o is the
 //   Manhattan distance to the goal. With `manhattan_through_free_cells` (default) it is
 //   measured through the grid: the 4-connected step count from the goal's cell over cells
