@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
+#include <string>
 #include <limits>
 #include <queue>
 #include <stdexcept>
@@ -29,6 +31,54 @@ Result<OccupancyGrid> OccupancyGrid::FromMap(const WarehouseMap& map, double res
   OccupancyGrid grid(static_cast<int>(std::ceil(size.x() / resolution - 1e-9)),
                      static_cast<int>(std::ceil(size.y() / resolution - 1e-9)), resolution, map.floor_min());
   for (const Shelf& shelf : map.shelves()) grid.SetRect(shelf.min, shelf.max, true);
+  grid.ComputeClearance();
+  return grid;
+}
+
+Result<OccupancyGrid> OccupancyGrid::FromMovingAi(std::string_view text, double tile, int subdivide) {
+  if (!(tile > 0.0) || subdivide < 1) return InvalidArgument("movingai grid: tile > 0 and subdivide >= 1 required");
+  std::vector<std::string_view> lines;
+  for (std::size_t at = 0; at <= text.size();) {
+    std::size_t end = text.find('\n', at);
+    if (end == std::string_view::npos) end = text.size();
+    std::string_view line = text.substr(at, end - at);
+    if (!line.empty() && line.back() == '\r') line.remove_suffix(1);
+    lines.push_back(line);
+    at = end + 1;
+  }
+  int width = 0;
+  int height = 0;
+  std::size_t row0 = 0;
+  for (std::size_t i = 0; i < lines.size(); ++i) {
+    const std::string_view line = lines[i];
+    if (line.rfind("height ", 0) == 0) height = std::atoi(std::string(line.substr(7)).c_str());
+    if (line.rfind("width ", 0) == 0) width = std::atoi(std::string(line.substr(6)).c_str());
+    if (line == "map") {
+      row0 = i + 1;
+      break;
+    }
+  }
+  if (row0 == 0 || width < 1 || height < 1 || lines.size() < row0 + static_cast<std::size_t>(height)) {
+    return InvalidArgument("movingai grid: needs height, width, map and that many rows");
+  }
+  if (static_cast<double>(width) * height * subdivide * subdivide > 1e8) {
+    return InvalidArgument("movingai grid: too many cells");
+  }
+  OccupancyGrid grid(width * subdivide, height * subdivide, tile / subdivide);
+  for (int row = 0; row < height; ++row) {
+    const std::string_view line = lines[row0 + static_cast<std::size_t>(row)];
+    if (line.size() < static_cast<std::size_t>(width)) {
+      return InvalidArgument("movingai grid: row " + std::to_string(row + 1) + " is shorter than the width");
+    }
+    for (int col = 0; col < width; ++col) {
+      const char c = line[static_cast<std::size_t>(col)];
+      if (c != '@' && c != 'T' && c != 'O' && c != 'W') continue;
+      const int ty = height - 1 - row;  // y up
+      for (int dy = 0; dy < subdivide; ++dy) {
+        for (int dx = 0; dx < subdivide; ++dx) grid.Set(col * subdivide + dx, ty * subdivide + dy, true);
+      }
+    }
+  }
   grid.ComputeClearance();
   return grid;
 }

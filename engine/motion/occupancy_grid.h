@@ -13,6 +13,7 @@
 #include <Eigen/Core>
 
 #include <cstdint>
+#include <string_view>
 #include <vector>
 
 #include "engine/common/result.h"
@@ -28,6 +29,12 @@ class OccupancyGrid {
   // The map's floor rectangle with its shelves as obstacles (a cell is occupied when its
   // centre lies in a shelf, or the shelf covers part of it: shelves are rounded outwards).
   static Result<OccupancyGrid> FromMap(const WarehouseMap& map, double resolution);
+
+  // A MovingAI `.map` text (header "type", "height H", "width W", "map", then H rows, the
+  // first row the north edge): '@', 'T', 'O' and 'W' are blocked, every other character
+  // free. Each map tile is `tile` metres square and becomes subdivide x subdivide cells
+  // (resolution tile / subdivide); origin (0, 0), y up. kInvalidArgument on a malformed text.
+  static Result<OccupancyGrid> FromMovingAi(std::string_view text, double tile, int subdivide = 1);
 
   int width() const { return width_; }
   int height() const { return height_; }

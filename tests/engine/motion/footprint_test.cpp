@@ -40,6 +40,22 @@ TEST(OccupancyGridTest, FromMapMarksExactlyTheShelves) {
   EXPECT_FALSE(OccupancyGrid::FromMap(*map, 0.0).ok());
 }
 
+TEST(OccupancyGridTest, FromMovingAiSubdividesTilesWithYUp) {
+  const Result<OccupancyGrid> grid =
+      OccupancyGrid::FromMovingAi("type octile\nheight 2\nwidth 3\nmap\n@..\n.T.\n", 1.0, 10);
+  ASSERT_TRUE(grid.ok()) << grid.error().message;
+  EXPECT_EQ(grid->width(), 30);
+  EXPECT_EQ(grid->height(), 20);
+  EXPECT_DOUBLE_EQ(grid->resolution(), 0.1);
+  EXPECT_TRUE(grid->OccupiedAt(0.5, 1.5));   // '@' top-left
+  EXPECT_TRUE(grid->OccupiedAt(1.95, 0.05)); // 'T' bottom-middle
+  EXPECT_FALSE(grid->OccupiedAt(0.5, 0.5));
+  EXPECT_FALSE(grid->OccupiedAt(2.5, 1.5));
+  EXPECT_TRUE(grid->has_clearance());
+  EXPECT_FALSE(OccupancyGrid::FromMovingAi("type octile\nheight 2\nwidth 3\nmap\n@..\n", 1.0).ok());
+  EXPECT_FALSE(OccupancyGrid::FromMovingAi("height 1\nwidth 3\nmap\n@.\n", 1.0).ok());
+}
+
 TEST(OccupancyGridTest, ClearanceIsDistanceToNearestObstacleOrEdge) {
   OccupancyGrid grid(21, 21, 0.1);
   grid.Set(10, 10, true);
