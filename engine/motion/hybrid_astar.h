@@ -32,8 +32,12 @@
 //   heading (when it differs), then drive straight along it and crab across it (or crab first,
 //   then straight: both orders tried), i.e. a Reeds-Shepp-like path whose curves are spins and
 //   whose lateral leg is a crab. Needs allow_crab (and allow_spin when the heading differs).
-// `allow_crab = false, allow_spin = false` is the car / differential-drive baseline: the same
-// search with forward, reverse and the four arcs only.
+// `allow_crab = false, allow_spin = false` is the baseline of issue 17 §2: the same search
+// with forward, reverse and the four arcs only — a car that may reverse (a differential-drive
+// robot would keep the spin: allow_spin = true alone).
+// The search ends at the first node whose analytic expansion succeeds (or that lies within
+// the goal tolerance): weighted and first-found, so paths are feasible, not optimal, and are
+// not smoothed.
 // Stops: PlanLimits::Exhausted is polled before each expansion (max_expansions counts them).
 // Errors: kInvalidArgument (bad options, start or goal pose collides), kUnreachable (every
 // reachable state expanded, no path), kFailedPrecondition (stopped by the limits: deadline or
