@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <chrono>
 #include <numbers>
+#include <random>
 
 #include "engine/motion/hybrid_astar.h"
 #include "engine/motion/motion_path_check.h"
@@ -147,6 +148,52 @@ TEST_F(NarrowFloorTest, CollidingStartOrGoalIsInvalid) {
   const Result<MotionPath> goal = PlanHybridAStar(checker_, floor_.cross_start, {2.0, 4.0, 0.0}, options_);
   ASSERT_FALSE(goal.ok());
   EXPECT_EQ(goal.error().code, ErrorCode::kInvalidArgument);
+}
+
+// Model check on random floors: whatever the planner returns passes CheckMotionPath (free,
+// drivable in its modes, at the goal), for 4WIS and the baseline.
+TEST(HybridAStarTest, RandomFloorsGiveValidPaths) {
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<double> pos(0.5, 4.5);
+  std::uniform_real_distribution<double> ang(-kPi, kPi);
+  int found = 0;
+  for (int round = 0; round < 12; ++round) {
+    OccupancyGrid grid(50, 50, 0.1);
+    for (int k = 0; k < 12; ++k) {
+      const double x = pos(rng), y = pos(rng);
+      grid.SetRect({x, y}, {x + 0.3, y + 0.3}, true);
+    }
+    grid.ComputeClearance();
+    const FootprintChecker checker(grid, {0.6, 0.4, 0.0});
+    auto free_pose = [&] {
+      MotionPose p{pos(rng), pos(rng), ang(rng)};
+      while (checker.Collides(p)) p = {pos(rng), pos(rng), ang(rng)};
+      return p;
+    };
+    const MotionPose start = free_pose();
+    const MotionPose goal = free_pose();
+    for (const bool wis : {true, false}) {
+      HybridAStarOptions o;
+      o.min_turn_radius = 0.6;
+      o.allow_crab = o.allow_spin = wis;
+      o.limits.max_expansions = 20000;
+      const Result<MotionPath> path = PlanHybridAStar(checker, start, goal, o);
+      if (!path.ok()) {
+        EXPECT_NE(path.error().code, ErrorCode::kInvalidArgument) << path.error().message;
+        continue;
+      }
+      ++found;
+      MotionPathCheck check;
+      check.radius = 0.6;
+      const Status valid = CheckMotionPath(checker, *path, start, goal, check);
+      EXPECT_TRUE(valid.ok()) << round << (wis ? " 4wis: " : " baseline: ") << valid.error().message;
+      if (!wis) {
+        EXPECT_FALSE(Uses(*path, {MotionMode::kCrabLeft, MotionMode::kCrabRight, MotionMode::kSpinLeft,
+                                  MotionMode::kSpinRight}));
+      }
+    }
+  }
+  EXPECT_GE(found, 12);
 }
 
 TEST(HybridAStarTest, AdaptiveXiShrinksTowardsTheGoal) {
