@@ -75,6 +75,17 @@ TEST_F(NarrowFloorTest, CrabSlotNeeds4wis) {
   EXPECT_EQ(car.error().code, ErrorCode::kUnreachable) << car.error().message;
 }
 
+// From beyond the analytic range, facing away: turn round in the 1.4 m corridor (too narrow
+// for a U-turn on arcs), drive back and crab into the slot.
+TEST_F(NarrowFloorTest, CrabSlotFromTheFarEndFacingAway) {
+  const MotionPose start{10.8, 0.8, 0.0};
+  const Result<MotionPath> wis = PlanHybridAStar(checker_, start, floor_.crab_goal, options_);
+  ASSERT_TRUE(wis.ok()) << wis.error().message;
+  ExpectValid(*wis, start, floor_.crab_goal);
+  EXPECT_GT(wis->nodes_expanded, 1u);
+  EXPECT_TRUE(Uses(*wis, {MotionMode::kCrabLeft}));
+}
+
 TEST_F(NarrowFloorTest, DeadEndAisleIsLeftBySpinningOrReversing) {
   const Result<MotionPath> wis = PlanHybridAStar(checker_, floor_.dead_end_start, floor_.dead_end_goal, options_);
   ASSERT_TRUE(wis.ok()) << wis.error().message;
