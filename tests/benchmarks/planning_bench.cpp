@@ -17,6 +17,15 @@
 //   (issue 16's target: N = 500 at <= 1 ms median), over a pool of 64 requests; the route table
 //   (lazy) is warmed on the requests' stops first, as the service's is on its pick and drop points.
 //   Counters: median_ms (per plan), planned / failed, expanded (SIPP states per plan).
+//   BM_HybridAStar/<variant>: BIT2024 step 6's hybrid A* for 4WIS robots (SPEC §3.7,
+//   engine/motion/hybrid_astar.h) on the narrow-area floor (engine/motion/narrow_floor.h:
+//   12 x 6 m, 0.1 m cells, robot 0.8 x 0.5 m, turning radius 0.8 m), the cross-floor query
+//   (corridor (0.8, 0.8, 0) -> hall upper lane (2.0, 5.1, pi)), default options. Variants:
+//   narrow (4WIS, adaptive xi, eq. (6)), narrow_fixed_xi (xi = 1 everywhere),
+//   narrow_baseline (crab and spin off: the car / differential-drive baseline),
+//   narrow_plain_manhattan (eq. (5)'s h_o as plain |dx| + |dy| instead of through free cells).
+//   Target (issue 17 §2): narrow <= 50 ms median. Counters: nodes (expanded), length (m),
+//   rotation (rad turned in place), switches (drive-class changes), solved.
 // Run from a Release build:
 //   cmake --build build-bench --target planning_bench && build-bench/tests/benchmarks/planning_bench
 #include <benchmark/benchmark.h>
@@ -31,6 +40,8 @@
 #include <utility>
 
 #include "engine/map/grid_floor.h"
+#include "engine/motion/hybrid_astar.h"
+#include "engine/motion/narrow_floor.h"
 #include "engine/planning/cbs.h"
 #include "engine/planning/conflict_elimination.h"
 #include "engine/planning/space_time_astar.h"
@@ -206,6 +217,43 @@ void BM_TimeWindowPlan(benchmark::State& state) {
   const auto solved = static_cast<double>(state.iterations()) - static_cast<double>(failed);
   state.counters["expanded"] = solved > 0 ? static_cast<double>(expanded) / solved : 0.0;
 }
+
+enum class HybridVariant { kAdaptive, kFixedXi, kBaseline, kPlainManhattan };
+
+void BM_HybridAStar(benchmark::State& state, HybridVariant variant) {
+  static const NarrowFloor floor = BuildNarrowFloor();
+  static const FootprintChecker checker(floor.grid, floor.footprint);
+  HybridAStarOptions options;
+  options.min_turn_radius = floor.min_turn_radius;
+  options.adaptive_xi = variant != HybridVariant::kFixedXi;
+  options.fixed_xi = 1.0;
+  options.allow_crab = options.allow_spin = variant != HybridVariant::kBaseline;
+  options.manhattan_through_free_cells = variant != HybridVariant::kPlainManhattan;
+  Result<MotionPath> last = MotionPath{};
+  for (auto _ : state) {
+    options.limits.stop = DeadlineCheck(std::chrono::seconds(10));
+    last = PlanHybridAStar(checker, floor.cross_start, floor.cross_goal, options);
+    benchmark::DoNotOptimize(last);
+  }
+  state.counters["solved"] = last.ok() ? 1 : 0;
+  if (!last.ok()) {
+    state.SetLabel(last.error().message.substr(0, 90));
+    return;
+  }
+  state.counters["nodes"] = static_cast<double>(last.value().nodes_expanded);
+  state.counters["length"] = last.value().length;
+  state.counters["rotation"] = last.value().rotation;
+  state.counters["switches"] = last.value().switches;
+}
+
+BENCHMARK_CAPTURE(BM_HybridAStar, narrow, HybridVariant::kAdaptive)
+    ->Unit(benchmark::kMillisecond)->Repetitions(5)->ReportAggregatesOnly(true);
+BENCHMARK_CAPTURE(BM_HybridAStar, narrow_fixed_xi, HybridVariant::kFixedXi)
+    ->Unit(benchmark::kMillisecond)->Repetitions(5)->ReportAggregatesOnly(true);
+BENCHMARK_CAPTURE(BM_HybridAStar, narrow_baseline, HybridVariant::kBaseline)
+    ->Unit(benchmark::kMillisecond)->Repetitions(5)->ReportAggregatesOnly(true);
+BENCHMARK_CAPTURE(BM_HybridAStar, narrow_plain_manhattan, HybridVariant::kPlainManhattan)
+    ->Unit(benchmark::kMillisecond)->Iterations(1)->Repetitions(3)->ReportAggregatesOnly(true);
 
 BENCHMARK(BM_IndependentPaths)->Arg(10)->Arg(50)->Arg(100)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_ConflictElimination)->Arg(10)->Arg(50)->Arg(100)->Unit(benchmark::kMillisecond)->Iterations(3);
