@@ -393,6 +393,17 @@ void MapToProto(const engine::WarehouseMap& map, const std::string& version, pb:
     q->mutable_max()->set_x(s.max.x());
     q->mutable_max()->set_y(s.max.y());
   }
+  for (const auto& f : map.free_spaces()) {
+    auto* q = m->add_free_spaces();
+    q->set_name(f.name);
+    for (const auto& v : f.polygon) {
+      auto* p = q->add_polygon();
+      p->set_x(v.x());
+      p->set_y(v.y());
+    }
+    q->set_area(f.area);
+    for (auto p : f.points) q->add_point_ids(p);
+  }
 }
 
 }  // namespace dispatch::server

@@ -62,6 +62,12 @@ void PrintSummary(const WarehouseMap& map) {
                   map.zones()[z].area, per_zone[static_cast<ZoneId>(z)]);
     }
   }
+  if (!map.free_spaces().empty()) {
+    std::printf("Free spaces (four-wheel steer): %zu\n", map.free_spaces().size());
+    for (const FreeSpace& f : map.free_spaces()) {
+      std::printf("  %-6s area %8.2f m^2, %4zu points\n", f.name.c_str(), f.area, f.points.size());
+    }
+  }
 }
 
 std::string Via(const WarehouseMap& map, const Route& r, std::size_t limit) {

@@ -165,7 +165,7 @@ Status ReadHeader(const json& doc) {
                            ")");
   }
   return CheckKeys(doc, "", {"format", "version", "name", "floor", "zones", "points", "paths",
-                             "intersections", "stations", "shelves"});
+                             "intersections", "stations", "shelves", "free_space"});
 }
 
 Status ReadFloor(const json& doc, MapBuilder& builder) {
@@ -189,8 +189,10 @@ Status ReadFloor(const json& doc, MapBuilder& builder) {
   return Ok{};
 }
 
-Status ReadZone(const json& z, const std::string& where, MapBuilder& builder) {
-  if (Status s = CheckKeys(z, where, {"id", "polygon"}); !s) return s;
+// An element {"id", "polygon"} (a zone, a free space): its id and vertices.
+Result<std::pair<std::string, std::vector<Eigen::Vector2d>>> ReadPolygonElement(
+    const json& z, const std::string& where, const char* what) {
+  if (Status s = CheckKeys(z, where, {"id", "polygon"}); !s) return s.error();
   auto id_m = Member(z, where, "id", true);
   if (!id_m) return id_m.error();
   auto id = AsId(**id_m, At(where, "id"));
@@ -201,7 +203,7 @@ Status ReadZone(const json& z, const std::string& where, MapBuilder& builder) {
   std::string pw = At(where, "polygon");
   if (!poly.is_array()) return TypeError(pw, "an array of [x, y] vertices", poly);
   if (poly.size() < 3) {
-    return InvalidArgument(pw + ": zone '" + *id + "' needs at least 3 vertices, got " +
+    return InvalidArgument(pw + ": " + what + " '" + *id + "' needs at least 3 vertices, got " +
                            std::to_string(poly.size()));
   }
   std::vector<Eigen::Vector2d> vertices;
@@ -210,7 +212,20 @@ Status ReadZone(const json& z, const std::string& where, MapBuilder& builder) {
     if (!v) return v.error();
     vertices.push_back(*v);
   }
-  builder.AddZone(std::move(id).value(), std::move(vertices));
+  return std::make_pair(std::move(id).value(), std::move(vertices));
+}
+
+Status ReadZone(const json& z, const std::string& where, MapBuilder& builder) {
+  auto zone = ReadPolygonElement(z, where, "zone");
+  if (!zone) return zone.error();
+  builder.AddZone(std::move(zone->first), std::move(zone->second));
+  return Ok{};
+}
+
+Status ReadFreeSpace(const json& z, const std::string& where, MapBuilder& builder) {
+  auto space = ReadPolygonElement(z, where, "free space");
+  if (!space) return space.error();
+  builder.AddFreeSpace(std::move(space->first), std::move(space->second));
   return Ok{};
 }
 
@@ -429,6 +444,7 @@ Result<WarehouseMap> ParseMapJson(std::string_view text) {
       {"zones", true, ReadZone},          {"points", true, ReadPoint},
       {"paths", true, ReadPath},          {"intersections", false, ReadIntersection},
       {"stations", false, ReadStation},   {"shelves", false, ReadShelf},
+      {"free_space", false, ReadFreeSpace},
   };
   for (const Section& section : sections) {
     auto array = ArrayMember(doc, section.key, section.required);
@@ -463,14 +479,15 @@ std::string WriteMapJson(const WarehouseMap& map) {
   floor["max"] = Vec2Json(map.floor_max());
   out << "  \"floor\": " << floor.dump() << ",\n";
 
-  std::vector<ordered_json> items;
-  for (const Zone& z : map.zones()) {
+  auto polygon_element = [](const std::string& name, const std::vector<Eigen::Vector2d>& polygon) {
     ordered_json e;
-    e["id"] = z.name;
+    e["id"] = name;
     e["polygon"] = ordered_json::array();
-    for (const auto& v : z.polygon) e["polygon"].push_back(Vec2Json(v));
-    items.push_back(std::move(e));
-  }
+    for (const auto& v : polygon) e["polygon"].push_back(Vec2Json(v));
+    return e;
+  };
+  std::vector<ordered_json> items;
+  for (const Zone& z : map.zones()) items.push_back(polygon_element(z.name, z.polygon));
   WriteArray(out, "zones", items, false);
 
   items.clear();
@@ -529,7 +546,12 @@ std::string WriteMapJson(const WarehouseMap& map) {
     e["max"] = Vec2Json(s.max);
     items.push_back(std::move(e));
   }
-  WriteArray(out, "shelves", items, true);
+  WriteArray(out, "shelves", items, map.free_spaces().empty());
+  if (!map.free_spaces().empty()) {  // the key only where there are some: older files stay as they were
+    items.clear();
+    for (const FreeSpace& f : map.free_spaces()) items.push_back(polygon_element(f.name, f.polygon));
+    WriteArray(out, "free_space", items, true);
+  }
   out << "}\n";
   return out.str();
 }

@@ -93,6 +93,20 @@ void RenderZones(std::ostringstream& out, const WarehouseMap& map, const Frame& 
   out << "</g>\n";
 }
 
+// Free-space regions (narrow areas for four-wheel-steer robots), over the zones.
+void RenderFreeSpaces(std::ostringstream& out, const WarehouseMap& map, const Frame& f) {
+  if (map.free_spaces().empty()) return;
+  out << "<g class=\"free-spaces\">\n";
+  for (const FreeSpace& s : map.free_spaces()) {
+    out << "<polygon class=\"free-space\" points=\"";
+    for (std::size_t k = 0; k < s.polygon.size(); ++k) {
+      out << (k ? " " : "") << Num(f.X(s.polygon[k].x())) << ',' << Num(f.Y(s.polygon[k].y()));
+    }
+    out << "\"><title>free space " << Escape(s.name) << "</title></polygon>\n";
+  }
+  out << "</g>\n";
+}
+
 // Zone names and areas, drawn last so lanes and points do not hide them.
 void RenderZoneLabels(std::ostringstream& out, const WarehouseMap& map, const Frame& f,
                       const SvgOptions& options) {
@@ -223,7 +237,10 @@ void RenderCompact(std::ostringstream& out, const WarehouseMap& map, const Frame
   out << "</g>\n";
 }
 
-void RenderLegend(std::ostringstream& out, double top, double width) {
+// The legend's entries: the fixed ones, the point kinds, and free space on maps that have it.
+std::size_t LegendEntries(const WarehouseMap& map) { return 12 + (map.free_spaces().empty() ? 0 : 1); }
+
+void RenderLegend(std::ostringstream& out, const WarehouseMap& map, double top, double width) {
   struct Entry {
     std::string swatch;
     std::string text;
@@ -243,6 +260,10 @@ void RenderLegend(std::ostringstream& out, double top, double width) {
                            "\" cx=\"8\" cy=\"0\" r=\"4\"/>",
                        StyleOf(kind).label});
   }
+  if (!map.free_spaces().empty()) {
+    entries.push_back({"<rect class=\"free-space\" x=\"0\" y=\"-6\" width=\"16\" height=\"12\"/>",
+                       "free space (four-wheel steer)"});
+  }
   constexpr double kEntryWidth = 170.0;
   constexpr double kRowHeight = 20.0;
   const int per_row = std::max(1, static_cast<int>((width - 20.0) / kEntryWidth));
@@ -256,9 +277,9 @@ void RenderLegend(std::ostringstream& out, double top, double width) {
   out << "</g>\n";
 }
 
-double LegendHeight(double width) {
+double LegendHeight(std::size_t entries, double width) {
   const int per_row = std::max(1, static_cast<int>((width - 20.0) / 170.0));
-  const int rows = (12 + per_row - 1) / per_row;
+  const int rows = (static_cast<int>(entries) + per_row - 1) / per_row;
   return 14.0 + rows * 20.0;
 }
 
@@ -275,7 +296,7 @@ std::string RenderMapSvg(const WarehouseMap& map, const SvgOptions& options) {
   const bool compact = map.point_count() > options.detail_limit;
   const double width = std::max(f.map_width(), options.show_legend ? 540.0 : 0.0);
   const double legend_top = f.map_height();
-  const double height = legend_top + (options.show_legend ? LegendHeight(width) : 0.0);
+  const double height = legend_top + (options.show_legend ? LegendHeight(LegendEntries(map), width) : 0.0);
 
   std::ostringstream out;
   out << "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"" << Num(width) << "\" height=\""
@@ -289,6 +310,7 @@ std::string RenderMapSvg(const WarehouseMap& map, const SvgOptions& options) {
          ".zone{fill-opacity:0.15;stroke:#757575;stroke-width:0.5}\n"
          ".zone-label{font:bold 11px sans-serif;fill:#424242;fill-opacity:0.8;text-anchor:middle}\n"
          ".shelf{fill:#8d6e63;stroke:#4e342e;stroke-width:0.5}\n"
+         ".free-space{fill:#a5d6a7;fill-opacity:0.45;stroke:#2e7d32;stroke-width:1;stroke-dasharray:3 2}\n"
          ".oneway{stroke:#37474f;stroke-width:1.2;fill:none}\n"
          ".lane2{stroke:#0277bd;stroke-width:1.2;stroke-dasharray:4 2;fill:none}\n"
          ".compact{stroke-width:0.12;stroke-dasharray:none}\n"
@@ -305,13 +327,14 @@ std::string RenderMapSvg(const WarehouseMap& map, const SvgOptions& options) {
       << "\" width=\"" << Num(extent.x() * f.scale) << "\" height=\""
       << Num(extent.y() * f.scale) << "\"/>\n";
   RenderZones(out, map, f);
+  RenderFreeSpaces(out, map, f);
   if (compact) {
     RenderCompact(out, map, f);
   } else {
     RenderDetailed(out, map, f, options);
   }
   RenderZoneLabels(out, map, f, options);
-  if (options.show_legend) RenderLegend(out, legend_top, width);
+  if (options.show_legend) RenderLegend(out, map, legend_top, width);
   out << "</svg>\n";
   return out.str();
 }

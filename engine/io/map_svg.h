@@ -1,5 +1,6 @@
 // SVG rendering of a WarehouseMap for humans: floor, zones (translucent, labelled with their
-// area S_p), shelves, lanes (one-way paths with arrowheads; bidirectional single lanes dashed
+// area S_p), free-space regions (narrow areas for four-wheel-steer robots, dashed green),
+// shelves, lanes (one-way paths with arrowheads; bidirectional single lanes dashed
 // and without arrows), intersections (inner region I_w highlighted, approach points O_w
 // marked), points by kind, station capacities, optional labels and a legend. The y axis
 // points up as on the floor plan (SVG's y is flipped).

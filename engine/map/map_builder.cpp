@@ -56,6 +56,29 @@ bool SelfIntersecting(const std::vector<Eigen::Vector2d>& poly) {
   return false;
 }
 
+// A zone's or free space's polygon: >= 3 finite vertices, positive area, not crossing itself,
+// on the floor (if one is set). Returns its area.
+Result<double> CheckPolygon(const std::string& where, const std::vector<Eigen::Vector2d>& polygon,
+                            const std::optional<std::pair<Eigen::Vector2d, Eigen::Vector2d>>& floor) {
+  if (polygon.size() < 3) return InvalidArgument(where + ": polygon needs >= 3 vertices");
+  for (const auto& v : polygon) {
+    if (!Finite(v)) return InvalidArgument(where + ": vertex is not a finite number");
+  }
+  const double area = PolygonArea(polygon);
+  if (!(area > 0)) return InvalidArgument(where + ": area is zero");
+  if (SelfIntersecting(polygon)) {
+    return InvalidArgument(where + ": polygon crosses itself, so its area is undefined");
+  }
+  if (floor) {
+    for (const auto& v : polygon) {
+      if ((v.array() < floor->first.array() - 1e-9).any() || (v.array() > floor->second.array() + 1e-9).any()) {
+        return InvalidArgument(where + ": vertex " + Fmt(v) + " lies outside the floor");
+      }
+    }
+  }
+  return area;
+}
+
 // Points reachable from `start` following arcs forward (or backward).
 std::vector<char> Reach(const WarehouseMap& map, PointId start, bool forward) {
   std::vector<char> seen(map.point_count(), 0);
@@ -113,6 +136,13 @@ void MapBuilder::AddStation(std::string name, std::string point, int capacity) {
   stations_.push_back({std::move(name), std::move(point), capacity});
 }
 
+void MapBuilder::AddFreeSpace(std::string name, std::vector<Eigen::Vector2d> polygon) {
+  FreeSpace space;
+  space.name = std::move(name);
+  space.polygon = std::move(polygon);
+  free_spaces_.push_back(std::move(space));
+}
+
 void MapBuilder::AddShelf(std::string name, const Eigen::Vector2d& min,
                           const Eigen::Vector2d& max) {
   shelves_.push_back({std::move(name), min, max});
@@ -130,23 +160,9 @@ Result<WarehouseMap> MapBuilder::Build(const MapBuildOptions& options) const {
     Zone zone = zones_[i];
     const std::string where = "zone " + std::to_string(i) + " ('" + zone.name + "')";
     if (zone.name.empty()) return InvalidArgument(where + ": empty id");
-    if (zone.polygon.size() < 3) return InvalidArgument(where + ": polygon needs >= 3 vertices");
-    for (const auto& v : zone.polygon) {
-      if (!Finite(v)) return InvalidArgument(where + ": vertex is not a finite number");
-    }
-    zone.area = PolygonArea(zone.polygon);
-    if (!(zone.area > 0)) return InvalidArgument(where + ": area is zero");
-    if (SelfIntersecting(zone.polygon)) {
-      return InvalidArgument(where + ": polygon crosses itself, so its area is undefined");
-    }
-    if (floor_) {
-      for (const auto& v : zone.polygon) {
-        if ((v.array() < floor_->first.array() - 1e-9).any() ||
-            (v.array() > floor_->second.array() + 1e-9).any()) {
-          return InvalidArgument(where + ": vertex " + Fmt(v) + " lies outside the floor");
-        }
-      }
-    }
+    Result<double> area = CheckPolygon(where, zone.polygon, floor_);
+    if (!area.ok()) return area.error();
+    zone.area = *area;
     if (!map.zone_index_.emplace(zone.name, static_cast<ZoneId>(i)).second) {
       return InvalidArgument(where + ": duplicate zone id");
     }
@@ -348,6 +364,26 @@ Result<WarehouseMap> MapBuilder::Build(const MapBuildOptions& options) const {
                              Fmt(shelf.max));
     }
     map.shelves_.push_back(shelf);
+  }
+
+  // Free spaces: each holds at least one point of the graph (where robots enter it).
+  names.clear();
+  for (std::size_t i = 0; i < free_spaces_.size(); ++i) {
+    FreeSpace space = free_spaces_[i];
+    const std::string where = "free space " + std::to_string(i) + " ('" + space.name + "')";
+    if (space.name.empty()) return InvalidArgument(where + ": empty id");
+    if (!names.insert(space.name).second) return InvalidArgument(where + ": duplicate id");
+    Result<double> area = CheckPolygon(where, space.polygon, floor_);
+    if (!area.ok()) return area.error();
+    space.area = *area;
+    space.points.clear();
+    for (std::size_t p = 0; p < map.points_.size(); ++p) {
+      if (space.Contains(map.points_[p].position)) space.points.push_back(static_cast<PointId>(p));
+    }
+    if (space.points.empty()) {
+      return InvalidArgument(where + ": holds no point of the road graph, so no robot could enter it");
+    }
+    map.free_spaces_.push_back(std::move(space));
   }
 
   // Every service point reaches every other one.

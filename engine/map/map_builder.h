@@ -42,6 +42,9 @@ class MapBuilder {
                        std::vector<std::string> approach);
   void AddStation(std::string name, std::string point, int capacity);
   void AddShelf(std::string name, const Eigen::Vector2d& min, const Eigen::Vector2d& max);
+  // A free-space region (warehouse_map.h FreeSpace): a simple polygon on the floor holding at
+  // least one point of the road graph.
+  void AddFreeSpace(std::string name, std::vector<Eigen::Vector2d> polygon);
 
   bool HasPoint(const std::string& name) const;
   std::size_t point_count() const { return points_.size(); }
@@ -78,6 +81,7 @@ class MapBuilder {
   std::vector<IntersectionSpec> intersections_;
   std::vector<StationSpec> stations_;
   std::vector<Shelf> shelves_;
+  std::vector<FreeSpace> free_spaces_;
   std::unordered_map<std::string, std::size_t> point_names_;
 };
 

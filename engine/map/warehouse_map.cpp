@@ -24,7 +24,7 @@ bool IsServicePoint(PointKind kind) {
          kind == PointKind::kCharge;
 }
 
-bool Zone::Contains(const Eigen::Vector2d& p) const {
+bool PolygonContains(const std::vector<Eigen::Vector2d>& polygon, const Eigen::Vector2d& p) {
   constexpr double kEps = 1e-9;
   const std::size_t n = polygon.size();
   bool inside = false;

@@ -70,11 +70,26 @@ struct Arc {
   bool single_lane() const { return reverse_arc >= 0; }
 };
 
+// Whether a simple polygon (either orientation) holds p; its boundary counts as inside.
+bool PolygonContains(const std::vector<Eigen::Vector2d>& polygon, const Eigen::Vector2d& p);
+
 struct Zone {
   std::string name;
   std::vector<Eigen::Vector2d> polygon;  // simple polygon, either orientation
   double area = 0.0;                     // S_p, m^2 (derived)
-  bool Contains(const Eigen::Vector2d& p) const;  // boundary counts as inside
+  bool Contains(const Eigen::Vector2d& p) const { return PolygonContains(polygon, p); }
+};
+
+// A free-space region (issue 17 §3): a narrow area where a robot that can (four-wheel steer)
+// is planned over continuous poses (engine/motion, BIT2024 step 6) instead of along the road
+// graph; shelves inside it are obstacles. The road graph's points inside it (boundary
+// included) are where the two meet: a robot enters and leaves the region there.
+struct FreeSpace {
+  std::string name;
+  std::vector<Eigen::Vector2d> polygon;  // simple polygon, either orientation
+  double area = 0.0;                     // m^2 (derived)
+  std::vector<PointId> points;           // derived: the graph's points in it, ascending
+  bool Contains(const Eigen::Vector2d& p) const { return PolygonContains(polygon, p); }
 };
 
 struct Intersection {
@@ -114,6 +129,7 @@ class WarehouseMap {
   const std::vector<Intersection>& intersections() const { return intersections_; }
   const std::vector<ParkingStation>& stations() const { return stations_; }
   const std::vector<Shelf>& shelves() const { return shelves_; }
+  const std::vector<FreeSpace>& free_spaces() const { return free_spaces_; }
 
   std::size_t point_count() const { return points_.size(); }
   const Point& point(PointId id) const { return points_.at(static_cast<std::size_t>(id)); }
@@ -156,6 +172,7 @@ class WarehouseMap {
   std::vector<Intersection> intersections_;
   std::vector<ParkingStation> stations_;
   std::vector<Shelf> shelves_;
+  std::vector<FreeSpace> free_spaces_;
   std::vector<std::vector<ArcId>> out_arcs_;
   std::vector<std::vector<ArcId>> in_arcs_;
   std::vector<int> intersection_of_;

@@ -11,6 +11,7 @@ window.WebMap = window.WebMap || {};
   const COLOURS = {
     floor: "#fbfbfc", floorEdge: "#9aa5b1",
     zone: "#7b8794", shelf: "#cdb89a", shelfEdge: "#a68c67",
+    freeSpace: "rgba(165, 214, 167, 0.45)", freeSpaceEdge: "#2e7d32",
     oneWay: "#8896a6", oneWayArrow: "#52606d", bidirectional: "#d97706",
     intersection: "rgba(120, 132, 148, 0.22)", lanePoint: "#9aa5b1",
     pick: "#16a34a", drop: "#dc2626", park: "#2563eb", charge: "#ca8a04",
@@ -38,6 +39,7 @@ window.WebMap = window.WebMap || {};
         .filter(p => p.a && p.b),
       zones: (json.zones || []).filter(z => Array.isArray(z.polygon) && z.polygon.length >= 3),
       shelves: (json.shelves || []).filter(s => s.min && s.max),
+      freeSpaces: (json.free_space || []).filter(f => Array.isArray(f.polygon) && f.polygon.length >= 3),
       stations: (json.stations || []).map(s => ({ id: s.id, point: ref(s.point), capacity: s.capacity }))
         .filter(s => s.point),
     };
@@ -143,6 +145,18 @@ window.WebMap = window.WebMap || {};
         const x = Math.min(...z.polygon.map(v => v[0])), y = Math.max(...z.polygon.map(v => v[1]));
         ctx.fillText(z.id, view.sx(x) + 4, view.sy(y) + 3);
       }
+    }
+
+    // Free-space regions (narrow areas for four-wheel-steer robots): dashed green.
+    if (floor.freeSpaces.length) {
+      ctx.fillStyle = COLOURS.freeSpace; ctx.strokeStyle = COLOURS.freeSpaceEdge;
+      ctx.setLineDash([6, 4]); ctx.lineWidth = 1.5;
+      for (const f of floor.freeSpaces) {
+        ctx.beginPath();
+        f.polygon.forEach((v, k) => k ? ctx.lineTo(view.sx(v[0]), view.sy(v[1])) : ctx.moveTo(view.sx(v[0]), view.sy(v[1])));
+        ctx.closePath(); ctx.fill(); ctx.stroke();
+      }
+      ctx.setLineDash([]); ctx.lineWidth = 1;
     }
 
     ctx.fillStyle = COLOURS.shelf; ctx.strokeStyle = COLOURS.shelfEdge;

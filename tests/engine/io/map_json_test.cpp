@@ -109,6 +109,47 @@ TEST(MapJsonTest, RoundTripGivesIdenticalTextAndEqualStructure) {
   EXPECT_EQ(p.point(*p.FindPoint("c")).zone, *p.FindZone("A"));
 }
 
+// Free-space regions (issue 17 §3): optional, read and written back, the graph's points in
+// them derived; each must hold a point and be a proper polygon on the floor.
+TEST(MapJsonTest, FreeSpacesRoundTripAndAreValidated) {
+  EXPECT_EQ(WriteMapJson(SampleMap()).find("free_space"), std::string::npos);  // only when some
+  json doc = SampleDoc();
+  doc["free_space"] = json::array({json{{"id", "F1"}, {"polygon", {{0, 0}, {6, 0}, {6, 3}, {0, 3}}}}});
+  Result<WarehouseMap> map = ParseMapJson(doc.dump());
+  ASSERT_TRUE(map.ok()) << map.error().message;
+  ASSERT_EQ(map->free_spaces().size(), 1u);
+  const FreeSpace& f = map->free_spaces()[0];
+  EXPECT_EQ(f.name, "F1");
+  EXPECT_DOUBLE_EQ(f.area, 18.0);
+  EXPECT_EQ(f.points, (std::vector<PointId>{*map->FindPoint("a"), *map->FindPoint("b")}));
+  const std::string text = WriteMapJson(*map);
+  EXPECT_NE(text.find("\n  \"free_space\": [\n    {\"id\":\"F1\",\"polygon\":[[0.0,0.0],[6.0,0.0]"),
+            std::string::npos) << text;
+  Result<WarehouseMap> again = ParseMapJson(text);
+  ASSERT_TRUE(again.ok()) << again.error().message;
+  EXPECT_EQ(WriteMapJson(*again), text);
+
+  auto with = [](json space) {
+    json d = SampleDoc();
+    d["free_space"] = json::array({std::move(space)});
+    return d;
+  };
+  EXPECT_EQ(ParseError(with({{"id", "F1"}, {"polygon", {{0, 0}, {6, 0}}}})),
+            "free_space[0].polygon: free space 'F1' needs at least 3 vertices, got 2");
+  EXPECT_EQ(ParseError(with({{"id", "F2"}, {"polygon", {{11, 6}, {13, 6}, {13, 7}}}})),
+            "free space 0 ('F2'): holds no point of the road graph, so no robot could enter it");
+  EXPECT_EQ(ParseError(with({{"id", "F3"}, {"polygon", {{0, 0}, {6, 0}, {6, 30}}}})),
+            "free space 0 ('F3'): vertex (6, 30) lies outside the floor");
+  EXPECT_EQ(ParseError(with({{"id", "F4"}, {"polygon", {{0, 0}, {6, 3}, {6, 0}, {0, 2}}}})),
+            "free space 0 ('F4'): polygon crosses itself, so its area is undefined");
+  EXPECT_EQ(ParseError(with({{"id", "F5"}, {"polgon", {{0, 0}, {6, 0}, {6, 3}}}})),
+            "free_space[0]: unknown field 'polgon'");
+  json twice = SampleDoc();
+  twice["free_space"] = json::array({json{{"id", "F"}, {"polygon", {{0, 0}, {6, 0}, {6, 3}}}},
+                                     json{{"id", "F"}, {"polygon", {{0, 0}, {6, 0}, {6, 3}}}}});
+  EXPECT_EQ(ParseError(twice), "free space 1 ('F'): duplicate id");
+}
+
 TEST(MapJsonTest, WriterIsCanonical) {
   const std::string text = WriteMapJson(SampleMap());
   EXPECT_EQ(text.rfind("{\n  \"format\": \"warehouse-map\",\n  \"version\": 1,\n", 0), 0u);

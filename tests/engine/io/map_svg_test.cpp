@@ -28,7 +28,7 @@ double CircleY(const std::string& svg, const std::string& point) {
 }
 
 // Two shelves, three one-way paths, two single lanes, an intersection and a station.
-WarehouseMap SampleMap() {
+MapBuilder SampleBuilder() {
   MapBuilder b("svg <sample>");
   b.SetFloor({0, 0}, {12, 6});
   b.AddZone("left & low", {{0, 0}, {6, 0}, {6, 6}, {0, 6}});
@@ -50,10 +50,16 @@ WarehouseMap SampleMap() {
   b.AddStation("P1", "p", 3);
   b.AddShelf("s1", {2, 3}, {3, 5});
   b.AddShelf("s2", {7, 2}, {8, 4});
+  return b;
+}
+
+WarehouseMap Build(const MapBuilder& b) {
   Result<WarehouseMap> map = b.Build();
   if (!map) ADD_FAILURE() << map.error().message;
   return std::move(map).value();
 }
+
+WarehouseMap SampleMap() { return Build(SampleBuilder()); }
 
 TEST(MapSvgTest, DetailedRenderHasEveryElement) {
   const WarehouseMap map = SampleMap();
@@ -101,6 +107,23 @@ TEST(MapSvgTest, LegendAndLabelsAreOptional) {
   const std::string without = RenderMapSvg(SampleMap(), options);
   EXPECT_EQ(without.find("class=\"pt-label\""), std::string::npos);
   EXPECT_EQ(without.find("class=\"zone-label\""), std::string::npos);
+}
+
+// Free-space regions: a dashed green polygon each, named in its title, and a legend entry; a
+// map without them has neither.
+TEST(MapSvgTest, FreeSpacesAreDrawnWithALegendEntry) {
+  const std::string without = RenderMapSvg(SampleMap());
+  EXPECT_EQ(without.find("<polygon class=\"free-space\""), std::string::npos);
+  EXPECT_EQ(without.find("free space (four-wheel steer)"), std::string::npos);
+  MapBuilder b = SampleBuilder();
+  b.AddFreeSpace("dock & bay", {{0, 0}, {6, 0}, {6, 2}, {0, 2}});
+  const std::string with = RenderMapSvg(Build(b));
+  EXPECT_EQ(Count(with, "<polygon class=\"free-space\""), 1u);
+  EXPECT_NE(with.find("<title>free space dock &amp; bay</title>"), std::string::npos);
+  EXPECT_NE(with.find(">free space (four-wheel steer)</text>"), std::string::npos);
+  // Drawn over the zones, under the shelves.
+  EXPECT_LT(with.find("class=\"zones\""), with.find("class=\"free-spaces\""));
+  EXPECT_LT(with.find("class=\"free-spaces\""), with.find("class=\"shelves\""));
 }
 
 TEST(MapSvgTest, CompactStyleAboveTheDetailLimit) {
