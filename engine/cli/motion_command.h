@@ -6,11 +6,19 @@
 // default MotionTiming, mode switches, expansions, ms; every path found goes through
 // CheckMotionPath) and with --svg writes the grid, the paths and footprints every 0.5 m
 // (engine/io/motion_svg.h).
+// With --robots N it runs BIT2024 step 7 instead (engine/motion/motion_conflict_elimination.h):
+// N robots on distinct stations of the floor (seeded draw of starts and goals among 12 fixed
+// poses in the hall, the corridor's ends, the crab slot, the opening and the dead end), prints
+// each robot's wait, length and arrival and the rounds, and --svg draws their paths.
 //   dispatch-sim motion [--from X,Y,THETA --to X,Y,THETA] [--svg FILE] [--budget-ms 10000]
-// Exit status: 0 when it ran (an unsolved query is a result), 1 on bad arguments or an
-// unwritable SVG file, 2 when a returned path failed the checker.
+//   dispatch-sim motion --robots N [--seed 1] [--svg FILE] [--budget-ms 10000]
+// Exit status: 0 when it ran (an unsolved query is a result; with --robots: solved), 1 on bad
+// arguments or an unwritable SVG file, 2 when a returned path failed the checker (with
+// --robots: not solved).
 #pragma once
 
+#include <cstddef>
+#include <cstdint>
 #include <string>
 
 namespace CLI {
@@ -24,6 +32,8 @@ struct MotionArgs {
   std::string to;
   std::string svg;
   double budget_ms = 10000.0;
+  std::size_t robots = 0;  // > 0: step 7 for this many robots instead of the queries
+  std::uint64_t seed = 1;
 };
 
 // Adds the subcommand to `app`; returns it (the caller dispatches to RunMotion when it ran).

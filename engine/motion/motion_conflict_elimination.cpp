@@ -80,9 +80,12 @@ Result<MotionFleetSolution> EliminateMotionConflicts(const OccupancyGrid& grid, 
     if (fresh) drawn->second = random() % 2 == 0 ? c->a : c->b;
     int keep = drawn->second;
     std::size_t o = static_cast<std::size_t>(keep == c->a ? c->b : c->a);
-    // A robot still waiting at its start cannot give way by waiting longer: when the kept one
-    // is already moving, it is the one constrained this round (around the waiting robot).
-    if (c->time <= paths[o].start_time && c->time > paths[static_cast<std::size_t>(keep)].start_time) {
+    // Waiting longer gives way to nobody when the robot to wait is still waiting at its start,
+    // or the kept one is parked at its goal: then the kept one is constrained this round (it
+    // detours round, or arrives after, the standing robot), unless it is itself still waiting.
+    const TimedMotionPath& to_wait = paths[o];
+    const TimedMotionPath& to_keep = paths[static_cast<std::size_t>(keep)];
+    if ((c->time <= to_wait.start_time || c->time >= to_keep.arrival()) && c->time > to_keep.start_time) {
       const int waiting = static_cast<int>(o);
       o = static_cast<std::size_t>(keep);
       keep = waiting;

@@ -19,9 +19,11 @@
 //  2. Delay (temporal): otherwise the robot keeps its path and waits `delay_step` seconds
 //     longer at its start; its start time is the total delay.
 // Each robot gets at most `max_detours` failed detour attempts, after which it only waits.
-// Exception to the kept robot's draw: a robot still waiting at its start when the conflict
-// happens gains nothing by waiting longer, so when the other one is already moving, the
-// moving one is constrained that round (it detours around, or waits for, the waiting one).
+// Exception to the kept robot's draw: waiting longer gives way to nobody when the robot to
+// wait is still waiting at its start at the conflict, or the kept robot is parked at its goal
+// then; in those cases the kept robot is constrained that round instead (it detours round
+// the standing robot, or waits so that it arrives after it has gone / it has passed), unless
+// it is itself still waiting at its start.
 // Termination: every round changes one robot's (detour cells, delay) strictly — the cell set
 // grows within the finite grid, or the delay grows by delay_step — and a delay past
 // `max_delay` is an error, so the loop ends by itself; the limits bound it further.

@@ -81,6 +81,27 @@ TEST(DispatchSimMotionCliTest, OneQueryFromTheCommandLine) {
   EXPECT_EQ(Row(run.output, "crab-slot", "4wis"), "") << run.output;
 }
 
+// --robots: BIT2024 step 7 for three robots between the floor's stations (seed 3 has
+// conflicts to eliminate: detours and a wait).
+TEST(DispatchSimMotionCliTest, RobotsRunStepSevenConflictFree) {
+  const std::string svg = std::string(MOTION_SVG_OUT) + ".robots.svg";
+  std::remove(svg.c_str());
+  const auto run = Sim("--robots 3 --seed 3 --svg " + svg);
+  ASSERT_EQ(run.status, 0) << run.output;
+  EXPECT_NE(run.output.find("3 robots, seed 3"), std::string::npos) << run.output;
+  EXPECT_NE(run.output.find("conflict-free (checked every 0.1 s): yes"), std::string::npos) << run.output;
+  EXPECT_EQ(run.output.find("rounds 0,"), std::string::npos) << run.output;
+  for (const char* robot : {"\n0 ", "\n1 ", "\n2 "}) EXPECT_NE(run.output.find(robot), std::string::npos) << run.output;
+  std::ifstream in(svg);
+  ASSERT_TRUE(in.good()) << svg;
+  std::stringstream text;
+  text << in.rdbuf();
+  EXPECT_NE(text.str().find("data-label=\"robot 2\""), std::string::npos);
+  // Same seed, same answer (the table above the timing line).
+  auto table = [](const std::string& out) { return out.substr(0, out.find("conflict-free")); };
+  EXPECT_EQ(table(Sim("--robots 3 --seed 3").output), table(run.output));
+}
+
 TEST(DispatchSimMotionCliTest, BadArgumentsFailWithAReason) {
   const auto half = Sim("--from 1,0.8,0");
   EXPECT_EQ(half.status, 1) << half.output;
@@ -96,6 +117,10 @@ TEST(DispatchSimMotionCliTest, BadArgumentsFailWithAReason) {
   EXPECT_NE(nowhere.output.find("cannot write"), std::string::npos) << nowhere.output;
   EXPECT_NE(Sim("--budget-ms -5").status, 0);
   EXPECT_NE(Sim("--robots").status, 0);
+  const auto crowd = Sim("--robots 7");
+  EXPECT_EQ(crowd.status, 1) << crowd.output;
+  EXPECT_NE(crowd.output.find("at most 6 robots"), std::string::npos) << crowd.output;
+  EXPECT_EQ(Sim("--robots 2 --from 1,0.8,0 --to 2,0.8,0").status, 1);
 }
 
 }  // namespace
