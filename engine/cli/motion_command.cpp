@@ -52,6 +52,7 @@ CLI::App* AddMotionCommand(CLI::App& app, MotionArgs& a) {
       ->capture_default_str()->check(CLI::PositiveNumber);
   m->add_option("--robots", a.robots, "Run BIT2024 step 7 for N robots between the floor's stations instead");
   m->add_option("--seed", a.seed, "Seed of the stations' draw and of step 7 (with --robots)")->capture_default_str();
+  m->add_flag("--trace", a.trace, "With --robots: print each round of step 7");
   return m;
 }
 
@@ -87,6 +88,11 @@ int RunFleet(const MotionArgs& a, const NarrowFloor& floor, const FootprintCheck
   options.seed = a.seed;
   options.planner.min_turn_radius = floor.min_turn_radius;
   const auto budget = std::chrono::duration<double, std::milli>(a.budget_ms);
+  if (a.trace) {
+    options.on_round = [](const MotionConflict& c, int constrained, bool detoured) {
+      std::printf("  round: %s -> robot %d %s\n", Describe(c).c_str(), constrained, detoured ? "detours" : "waits");
+    };
+  }
   options.limits.stop = DeadlineCheck(std::chrono::duration_cast<std::chrono::steady_clock::duration>(budget));
   std::printf("BIT2024 step 7 on the narrow floor: %zu robots, seed %llu; %.1f m/s, %.1f rad/s, clearance %.2f m, "
               "sampled every %.1f s\n",

@@ -11,7 +11,7 @@
 // poses in the hall, the corridor's ends, the crab slot, the opening and the dead end), prints
 // each robot's wait, length and arrival and the rounds, and --svg draws their paths.
 //   dispatch-sim motion [--from X,Y,THETA --to X,Y,THETA] [--svg FILE] [--budget-ms 10000]
-//   dispatch-sim motion --robots N [--seed 1] [--svg FILE] [--budget-ms 10000]
+//   dispatch-sim motion --robots N [--seed 1] [--trace] [--svg FILE] [--budget-ms 10000]
 // Exit status: 0 when it ran (an unsolved query is a result; with --robots: solved), 1 on bad
 // arguments or an unwritable SVG file, 2 when a returned path failed the checker (with
 // --robots: not solved).
@@ -34,6 +34,7 @@ struct MotionArgs {
   double budget_ms = 10000.0;
   std::size_t robots = 0;  // > 0: step 7 for this many robots instead of the queries
   std::uint64_t seed = 1;
+  bool trace = false;  // with --robots: one line per round of step 7
 };
 
 // Adds the subcommand to `app`; returns it (the caller dispatches to RunMotion when it ran).

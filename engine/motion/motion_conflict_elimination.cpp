@@ -89,6 +89,7 @@ Result<MotionFleetSolution> EliminateMotionConflicts(const OccupancyGrid& grid, 
       const int waiting = static_cast<int>(o);
       o = static_cast<std::size_t>(keep);
       keep = waiting;
+      drawn->second = keep;  // and from now on for this pair, or the two take turns waiting
     }
     RobotState& s = state[o];
     // s73, the detour: the kept robot's cells around the conflict, as static obstacles.
@@ -141,6 +142,7 @@ Result<MotionFleetSolution> EliminateMotionConflicts(const OccupancyGrid& grid, 
       ++out.delays;
     }
     paths[o] = TimeMotionPath(s.path, s.delay, options.timing);
+    if (options.on_round) options.on_round(*c, static_cast<int>(o), detoured);
   }
   if (Status ok = CheckTimedMotionPaths(paths, footprints, options.conflicts); !ok.ok()) {
     return Error{ok.error().code, "motion conflicts: final check: " + ok.error().message};

@@ -37,6 +37,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <functional>
 #include <vector>
 
 #include "engine/common/result.h"
@@ -67,6 +68,9 @@ struct MotionConflictEliminationOptions {
   // max_expansions counts rounds (conflicts handled); stop is the deadline / cancel, polled
   // each round and inside every search.
   PlanLimits limits{{}, 100000};
+  // Called after each round with the conflict, the constrained robot and whether it detoured
+  // (else it waited); for traces. May be empty.
+  std::function<void(const MotionConflict&, int constrained, bool detoured)> on_round;
 };
 
 struct MotionFleetSolution {
