@@ -28,9 +28,10 @@
 // grows within the finite grid, or the delay grows by delay_step — and a delay past
 // `max_delay` is an error, so the loop ends by itself; the limits bound it further.
 // What it cannot solve: a robot that must give way part-way along its path (two robots
-// head-on in a corridor too narrow to pass, where one would have to pull into a side slot,
-// wait and come out again) — waiting happens only at the start, and a detour never reaches a
-// pose that is not on the way to its own goal. That case ends in kUnreachable.
+// head-on in a corridor where they could pass only by both keeping to the walls, or by one
+// pulling into a side slot, waiting and coming out again) — waiting happens only at the
+// start, the detour avoids the kept robot's cells wherever that robot runs, and it never
+// reaches a pose that is not on the way to its own goal. That case ends in kUnreachable.
 // Deterministic for a seed (max_expansions-bounded searches); pure; thread-safe for distinct
 // calls.
 #pragma once

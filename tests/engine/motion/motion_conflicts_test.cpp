@@ -142,11 +142,11 @@ TEST_F(MotionConflictEliminationTest, RobotsCrossingInTheHall) {
   }
 }
 
-// Head-on in the 1.4 m corridor, each to the other's end: two 0.5 m robots with 0.1 m
-// clearance cannot pass each other there, and giving way needs one to pull into the crab slot
-// or the opening part-way and come out again, which this scheme (waiting only at the start,
-// static detours to the own goal) cannot produce: it must end with a clear error, not an
-// invalid answer.
+// Head-on in the 1.4 m corridor, each to the other's end. Passing needs both robots to keep
+// to the walls (0.5 + 0.1 + 0.5 m of 1.4 m), or one to pull into the crab slot or the opening
+// part-way, wait and come out again. This scheme produces neither: the kept robot runs near
+// the middle, its grown cells leave ~0.35 m either side (no detour), and waiting happens only
+// at the start. So it must end with a clear error, not an invalid answer.
 TEST_F(MotionConflictEliminationTest, HeadOnInTheCorridorIsReportedUnsolvable) {
   const std::vector<MotionRobot> robots = {Robot({1.0, 0.8, 0.0}, {10.8, 0.8, 0.0}),
                                            Robot({10.8, 0.8, kPi}, {1.0, 0.8, kPi})};
