@@ -206,7 +206,7 @@ TEST(MotionConflictEliminationRandomTest, OpenFloorAnswersAreConflictFreeAndRepr
   EXPECT_GE(with_conflicts, 2);  // not only trivially separate robots
 }
 
-TEST_F(MotionConflictEliminationTest, DeadlineZeroStopsAndBadInputIsRejected) {
+TEST_F(MotionConflictEliminationTest, DeadlineZeroAndTheRoundBoundStopAndBadInputIsRejected) {
   const std::vector<MotionRobot> robots = {Robot(floor_.cross_start, floor_.cross_goal)};
   options_.limits.stop = [] { return true; };
   const auto stopped = EliminateMotionConflicts(floor_.grid, robots, options_);
@@ -214,6 +214,14 @@ TEST_F(MotionConflictEliminationTest, DeadlineZeroStopsAndBadInputIsRejected) {
   EXPECT_EQ(stopped.error().code, ErrorCode::kFailedPrecondition);
   EXPECT_NE(stopped.error().message.find("stopped"), std::string::npos) << stopped.error().message;
   options_.limits.stop = nullptr;
+  // The round bound stops it at the first conflict of the corridor/hall pair.
+  options_.limits.max_expansions = 1;
+  const auto bounded = EliminateMotionConflicts(
+      floor_.grid, {Robot({1.0, 0.8, 0.0}, {10.8, 0.8, 0.0}), Robot({6.0, 3.2, -kPi / 2}, floor_.crab_goal)}, options_);
+  ASSERT_FALSE(bounded.ok());
+  EXPECT_EQ(bounded.error().code, ErrorCode::kFailedPrecondition);
+  EXPECT_NE(bounded.error().message.find("stopped after 1 rounds"), std::string::npos) << bounded.error().message;
+  options_.limits.max_expansions = 0;
   EXPECT_EQ(EliminateMotionConflicts(floor_.grid, {}, options_).error().code, ErrorCode::kInvalidArgument);
   const auto wall = EliminateMotionConflicts(floor_.grid, {Robot({0.0, 0.0, 0.0}, floor_.cross_goal)}, options_);
   EXPECT_EQ(wall.error().code, ErrorCode::kInvalidArgument);
