@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstdio>
 #include <fstream>
+#include <numbers>
 #include <optional>
 #include <random>
 #include <sstream>
@@ -60,7 +61,7 @@ namespace {
 
 // BIT2024 step 7 on the narrow floor: N robots, starts and goals drawn among the stations.
 int RunFleet(const MotionArgs& a, const NarrowFloor& floor, const FootprintChecker& checker) {
-  constexpr double kPi = 3.14159265358979323846;
+  constexpr double kPi = std::numbers::pi;
   const std::vector<MotionPose> stations = {
       {0.7, 3.15, 0.0},  {3.5, 3.15, 0.0},      {7.0, 3.15, kPi / 2}, {0.7, 5.1, 0.0},
       {3.5, 5.1, 0.0},   {6.8, 5.1, kPi},       {5.2, 5.5, 0.0},      {1.0, 0.8, 0.0},

@@ -1,6 +1,7 @@
 #include "engine/motion/motion_conflict_elimination.h"
 
 #include <cmath>
+#include <cstdio>
 #include <map>
 #include <random>
 #include <string>
@@ -135,8 +136,10 @@ Result<MotionFleetSolution> EliminateMotionConflicts(const OccupancyGrid& grid, 
     // s73, the delay: wait at the start.
     if (!detoured) {
       if (s.delay + options.delay_step > options.max_delay + 1e-9) {
-        return Unreachable("motion conflicts: robot " + std::to_string(o) + " cannot wait past " +
-                           std::to_string(options.max_delay) + " s nor detour, at " + Describe(*c));
+        char cap[32];
+        std::snprintf(cap, sizeof cap, "%g", options.max_delay);
+        return Unreachable("motion conflicts: robot " + std::to_string(o) + " cannot wait past " + cap +
+                           " s nor detour, at " + Describe(*c));
       }
       s.delay += options.delay_step;
       ++out.delays;
