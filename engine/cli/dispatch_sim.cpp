@@ -17,8 +17,8 @@
 //       planners side by side (both: stream_command.h).
 //   dispatch-sim mapf --map FILE.map --agents N [--planner conflict-elimination|cbs|both]
 //       the discrete-time planners on a floor (mapf_command.h).
-//   dispatch-sim motion [--from X,Y,THETA --to X,Y,THETA] [--svg FILE]
-//       4WIS hybrid A* vs. the baseline on the narrow floor (motion_command.h).
+//   dispatch-sim motion [--from X,Y,THETA --to X,Y,THETA | --robots N [--seed S]] [--svg FILE]
+//       4WIS hybrid A* vs. the baseline on the narrow floor, or BIT2024 step 7 (motion_command.h).
 //   dispatch-sim headon
 //       seed 004 §4.3: a head-on conflict resolved by waiting vs. re-planning.
 //   dispatch-sim routing [--tasks 4,8,12,16,20] [--seeds 5] [--turn-time 1]
