@@ -17,6 +17,8 @@
 //       planners side by side (both: stream_command.h).
 //   dispatch-sim mapf --map FILE.map --agents N [--planner conflict-elimination|cbs|both]
 //       the discrete-time planners on a floor (mapf_command.h).
+//   dispatch-sim motion [--from X,Y,THETA --to X,Y,THETA | --robots N [--seed S]] [--svg FILE]
+//       4WIS hybrid A* vs. the baseline on the narrow floor, or BIT2024 step 7 (motion_command.h).
 //   dispatch-sim headon
 //       seed 004 §4.3: a head-on conflict resolved by waiting vs. re-planning.
 //   dispatch-sim routing [--tasks 4,8,12,16,20] [--seeds 5] [--turn-time 1]
@@ -41,6 +43,7 @@
 #include "engine/allocation/auction_allocator.h"
 #include "engine/cli/journal_replay.h"
 #include "engine/cli/mapf_command.h"
+#include "engine/cli/motion_command.h"
 #include "engine/cli/routing_command.h"
 #include "engine/cli/stream_command.h"
 #include "engine/cli/scenario.h"
@@ -207,11 +210,14 @@ int Main(int argc, char** argv) {
   r->add_option("--max-time", replay.max_time, "What-if simulated seconds before giving up")->capture_default_str();
   MapfArgs mapf;
   auto* m = AddMapfCommand(app, mapf);
+  MotionArgs motion;
+  auto* mo = AddMotionCommand(app, motion);
   RoutingArgs routing;
   auto* rt = AddRoutingCommand(app, routing);
   CLI11_PARSE(app, argc, argv);
   if (*rt) return RunRouting(routing);
   if (*m) return RunMapf(mapf);
+  if (*mo) return RunMotion(motion);
   if (*r) return RunReplay(replay);
   if (*p) return RunPlan(plan);
   if (*streams.stream) return RunStream(stream);
