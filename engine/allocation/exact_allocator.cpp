@@ -3,33 +3,17 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <functional>
 #include <limits>
-#include <optional>
 #include <set>
 #include <string>
 #include <utility>
 
+#include "engine/allocation/batch_orders.h"
 #include "engine/planning/plan_limits.h"
 
 namespace dispatch::engine {
 namespace {
-
-// The `count` robots with room that can start `task` soonest, ascending by index.
-std::vector<std::size_t> Candidates(const FleetState& state, const PlanTask& task, std::size_t count) {
-  std::vector<std::pair<double, std::size_t>> ranked;
-  for (std::size_t i = 0; i < state.robot_count(); ++i) {
-    if (!state.HasRoom(i)) continue;
-    const QueueSummary& s = state.summary(i);
-    const double start = s.end_time + state.routes().Cost(s.end_point, task.picks.front());
-    if (std::isfinite(start)) ranked.emplace_back(start, i);
-  }
-  const std::size_t keep = std::min(count, ranked.size());
-  std::partial_sort(ranked.begin(), ranked.begin() + static_cast<std::ptrdiff_t>(keep), ranked.end());
-  std::vector<std::size_t> out;
-  for (std::size_t k = 0; k < keep; ++k) out.push_back(ranked[k].second);
-  std::sort(out.begin(), out.end());
-  return out;
-}
 
 // The free queue places of `robots` (AllocationConfig::max_queue; unbounded without a limit).
 std::size_t FreePlaces(const FleetState& state, const std::set<std::size_t>& robots) {
@@ -53,28 +37,14 @@ ExactAllocator::ExactAllocator(ExactOptions options) : options_(options) {
 }
 
 Result<AwardExplanation> ExactAllocator::Allocate(const Order& order, FleetState& state) {
-  std::optional<Result<AwardExplanation>> out;
-  AllocateBatch({&order}, state, [&](const Order&, Result<AwardExplanation> award) { out.emplace(std::move(award)); });
-  return std::move(*out);  // every order of a batch reaches the sink once
+  return AllocateAsBatch(*this, order, state);
 }
 
 void ExactAllocator::AllocateBatch(const std::vector<const Order*>& orders, FleetState& state,
                                    const AwardSink& sink) {
-  std::vector<const Order*> singles;
-  std::vector<PlanTask> tasks;
-  for (const Order* o : orders) {
-    if (o->formation) {
-      sink(*o, auction_.Allocate(*o, state));
-      continue;
-    }
-    Result<PlanTask> task = PrepareOrder(*o, state);
-    if (!task.ok()) {
-      sink(*o, task.error());
-      continue;
-    }
-    singles.push_back(o);
-    tasks.push_back(std::move(task).value());
-  }
+  BatchSingles taken = TakeSingles(orders, state, auction_, sink);
+  const std::vector<const Order*>& singles = taken.orders;
+  const std::vector<PlanTask>& tasks = taken.tasks;
   const std::function<bool()> stop = DeadlineCheck(options_.budget);
   std::size_t next = 0;
   while (next < singles.size()) {
@@ -86,7 +56,7 @@ void ExactAllocator::AllocateBatch(const std::vector<const Order*>& orders, Flee
     std::vector<std::size_t> chunk;
     std::set<std::size_t> robots;
     while (next < singles.size()) {
-      const std::vector<std::size_t> mine = Candidates(state, tasks[next], options_.candidates);
+      const std::vector<std::size_t> mine = SoonestRobots(state, tasks[next], options_.candidates);
       if (mine.empty()) {  // no robot with room reaches it: the auction says why
         if (!chunk.empty()) break;  // after the chunk is committed (its robots may fill up)
         sink(*singles[next], auction_.Allocate(*singles[next], state));

@@ -3,10 +3,11 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <optional>
 #include <set>
 #include <string>
 #include <utility>
+
+#include "engine/allocation/batch_orders.h"
 
 namespace dispatch::engine {
 
@@ -15,50 +16,26 @@ SwarmAllocator::SwarmAllocator(SwarmOptions options, std::size_t candidates,
     : options_(std::move(options)), candidates_(std::max<std::size_t>(1, candidates)), budget_(budget) {}
 
 Result<AwardExplanation> SwarmAllocator::Allocate(const Order& order, FleetState& state) {
-  std::optional<Result<AwardExplanation>> out;
-  AllocateBatch({&order}, state, [&](const Order&, Result<AwardExplanation> award) { out.emplace(std::move(award)); });
-  return std::move(*out);  // every order of a batch reaches the sink once
+  return AllocateAsBatch(*this, order, state);
 }
 
 void SwarmAllocator::AllocateBatch(const std::vector<const Order*>& orders, FleetState& state,
                                    const AwardSink& sink) {
-  std::vector<const Order*> singles;
-  std::vector<PlanTask> tasks;
-  for (const Order* o : orders) {
-    if (o->formation) {
-      sink(*o, auction_.Allocate(*o, state));
-      continue;
-    }
-    Result<PlanTask> task = PrepareOrder(*o, state);
-    if (!task.ok()) {
-      sink(*o, task.error());
-      continue;
-    }
-    singles.push_back(o);
-    tasks.push_back(std::move(task).value());
-  }
+  BatchSingles taken = TakeSingles(orders, state, auction_, sink);
+  std::vector<const Order*>& singles = taken.orders;
+  std::vector<PlanTask>& tasks = taken.tasks;
   // The robots searched: for each order the `candidates_` with room that can start it soonest.
   // An order no robot with room reaches goes to the auction, which says why.
   const RouteTable& routes = state.routes();
   std::set<std::size_t> chosen;
-  std::vector<std::pair<double, std::size_t>> ranked;
   std::size_t kept = 0;
   for (std::size_t j = 0; j < singles.size(); ++j) {
-    const PlanTask& task = tasks[j];
-    ranked.clear();
-    for (std::size_t i = 0; i < state.robot_count(); ++i) {
-      if (!state.HasRoom(i)) continue;
-      const QueueSummary& s = state.summary(i);
-      const double start = s.end_time + routes.Cost(s.end_point, task.picks.front());
-      if (std::isfinite(start)) ranked.emplace_back(start, i);
-    }
-    if (ranked.empty()) {
+    const std::vector<std::size_t> soonest = SoonestRobots(state, tasks[j], candidates_);
+    if (soonest.empty()) {
       sink(*singles[j], auction_.Allocate(*singles[j], state));
       continue;
     }
-    const std::size_t keep = std::min(candidates_, ranked.size());
-    std::partial_sort(ranked.begin(), ranked.begin() + static_cast<std::ptrdiff_t>(keep), ranked.end());
-    for (std::size_t k = 0; k < keep; ++k) chosen.insert(ranked[k].second);
+    chosen.insert(soonest.begin(), soonest.end());
     singles[kept] = singles[j];
     tasks[kept++] = tasks[j];
   }

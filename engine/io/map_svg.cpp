@@ -8,6 +8,8 @@
 #include <string_view>
 #include <vector>
 
+#include "engine/io/xml_text.h"
+
 namespace dispatch::engine {
 namespace {
 
@@ -25,22 +27,6 @@ std::string Num(double v) {
   }
   if (s == "-0") s = "0";
   return s;
-}
-
-std::string Escape(std::string_view text) {
-  std::string out;
-  out.reserve(text.size());
-  for (char c : text) {
-    switch (c) {
-      case '&': out += "&amp;"; break;
-      case '<': out += "&lt;"; break;
-      case '>': out += "&gt;"; break;
-      case '"': out += "&quot;"; break;
-      case '\'': out += "&apos;"; break;
-      default: out += c;
-    }
-  }
-  return out;
 }
 
 struct KindStyle {
@@ -88,7 +74,7 @@ void RenderZones(std::ostringstream& out, const WarehouseMap& map, const Frame& 
     for (std::size_t k = 0; k < z.polygon.size(); ++k) {
       out << (k ? " " : "") << Num(f.X(z.polygon[k].x())) << ',' << Num(f.Y(z.polygon[k].y()));
     }
-    out << "\"><title>" << Escape(z.name) << "</title></polygon>\n";
+    out << "\"><title>" << XmlEscape(z.name) << "</title></polygon>\n";
   }
   out << "</g>\n";
 }
@@ -102,7 +88,7 @@ void RenderFreeSpaces(std::ostringstream& out, const WarehouseMap& map, const Fr
     for (std::size_t k = 0; k < s.polygon.size(); ++k) {
       out << (k ? " " : "") << Num(f.X(s.polygon[k].x())) << ',' << Num(f.Y(s.polygon[k].y()));
     }
-    out << "\"><title>free space " << Escape(s.name) << "</title></polygon>\n";
+    out << "\"><title>free space " << XmlEscape(s.name) << "</title></polygon>\n";
   }
   out << "</g>\n";
 }
@@ -117,7 +103,7 @@ void RenderZoneLabels(std::ostringstream& out, const WarehouseMap& map, const Fr
     for (const auto& v : z.polygon) c += v;
     c /= static_cast<double>(z.polygon.size());
     out << "<text class=\"zone-label\" x=\"" << Num(f.X(c.x())) << "\" y=\"" << Num(f.Y(c.y()))
-        << "\">" << Escape(z.name) << "<tspan x=\"" << Num(f.X(c.x())) << "\" dy=\"1.1em\">S="
+        << "\">" << XmlEscape(z.name) << "<tspan x=\"" << Num(f.X(c.x())) << "\" dy=\"1.1em\">S="
         << Num(z.area) << " m\u00b2</tspan></text>\n";
   }
   out << "</g>\n";
@@ -130,7 +116,7 @@ void RenderDetailed(std::ostringstream& out, const WarehouseMap& map, const Fram
   for (const Shelf& s : map.shelves()) {
     out << "<rect class=\"shelf\" x=\"" << Num(f.X(s.min.x())) << "\" y=\"" << Num(f.Y(s.max.y()))
         << "\" width=\"" << Num((s.max.x() - s.min.x()) * f.scale) << "\" height=\""
-        << Num((s.max.y() - s.min.y()) * f.scale) << "\"><title>" << Escape(s.name)
+        << Num((s.max.y() - s.min.y()) * f.scale) << "\"><title>" << XmlEscape(s.name)
         << "</title></rect>\n";
   }
   out << "</g>\n<g class=\"intersections\">\n";
@@ -139,13 +125,13 @@ void RenderDetailed(std::ostringstream& out, const WarehouseMap& map, const Fram
       const Point& p = map.point(id);
       out << "<circle class=\"inter-inner\" cx=\"" << Num(f.X(p.position.x())) << "\" cy=\""
           << Num(f.Y(p.position.y())) << "\" r=\"" << Num(3 * r) << "\"><title>"
-          << Escape(x.name) << " inner</title></circle>\n";
+          << XmlEscape(x.name) << " inner</title></circle>\n";
     }
     for (PointId id : x.approach) {
       const Point& p = map.point(id);
       out << "<rect class=\"approach\" x=\"" << Num(f.X(p.position.x()) - 2 * r) << "\" y=\""
           << Num(f.Y(p.position.y()) - 2 * r) << "\" width=\"" << Num(4 * r) << "\" height=\""
-          << Num(4 * r) << "\"><title>" << Escape(x.name) << " approach</title></rect>\n";
+          << Num(4 * r) << "\"><title>" << XmlEscape(x.name) << " approach</title></rect>\n";
     }
   }
   out << "</g>\n<g class=\"paths\">\n";
@@ -167,19 +153,19 @@ void RenderDetailed(std::ostringstream& out, const WarehouseMap& map, const Fram
   for (const Point& p : map.points()) {
     out << "<circle class=\"pt " << StyleOf(p.kind).css << "\" cx=\"" << Num(f.X(p.position.x()))
         << "\" cy=\"" << Num(f.Y(p.position.y())) << "\" r=\""
-        << Num(IsServicePoint(p.kind) ? r : 0.6 * r) << "\"><title>" << Escape(p.name)
+        << Num(IsServicePoint(p.kind) ? r : 0.6 * r) << "\"><title>" << XmlEscape(p.name)
         << "</title></circle>\n";
   }
   for (const ParkingStation& s : map.stations()) {
     const Point& p = map.point(s.point);
     out << "<text class=\"station-label\" x=\"" << Num(f.X(p.position.x()) + 1.5 * r) << "\" y=\""
-        << Num(f.Y(p.position.y()) + 3 * r) << "\">" << Escape(s.name) << " \u00d7" << s.capacity
+        << Num(f.Y(p.position.y()) + 3 * r) << "\">" << XmlEscape(s.name) << " \u00d7" << s.capacity
         << "</text>\n";
   }
   if (options.show_point_labels) {
     for (const Point& p : map.points()) {
       out << "<text class=\"pt-label\" x=\"" << Num(f.X(p.position.x()) + 1.5 * r) << "\" y=\""
-          << Num(f.Y(p.position.y()) - 1.5 * r) << "\">" << Escape(p.name) << "</text>\n";
+          << Num(f.Y(p.position.y()) - 1.5 * r) << "\">" << XmlEscape(p.name) << "</text>\n";
     }
   }
   out << "</g>\n";
@@ -272,7 +258,7 @@ void RenderLegend(std::ostringstream& out, const WarehouseMap& map, double top, 
     const double x = 20.0 + static_cast<double>(static_cast<int>(i) % per_row) * kEntryWidth;
     const double y = top + 14.0 + static_cast<double>(static_cast<int>(i) / per_row) * kRowHeight;
     out << "<g transform=\"translate(" << Num(x) << ' ' << Num(y) << ")\">" << entries[i].swatch
-        << "<text x=\"22\" y=\"4\">" << Escape(entries[i].text) << "</text></g>\n";
+        << "<text x=\"22\" y=\"4\">" << XmlEscape(entries[i].text) << "</text></g>\n";
   }
   out << "</g>\n";
 }
@@ -301,7 +287,7 @@ std::string RenderMapSvg(const WarehouseMap& map, const SvgOptions& options) {
   std::ostringstream out;
   out << "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"" << Num(width) << "\" height=\""
       << Num(height) << "\" viewBox=\"0 0 " << Num(width) << ' ' << Num(height) << "\">\n";
-  out << "<title>" << Escape(map.name()) << "</title>\n";
+  out << "<title>" << XmlEscape(map.name()) << "</title>\n";
   out << "<defs>\n<marker id=\"arrow\" viewBox=\"0 0 10 10\" refX=\"10\" refY=\"5\" "
          "markerWidth=\"5\" markerHeight=\"5\" orient=\"auto\"><path d=\"M0 0L10 5L0 10z\" "
          "fill=\"#37474f\"/></marker>\n</defs>\n";

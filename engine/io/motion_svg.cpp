@@ -4,24 +4,11 @@
 #include <cstdio>
 #include <string_view>
 
+#include "engine/io/xml_text.h"
 #include "engine/motion/motion_conflicts.h"
 
 namespace dispatch::engine {
 namespace {
-
-std::string Escape(std::string_view text) {
-  std::string out;
-  for (char c : text) {
-    switch (c) {
-      case '&': out += "&amp;"; break;
-      case '<': out += "&lt;"; break;
-      case '>': out += "&gt;"; break;
-      case '"': out += "&quot;"; break;
-      default: out += c;
-    }
-  }
-  return out;
-}
 
 std::string Num(double v) {
   char buf[32];
@@ -66,7 +53,7 @@ std::string RenderMotionSvg(const OccupancyGrid& grid, const std::vector<MotionS
   svg += "</g>\n";
   for (const MotionSvgPath& p : paths) {
     const std::vector<MotionPose>& poses = p.path.poses;
-    svg += "<g class=\"motion-path\" data-label=\"" + Escape(p.label) + "\">\n";
+    svg += "<g class=\"motion-path\" data-label=\"" + XmlEscape(p.label) + "\">\n";
     double since = 0.0;
     for (std::size_t i = 0; i < poses.size(); ++i) {
       if (i > 0) {
@@ -96,13 +83,13 @@ std::string RenderMotionSvg(const OccupancyGrid& grid, const std::vector<MotionS
   double ly = floor_h * s + 2.0 * o.margin_px + 12.0;
   svg += "<g class=\"legend\" font-family=\"sans-serif\" font-size=\"13\">\n";
   if (!o.title.empty()) {
-    svg += "<text x=\"" + Num(o.margin_px) + "\" y=\"" + Num(ly) + "\">" + Escape(o.title) + "</text>\n";
+    svg += "<text x=\"" + Num(o.margin_px) + "\" y=\"" + Num(ly) + "\">" + XmlEscape(o.title) + "</text>\n";
     ly += 18.0;
   }
   for (const MotionSvgPath& p : paths) {
     svg += "<rect x=\"" + Num(o.margin_px) + "\" y=\"" + Num(ly - 10.0) + "\" width=\"20\" height=\"10\" fill=\"" +
            p.colour + "\"/>\n";
-    svg += "<text x=\"" + Num(o.margin_px + 28.0) + "\" y=\"" + Num(ly) + "\">" + Escape(p.label) + "</text>\n";
+    svg += "<text x=\"" + Num(o.margin_px + 28.0) + "\" y=\"" + Num(ly) + "\">" + XmlEscape(p.label) + "</text>\n";
     ly += 18.0;
   }
   svg += "</g>\n</svg>\n";
