@@ -2,14 +2,11 @@
 
 #include <CLI/CLI.hpp>
 
-#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
-#include <numbers>
 #include <optional>
-#include <random>
 #include <sstream>
 #include <vector>
 
@@ -61,30 +58,18 @@ namespace {
 
 // BIT2024 step 7 on the narrow floor: N robots, starts and goals drawn among the stations.
 int RunFleet(const MotionArgs& a, const NarrowFloor& floor, const FootprintChecker& checker) {
-  constexpr double kPi = std::numbers::pi;
-  const std::vector<MotionPose> stations = {
-      {0.7, 3.15, 0.0},  {3.5, 3.15, 0.0},      {7.0, 3.15, kPi / 2}, {0.7, 5.1, 0.0},
-      {3.5, 5.1, 0.0},   {6.8, 5.1, kPi},       {5.2, 5.5, 0.0},      {1.0, 0.8, 0.0},
-      {10.8, 0.8, kPi},  {3.5, 1.825, 0.0},     {6.0, 2.0, kPi / 2},  {9.05, 5.3, kPi / 2}};
-  if (a.robots * 2 > stations.size()) {
-    std::fprintf(stderr, "dispatch-sim: motion: at most %zu robots fit the floor's %zu stations\n",
-                 stations.size() / 2, stations.size());
-    return 1;
-  }
-  for (const MotionPose& p : stations) {
+  for (const MotionPose& p : floor.stations) {
     if (checker.Collides(p)) {
       std::fprintf(stderr, "dispatch-sim: motion: station (%g, %g) collides (a bug)\n", p.x, p.y);
       return 2;
     }
   }
-  std::vector<std::size_t> order(stations.size());
-  for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
-  std::mt19937_64 random(a.seed);
-  std::shuffle(order.begin(), order.end(), random);
-  std::vector<MotionRobot> robots;
-  for (std::size_t i = 0; i < a.robots; ++i) {
-    robots.push_back({stations[order[i]], stations[order[a.robots + i]], floor.footprint});
+  Result<std::vector<MotionRobot>> drawn_robots = NarrowFloorRobots(floor, a.robots, a.seed);
+  if (!drawn_robots.ok()) {
+    std::fprintf(stderr, "dispatch-sim: motion: %s\n", drawn_robots.error().message.c_str());
+    return 1;
   }
+  const std::vector<MotionRobot>& robots = *drawn_robots;
   MotionConflictEliminationOptions options;
   options.seed = a.seed;
   options.planner.min_turn_radius = floor.min_turn_radius;

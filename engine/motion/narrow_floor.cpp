@@ -1,6 +1,9 @@
 #include "engine/motion/narrow_floor.h"
 
+#include <algorithm>
 #include <numbers>
+#include <random>
+#include <string>
 
 namespace dispatch::engine {
 
@@ -29,7 +32,27 @@ NarrowFloor BuildNarrowFloor() {
       .dead_end_goal = {10.8, 0.8, 0.0},
       .cross_start = {0.8, 0.8, 0.0},
       .cross_goal = {2.0, 5.1, kPi},
+      .stations = {{0.7, 3.15, 0.0}, {3.5, 3.15, 0.0}, {7.0, 3.15, kPi / 2}, {0.7, 5.1, 0.0},
+                   {3.5, 5.1, 0.0},  {6.8, 5.1, kPi},  {5.2, 5.5, 0.0},      {1.0, 0.8, 0.0},
+                   {10.8, 0.8, kPi}, {3.5, 1.825, 0.0}, {6.0, 2.0, kPi / 2}, {9.05, 5.3, kPi / 2}},
   };
+}
+
+Result<std::vector<MotionRobot>> NarrowFloorRobots(const NarrowFloor& floor, std::size_t robots, std::uint64_t seed) {
+  const std::vector<MotionPose>& stations = floor.stations;
+  if (robots * 2 > stations.size()) {
+    return InvalidArgument("at most " + std::to_string(stations.size() / 2) + " robots fit the floor's " +
+                           std::to_string(stations.size()) + " stations");
+  }
+  std::vector<std::size_t> order(stations.size());
+  for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
+  std::mt19937_64 random(seed);
+  std::shuffle(order.begin(), order.end(), random);
+  std::vector<MotionRobot> out;
+  for (std::size_t i = 0; i < robots; ++i) {
+    out.push_back({stations[order[i]], stations[order[robots + i]], floor.footprint});
+  }
+  return out;
 }
 
 }  // namespace dispatch::engine

@@ -5,7 +5,13 @@
 // Pure; the returned value is independent of every other.
 #pragma once
 
+#include <cstddef>
+#include <cstdint>
+#include <vector>
+
+#include "engine/common/result.h"
 #include "engine/motion/footprint.h"
+#include "engine/motion/motion_conflict_elimination.h"
 #include "engine/motion/motion_path.h"
 #include "engine/motion/occupancy_grid.h"
 
@@ -24,8 +30,15 @@ struct NarrowFloor {
   // Across the floor: corridor -> the hall's upper lane, facing west.
   MotionPose cross_start;
   MotionPose cross_goal;
+  // Where several robots start and end (BIT2024 step 7): hall, corridor ends, crab slot,
+  // opening, dead end; every one free.
+  std::vector<MotionPose> stations;
 };
 
 NarrowFloor BuildNarrowFloor();
+
+// `robots` robots, starts and goals drawn without repeats among the floor's stations (seeded).
+// kInvalidArgument for more robots than half the stations.
+Result<std::vector<MotionRobot>> NarrowFloorRobots(const NarrowFloor& floor, std::size_t robots, std::uint64_t seed);
 
 }  // namespace dispatch::engine

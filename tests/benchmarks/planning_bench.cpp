@@ -26,12 +26,18 @@
 //   narrow_plain_manhattan (eq. (5)'s h_o as plain |dx| + |dy| instead of through free cells).
 //   Target (issue 17 §2): narrow <= 50 ms median. Counters: nodes (expanded), length (m),
 //   rotation (rad turned in place), switches (drive-class changes), solved.
+//   BM_MotionConflictElimination/N: BIT2024 step 7 over those paths
+//   (engine/motion/motion_conflict_elimination.h): N robots between the narrow floor's
+//   stations, seeds 1-8, each with a 10 s budget; the time is all 8. Counters: solved (of 8),
+//   rounds (mean over the solved), makespan (mean last arrival, s, solved runs) beside
+//   alone_makespan (the same robots' paths planned alone, conflicts ignored: the lower bound).
 // Run from a Release build:
 //   cmake --build build-bench --target planning_bench && build-bench/tests/benchmarks/planning_bench
 #include <benchmark/benchmark.h>
 
 #include <algorithm>
 #include <chrono>
+#include <cstdint>
 #include <functional>
 #include <memory>
 #include <random>
@@ -41,6 +47,7 @@
 
 #include "engine/map/grid_floor.h"
 #include "engine/motion/hybrid_astar.h"
+#include "engine/motion/motion_conflict_elimination.h"
 #include "engine/motion/narrow_floor.h"
 #include "engine/planning/cbs.h"
 #include "engine/planning/conflict_elimination.h"
@@ -254,6 +261,44 @@ BENCHMARK_CAPTURE(BM_HybridAStar, narrow_baseline, HybridVariant::kBaseline)
     ->Unit(benchmark::kMillisecond)->Repetitions(5)->ReportAggregatesOnly(true);
 BENCHMARK_CAPTURE(BM_HybridAStar, narrow_plain_manhattan, HybridVariant::kPlainManhattan)
     ->Unit(benchmark::kMillisecond)->Iterations(1)->Repetitions(3)->ReportAggregatesOnly(true);
+
+void BM_MotionConflictElimination(benchmark::State& state) {
+  static const NarrowFloor floor = BuildNarrowFloor();
+  const auto n = static_cast<std::size_t>(state.range(0));
+  double solved = 0, rounds = 0, makespan = 0, alone = 0;
+  for (auto _ : state) {
+    solved = rounds = makespan = alone = 0;
+    for (std::uint64_t seed = 1; seed <= 8; ++seed) {
+      auto robots = NarrowFloorRobots(floor, n, seed);
+      if (!robots.ok()) throw std::runtime_error(robots.error().message);
+      MotionConflictEliminationOptions options;
+      options.seed = seed;
+      options.planner.min_turn_radius = floor.min_turn_radius;
+      options.limits.stop = DeadlineCheck(std::chrono::seconds(10));
+      auto fleet = EliminateMotionConflicts(floor.grid, *robots, options);
+      if (!fleet.ok()) continue;
+      solved += 1;
+      rounds += static_cast<double>(fleet->rounds);
+      double last = 0, last_alone = 0;
+      for (std::size_t i = 0; i < n; ++i) {
+        last = std::max(last, fleet->paths[i].arrival());
+        HybridAStarOptions alone_options = options.planner;
+        alone_options.limits = {};
+        auto path = PlanHybridAStar(FootprintChecker(floor.grid, floor.footprint), (*robots)[i].start,
+                                    (*robots)[i].goal, alone_options);
+        if (path.ok()) last_alone = std::max(last_alone, TimeMotionPath(*path, 0.0, options.timing).arrival());
+      }
+      makespan += last;
+      alone += last_alone;
+    }
+  }
+  state.counters["solved"] = solved;
+  state.counters["rounds"] = solved > 0 ? rounds / solved : 0;
+  state.counters["makespan"] = solved > 0 ? makespan / solved : 0;
+  state.counters["alone_makespan"] = solved > 0 ? alone / solved : 0;
+}
+
+BENCHMARK(BM_MotionConflictElimination)->Arg(2)->Arg(3)->Arg(4)->Unit(benchmark::kMillisecond)->Iterations(1);
 
 BENCHMARK(BM_IndependentPaths)->Arg(10)->Arg(50)->Arg(100)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_ConflictElimination)->Arg(10)->Arg(50)->Arg(100)->Unit(benchmark::kMillisecond)->Iterations(3);
