@@ -149,8 +149,11 @@ void Dispatcher::Loop() {
       const auto wall = Clock::now();
       if (at < clock_.At(wall) + tick_s * options_.time_scale) wake = std::min(wake, clock_.WallAt(at, wall));
     }
-    // A round waiting for the batch window starts when it ends.
-    if (rounds_due_.Waiting(Now())) wake = std::min(wake, clock_.WallAt(rounds_due_.not_before(), Clock::now()));
+    // A round waiting for the batch window starts when it ends (within the tick, so a long
+    // window never becomes a wall time out of the clock's range).
+    if (const double now = Now(); rounds_due_.Waiting(now) && rounds_due_.not_before() < now + tick_s * options_.time_scale) {
+      wake = std::min(wake, clock_.WallAt(rounds_due_.not_before(), Clock::now()));
+    }
     CommandQueue::Batch batch = queue_.Take(wake);
     for (auto& command : batch.commands) command();
     if (Clock::now() >= next_tick) {
