@@ -2,8 +2,8 @@
 # The sanitizer runs of the test command (issue 18 §5; deploy/test.sh runs this after the
 # suite):
 #  1. ASan + UBSan (build-asan/; the engine library at -O1, everything else at -O0, which
-#     compiles ~40% faster: the build is most of this run's time): every GoogleTest test and
-#     the fuzz corpus replays (every input ever kept or found by deploy/fuzz.sh), any report
+#     compiles ~40% faster: the build is most of this run's time): every GoogleTest test but
+#     six long simulations (below) and the fuzz corpus replays (every input ever kept or found by deploy/fuzz.sh), any report
 #     fatal;
 #  2. TSan (build-tsan/): the dispatch core's tests (tests/engine/dispatch) and the service's
 #     tests that do not serve gRPC (the dispatcher loop and its parts, its worker threads, the
@@ -41,7 +41,16 @@ for run in "${runs[@]}"; do
         targets+=("fuzz_${h}_replay")
       done
       cmake --build build-asan -j "$jobs" --target "${targets[@]}"
-      ctest --test-dir build-asan --output-on-failure -j "$jobs" -LE e2e
+      # Six long simulations (30-55 s each under ASan, 4 minutes of CPU in all) run in the plain
+      # build only; shorter runs of the same code (teams breaking up, restarts, zone lookups)
+      # stay here.
+      long='^(CoreStreamTest[.](ABrokenUpFormationHandsItsIntersectionGrantToItsMembers'
+      long+='|MembersOnTheirWayStayExemptFromEachOtherWhenTheirTeamBreaksUp'
+      long+='|MembersOfABrokenUpTeamStayExemptUntilAllHaveDrivenOff)'
+      long+='|TrafficGateTest[.]AFormationOrderCompletesWhateverMomentTheServerRestartsAt'
+      long+='|TrafficPredictionZoneAtTest[.]LorrScaleFloorIsFastAndExact'
+      long+='|CoreStreamFormationTest[.]RandomStreamsWithFormationsOnChu2024)$'
+      ctest --test-dir build-asan --output-on-failure -j "$jobs" -LE e2e -E "$long"
       ;;
     tsan)
       cmake -S . -B build-tsan $(generator build-tsan) "${flags[@]}" -DDISPATCH_SANITIZE=thread >/dev/null
