@@ -45,6 +45,11 @@ std::vector<Key> Keys() {
       MakeKey("zeta", &ServerConfig::zeta),
       MakeKey("planner", &ServerConfig::planner),
       MakeKey("turn_time", &ServerConfig::turn_time),
+      {"drop_time",  // a number, or null: the order's own t_w (the default)
+       [](const nlohmann::json& j, ServerConfig& c) {
+         c.drop_time = j.is_null() ? std::nullopt : std::optional<double>(j.get<double>());
+       },
+       [](const ServerConfig& c) { return c.drop_time ? nlohmann::json(*c.drop_time) : nlohmann::json(nullptr); }},
       MakeKey("routing", &ServerConfig::routing),
       MakeKey("heat_period", &ServerConfig::heat_period),
       MakeKey("alpha", &ServerConfig::alpha),
@@ -152,7 +157,8 @@ engine::Status ValidateServerConfig(const ServerConfig& c) {
   }
   if (!std::isfinite(c.heat_period) || c.heat_period <= 0) return InvalidArgument("heat_period must be > 0 seconds");
   if (!std::isfinite(c.batch_window) || c.batch_window < 0) return InvalidArgument("batch_window must be >= 0 seconds");
-  for (auto [name, v] : {std::pair{"zeta", c.zeta}, {"alpha", c.alpha}, {"beta", c.beta}, {"turn_time", c.turn_time}}) {
+  for (auto [name, v] : {std::pair{"zeta", c.zeta}, {"alpha", c.alpha}, {"beta", c.beta}, {"turn_time", c.turn_time},
+                         {"drop_time", c.drop_time.value_or(0.0)}}) {
     if (!std::isfinite(v) || v < 0) return InvalidArgument(std::string(name) + " must be finite and >= 0");
   }
   auto positive = [](double v) { return std::isfinite(v) && v > 0; };
@@ -203,6 +209,9 @@ engine::Result<ParsedCommandLine> ParseCommandLine(int argc, char** argv) {
       ->capture_default_str();
   app.add_option("--turn-time", flags.turn_time, "Turning time per 90 degrees, s (plans, route costs)")
       ->capture_default_str();
+  app.add_option("--drop-time", flags.drop_time,
+                 "Seconds a robot works at an order's drop (default: the order's t_w; 0: the seed's "
+                 "model, Chu2024 eq. 3 counts the picks only)");
   app.add_option("--priority", flags.priority, "Traffic priority within a class: index | release (Wang2019)")
       ->capture_default_str();
   app.add_option("--head-on-priority", flags.head_on_priority,

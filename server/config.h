@@ -3,6 +3,7 @@
 // ValidateServerConfig. Thread-safe to share once built.
 #pragma once
 
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -37,6 +38,10 @@ struct ServerConfig {
   // ETAs, route costs and the time-window planner (AllocationConfig::turn_time).
   std::string planner = "rules";
   double turn_time = 0.0;
+  // Seconds a robot works at an order's drop (AllocationConfig::drop_time): unset (default)
+  // = the order's own t_w, as at a pick; 0 = the seed's model (Chu2024 eq. (3) counts the
+  // picks only).
+  std::optional<double> drop_time;
   // The rules planner's routes (AllocationConfig::routing): floyd | heat (Wang2019 path heat,
   // lanes' use counted over heat_period seconds).
   std::string routing = "floyd";

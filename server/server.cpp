@@ -154,6 +154,7 @@ engine::Result<std::unique_ptr<DispatchServer>> DispatchServer::Start(const Serv
   allocation.formation_max_queue = static_cast<std::size_t>(config.formation_max_queue);
   allocation.planner = engine::ParsePlanner(config.planner).value_or(engine::PlannerKind::kRules);
   allocation.turn_time = config.turn_time;
+  allocation.drop_time = config.drop_time;
   allocation.routing = engine::ParseRouting(config.routing).value_or(engine::RoutingKind::kFloyd);
   allocation.heat_period = config.heat_period;
   engine::RouteTableOptions route_options;

@@ -132,6 +132,7 @@ Result<std::string> EncodeRunSetup(const RunSetup& s) {
                        {"max_queue", a.max_queue},
                        {"formation_max_queue", a.formation_max_queue},
                        {"work_time_override", a.work_time_override ? json(*a.work_time_override) : json(nullptr)},
+                       {"drop_time", a.drop_time ? json(*a.drop_time) : json(nullptr)},
                        {"bucket_seconds", a.traffic.bucket_seconds},
                        {"origin_time", a.traffic.origin_time},
                        {"zone_cell_size", a.traffic.zone_cell_size},
@@ -201,6 +202,9 @@ Result<RunSetup> DecodeRunSetup(const std::string& text) {
     c.windows.body_length = a.value("windows_body_length", c.windows.body_length);
     c.windows.headway_s = a.value("windows_headway_s", c.windows.headway_s);
     c.turn_time = a.value("turn_time", 0.0);
+    // Journals before drop_time worked each order's t_w at its drop (null, or no key).
+    c.drop_time.reset();
+    if (a.contains("drop_time") && !a.at("drop_time").is_null()) c.drop_time = a.at("drop_time").get<double>();
     const std::string routing = a.value("routing", std::string("floyd"));
     const auto route_kind = engine::ParseRouting(routing);
     if (!route_kind) return Corrupt("run setup", "unknown routing " + routing);

@@ -38,6 +38,9 @@ Status ValidateAllocationConfig(const AllocationConfig& config) {
       return s;
     }
   }
+  if (config.drop_time) {
+    if (Status s = non_negative("drop_time", *config.drop_time); !s.ok()) return s;
+  }
   return Ok{};
 }
 

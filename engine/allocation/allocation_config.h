@@ -73,6 +73,11 @@ struct AllocationConfig {
   double hold_seconds = 300.0;  // predicted stay at a plan's end, seconds; >= 0
   std::size_t price_every_bid_up_to = 64;  // robots; larger fleets skip bids that cannot win
   std::optional<double> work_time_override;  // t_w for every order, seconds; unset = per order
+  // Seconds a robot works at an order's drop. Unset (default): the order's t_w (or the
+  // override), as at a pick: a drop takes as long as a pick. 0: the seed's model, where eq.
+  // (3)'s n_c counts the pick points only and nothing is worked at the drop
+  // (engine/fleet/plan.h says why).
+  std::optional<double> drop_time;
   // Orders a robot may hold (its current one included) and still bid for another; 0 = no
   // limit (the paper's auction: every order is awarded at once, queues grow without bound).
   std::size_t max_queue = 0;

@@ -79,6 +79,7 @@ PlanTask FleetState::TaskOf(const std::vector<PointId>& picks, PointId drop,
   task.picks = picks;
   task.drop = drop;
   task.work_time = config_.work_time_override.value_or(order_work_time);
+  task.drop_time = config_.drop_time.value_or(task.work_time);
   return task;
 }
 

@@ -99,17 +99,18 @@ double RouteSampler::AppendTask(const PlanTask& task, double arrival,
   if (task.picks.empty()) return kInf;
   double t = arrival;
   PointId at = task.picks.front();
-  auto stop = [&](PointId p) {
+  auto stop = [&](PointId p, double work) {
     out.push_back({map_->point(p).position, t});
-    t += task.work_time;
+    t += work;
     at = p;
   };
-  stop(at);
+  stop(at, task.work_time);
   for (std::size_t k = 1; k <= task.picks.size(); ++k) {
-    const PointId next = k < task.picks.size() ? task.picks[k] : task.drop;
+    const bool drop = k == task.picks.size();
+    const PointId next = drop ? task.drop : task.picks[k];
     t = AppendLeg(at, next, t, out);
     if (t == kInf) return kInf;
-    stop(next);
+    stop(next, drop ? task.drop_time : task.work_time);
   }
   return t;
 }

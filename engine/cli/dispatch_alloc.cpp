@@ -9,6 +9,7 @@
 #include <iostream>
 #include <map>
 #include <memory>
+#include <optional>
 #include <string>
 
 #include "engine/cli/scenario.h"
@@ -114,6 +115,9 @@ int Main(int argc, char** argv) {
       ->check(CLI::PositiveNumber);
   app.add_option("--robots", robot_count, "Robots R1..Rn in stations P1..Pn (0 = one each)")
       ->capture_default_str();
+  app.add_option("--drop-time", config.drop_time,
+                 "Seconds worked at a drop (default: the order's t_w; 0: the seed's model, eq. 3)")
+      ->check(CLI::NonNegativeNumber);
   app.add_option("--explain", explain, "Task whose bids to print (default: the last formation task)");
   CLI11_PARSE(app, argc, argv);
 

@@ -37,6 +37,7 @@
 #include <fstream>
 #include <iostream>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -87,6 +88,7 @@ void Print(const char* label, const SimResult& r, const SafetyReport& safety) {
 struct PlanArgs {
   std::string table, rules = "both", csv;
   double zeta = 100.0;
+  std::optional<double> drop_time;  // AllocationConfig::drop_time (unset: the order's t_w)
   SimConfig sim;
 };
 
@@ -110,6 +112,7 @@ int RunPlan(const PlanArgs& args) {
   if (!routes.ok()) return Fail(routes.error().message);
   std::shared_ptr<const RouteTable> shared_routes = std::move(routes).value();
   config.zeta = zeta;
+  config.drop_time = args.drop_time;
   auto state = FleetState::Create(map, shared_routes, *robots, config);
   if (!state.ok()) return Fail(state.error().message);
   AuctionAllocator auction;
@@ -191,6 +194,9 @@ int Main(int argc, char** argv) {
   p->add_option("--rules", plan.rules, "Traffic rules: on, off or both")->capture_default_str()
       ->check(CLI::IsMember({"on", "off", "both"}));
   p->add_option("--csv", plan.csv, "Write t,min_distance_off,min_distance_on here");
+  p->add_option("--drop-time", plan.drop_time,
+                "Seconds worked at a drop (default: the order's t_w; 0: the seed's model, eq. 3)")
+      ->check(CLI::NonNegativeNumber);
   p->add_option("--dt", plan.sim.time_step, "Time step, s")->capture_default_str()
       ->check(CLI::PositiveNumber);
   StreamArgs stream, compare;

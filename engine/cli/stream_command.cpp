@@ -102,6 +102,7 @@ StreamConfig ConfigOf(const StreamArgs& a, const std::string& strategy, double z
   c.allocation.formation_max_queue = a.formation_max_queue;
   c.allocation.planner = ParsePlanner(a.planner).value_or(PlannerKind::kRules);
   c.allocation.turn_time = a.turn_s;
+  c.allocation.drop_time = a.drop_s;
   c.allocation.routing = ParseRouting(a.routing).value_or(RoutingKind::kFloyd);
   c.allocation.heat_period = a.heat_period;
   c.traffic.priority_by_release = a.priority == "release";
@@ -298,6 +299,10 @@ StreamCommands AddStreamCommands(CLI::App& app, StreamArgs& stream_args, StreamA
         ->capture_default_str();
     c->add_option("--turn-time", a.turn_s, "Turning time per 90 degrees, s (plans, route costs, robots)")
         ->capture_default_str()->check(CLI::NonNegativeNumber);
+    c->add_option("--drop-time", a.drop_s,
+                  "Seconds a robot works at a drop (default: the order's t_w; 0: the seed's model, "
+                  "Chu2024 eq. 3 counts the picks only)")
+        ->check(CLI::NonNegativeNumber);
     c->add_option("--routing", a.routing, "Routes of the rules planner: floyd (shortest) or heat (Wang2019)")
         ->capture_default_str();
     c->add_option("--priority", a.priority, "Traffic priority within a class: index or release (Wang2019)")

@@ -7,6 +7,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <limits>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -32,6 +33,7 @@ struct StreamArgs {
   std::string routing = "floyd";           // AllocationConfig::routing
   std::vector<std::string> routings;       // compare: one column per routing (x planner)
   double turn_s = 0.0;                     // turning time per 90 degrees (AllocationConfig::turn_time)
+  std::optional<double> drop_s;            // work at a drop (AllocationConfig::drop_time)
   double heat_period = 60.0;               // path heat: δ, s
   std::string priority = "index";          // TrafficControllerConfig::priority_by_release
   bool head_on_priority = false;           // TrafficControllerConfig::head_on_priority

@@ -142,9 +142,11 @@ double Plan::end_time() const {
   return waypoints.back().departure();
 }
 
-int TaskPointCount(const PlanTask& task) { return static_cast<int>(task.picks.size()) + 1; }
+int TaskPointCount(const PlanTask& task) { return static_cast<int>(task.picks.size()); }
 
-double TaskWorkTime(const PlanTask& task) { return TaskPointCount(task) * task.work_time; }
+double TaskWorkTime(const PlanTask& task) {
+  return TaskPointCount(task) * task.work_time + task.drop_time;
+}
 
 Result<Plan> BuildPlan(const WarehouseMap& map, const RouteTable& routes, PointId start,
                        double start_time, double speed, const std::vector<PlanTask>& tasks,
@@ -158,6 +160,10 @@ Result<Plan> BuildPlan(const WarehouseMap& map, const RouteTable& routes, PointI
     if (!std::isfinite(task.work_time) || task.work_time < 0.0) {
       return InvalidArgument(what + "work time must be >= 0 s, got " +
                              std::to_string(task.work_time));
+    }
+    if (!std::isfinite(task.drop_time) || task.drop_time < 0.0) {
+      return InvalidArgument(what + "drop time must be >= 0 s, got " +
+                             std::to_string(task.drop_time));
     }
     for (PointId p : task.picks) {
       if (!ValidPoint(map, p)) return NotFound(what + "unknown pick point id " + std::to_string(p));
@@ -177,7 +183,7 @@ Result<Plan> BuildPlan(const WarehouseMap& map, const RouteTable& routes, PointI
                      what + ", pick " + std::to_string(i + 1) + ": " + s.error().message};
       }
     }
-    if (Status s = driver.Visit(task.drop, WaypointAction::kDrop, task.work_time); !s.ok()) {
+    if (Status s = driver.Visit(task.drop, WaypointAction::kDrop, task.drop_time); !s.ok()) {
       return Error{s.error().code, what + ", drop: " + s.error().message};
     }
   }

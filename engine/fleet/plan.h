@@ -7,9 +7,11 @@
 // dwell 0. Between the departure from one waypoint and the arrival at the next the robot
 // moves in a straight line at constant speed.
 //
-// Work time counting (Chu2024 eq. (3): T_w = n_c * t_w): the paper's task points ("任务点")
-// are an order's pick points AND its target (drop) point, so a task with k picks has
-// n_c = k + 1 and the robot works t_w at every pick and again at the drop.
+// Work time counting (Chu2024 eq. (3): T_w = n_c * t_w): n_c counts the paper's task points
+// ("任务点"), which §4.2 defines as an order's pick points ("任务点为订单取货地点"); the drop is
+// its target point ("目标点"), where §2.2 has the robot drive, not work. So a task with k picks
+// has n_c = k and the robot works t_w at every pick. At the drop it works the task's own
+// `drop_time` (0 in the seed's model; AllocationConfig::drop_time sets it for the product).
 //
 // Invariants of a Plan from BuildPlan: waypoints non-empty, seq = 0, 1, 2, ...; etas
 // non-decreasing; eta[i+1] >= eta[i] + dwell[i]. Plain values; safe to share once built.
@@ -66,16 +68,18 @@ struct Plan {
   double end_time() const;    // last departure (precondition as above)
 };
 
-// One task for one robot: visit the picks in order, then the drop; t_w at each (see above).
+// One task for one robot: visit the picks in order, t_w at each, then the drop, drop_time
+// there (see above).
 struct PlanTask {
   std::vector<PointId> picks;
   PointId drop = kNoPoint;
-  double work_time = 0.0;  // t_w, seconds, >= 0
+  double work_time = 0.0;  // t_w, seconds at each pick, >= 0
+  double drop_time = 0.0;  // seconds at the drop, >= 0
 };
 
-// n_c of one task: picks + the drop (Chu2024 eq. (3)).
+// n_c of one task: its picks (Chu2024 eq. (3)).
 int TaskPointCount(const PlanTask& task);
-// T_w of one task: n_c * t_w (Chu2024 eq. (3)).
+// T_w of one task: n_c * t_w (Chu2024 eq. (3)) + its drop_time.
 double TaskWorkTime(const PlanTask& task);
 
 // Builds the plan of one robot at `start` at `start_time` serving `tasks` in order at speed

@@ -20,7 +20,7 @@ TEST(ServerConfigTest, FlagsSetTheConfig) {
   auto parsed = Parse({"--grpc-port", "0", "--http-port", "8081", "--db", "x.db", "--map", "chu2024",
                        "--strategy", "exact", "--batch-window", "2.5", "--zeta", "0", "--alpha", "0.3", "--beta", "0.7",
                        "--time-scale", "10", "--bind", "127.0.0.1", "--ports-file", "p.json",
-                       "--planner", "time-windows", "--turn-time", "1.5", "--routing", "heat",
+                       "--planner", "time-windows", "--turn-time", "1.5", "--drop-time", "0", "--routing", "heat",
                        "--heat-period", "30", "--priority", "release", "--formation-max-queue", "0",
                        "--one-formation-per-pick", "false", "--head-on-priority", "true", "--head-on-give-way", "true"});
   ASSERT_TRUE(parsed.ok()) << parsed.error().message;
@@ -40,6 +40,7 @@ TEST(ServerConfigTest, FlagsSetTheConfig) {
   EXPECT_EQ(c.ports_file, "p.json");
   EXPECT_EQ(c.planner, "time-windows");
   EXPECT_DOUBLE_EQ(c.turn_time, 1.5);
+  EXPECT_EQ(c.drop_time, 0.0);
   EXPECT_EQ(c.routing, "heat");
   EXPECT_DOUBLE_EQ(c.heat_period, 30.0);
   EXPECT_EQ(c.priority, "release");
@@ -50,13 +51,16 @@ TEST(ServerConfigTest, FlagsSetTheConfig) {
 TEST(ServerConfigTest, FileKeysApplyAndFlagsWin) {
   TempDir dir;
   const std::string file = dir.File("dispatchd.json");
-  std::ofstream(file) << R"({"grpc_port": 7000, "http_port": 7001, "db": "file.db", "zeta": 50})";
+  std::ofstream(file) << R"({"grpc_port": 7000, "http_port": 7001, "db": "file.db", "zeta": 50, "drop_time": 2.5})";
   auto parsed = Parse({"--config", file, "--http-port", "9000"});
   ASSERT_TRUE(parsed.ok()) << parsed.error().message;
   EXPECT_EQ(parsed->config.grpc_port, 7000);
   EXPECT_EQ(parsed->config.http_port, 9000);
   EXPECT_EQ(parsed->config.db, "file.db");
   EXPECT_DOUBLE_EQ(parsed->config.zeta, 50.0);
+  EXPECT_EQ(parsed->config.drop_time, 2.5);
+  EXPECT_FALSE(Parse({}).value().config.drop_time.has_value()) << "by default the order's t_w";
+  EXPECT_EQ(Parse({"--config", file, "--drop-time", "1"}).value().config.drop_time, 1.0);
   EXPECT_EQ(parsed->config.strategy, "auction");
   EXPECT_DOUBLE_EQ(parsed->config.batch_window, 0.0);
   EXPECT_EQ(parsed->config.planner, "rules");
@@ -75,6 +79,9 @@ TEST(ServerConfigTest, BadValuesAreNamed) {
   auto strategy = Parse({"--strategy", "random"});
   ASSERT_FALSE(strategy.ok());
   EXPECT_NE(strategy.error().message.find("random"), std::string::npos);
+  auto drop = Parse({"--drop-time", "-1"});
+  ASSERT_FALSE(drop.ok());
+  EXPECT_NE(drop.error().message.find("drop_time must be finite and >= 0"), std::string::npos) << drop.error().message;
   auto planner = Parse({"--planner", "cbs"});
   ASSERT_FALSE(planner.ok());
   EXPECT_NE(planner.error().message.find("planner must be one of rules, time-windows, conflict-elimination, got 'cbs'"), std::string::npos);

@@ -296,6 +296,7 @@ TEST(JournalStoreTest, ARunSetupRoundTrips) {
   s.allocation.work_time_override = 7.5;
   s.allocation.planner = engine::PlannerKind::kTimeWindows;
   s.allocation.turn_time = 1.5;
+  s.allocation.drop_time = 0.0;
   s.allocation.routing = engine::RoutingKind::kHeat;
   s.allocation.heat_period = 30.0;
   s.allocation.formation_max_queue = 2;
@@ -317,6 +318,7 @@ TEST(JournalStoreTest, ARunSetupRoundTrips) {
   EXPECT_EQ(back->allocation.work_time_override, 7.5);
   EXPECT_EQ(back->allocation.planner, engine::PlannerKind::kTimeWindows);
   EXPECT_EQ(back->allocation.turn_time, 1.5);
+  EXPECT_EQ(back->allocation.drop_time, 0.0);
   EXPECT_EQ(back->allocation.routing, engine::RoutingKind::kHeat);
   EXPECT_EQ(back->allocation.heat_period, 30.0);
   EXPECT_EQ(back->allocation.formation_max_queue, 2u);
@@ -340,6 +342,9 @@ TEST(JournalStoreTest, ARunSetupRoundTrips) {
   ASSERT_TRUE(before.ok()) << before.error().message;
   EXPECT_EQ(before->allocation.planner, engine::PlannerKind::kRules);
   EXPECT_EQ(before->allocation.routing, engine::RoutingKind::kFloyd);
+  // ... and worked each order's t_w at its drop.
+  old["allocation"].erase("drop_time");
+  EXPECT_FALSE(DecodeRunSetup(old.dump()).value().allocation.drop_time.has_value());
   // ... and had no limit on a formation member's queue.
   old["allocation"].erase("formation_max_queue");
   EXPECT_EQ(DecodeRunSetup(old.dump()).value().allocation.formation_max_queue, 0u);

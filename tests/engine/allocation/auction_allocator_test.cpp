@@ -92,7 +92,7 @@ TEST_F(AuctionGridTest, BidsEqualTheFormulaAndTheQueueTotals) {
       // eq. (3) over the whole queue: T_d from table costs, T_w = n_c t_w.
       EXPECT_NEAR(bids[i].t_d, q.travel_time + routes_->Cost(q.end_point, o.picks[0]) +
                                    s.TaskTravelTime(*task), 1e-9);
-      EXPECT_NEAR(bids[i].t_w, q.work_time + (o.picks.size() + 1) * o.work_time, 1e-9);
+      EXPECT_NEAR(bids[i].t_w, q.work_time + o.picks.size() * o.work_time + c.drop_time.value_or(o.work_time), 1e-9);
       EXPECT_GE(bids[i].flow, 0.0);
     }
     Result<AwardExplanation> award = auction.Allocate(o, s);
@@ -137,7 +137,7 @@ TEST_F(AuctionGridTest, AQueuedRobotBidsForItsWholeQueue) {
   ASSERT_TRUE(a2.ok());
   EXPECT_DOUBLE_EQ(a2->bids[0].ready_time, end1);
   EXPECT_DOUBLE_EQ(a2->bids[0].t_d, td1 + 2.0 + 7.0);  // 0,7 -> 1,6 -> 7,7
-  EXPECT_DOUBLE_EQ(a2->bids[0].t_w, 4 * kDefaultWorkTime);
+  EXPECT_DOUBLE_EQ(a2->bids[0].t_w, 4 * kDefaultWorkTime);  // two picks and two drops (t_w each)
   ASSERT_EQ(s.queue(0).size(), 2u);
   EXPECT_DOUBLE_EQ(s.queue(0)[1].start_time, end1);
 }

@@ -26,8 +26,8 @@ class FleetStateTest : public ::testing::Test {
     map_ = Grid(6, 4, 1.0, 3, {{2, 0}, {4, 3}, {5, 0}}, {{0, 3}, {5, 3}});
     routes_ = Routes(map_);
   }
-  PlanTask Task(const char* pick, const char* drop, double tw = 2.0) {
-    return PlanTask{{Pt(*map_, pick)}, Pt(*map_, drop), tw};
+  PlanTask Task(const char* pick, const char* drop, double tw = 2.0) {  // t_w at the drop too
+    return PlanTask{{Pt(*map_, pick)}, Pt(*map_, drop), tw, tw};
   }
   std::shared_ptr<const WarehouseMap> map_;
   std::shared_ptr<const RouteTable> routes_;
@@ -230,6 +230,27 @@ TEST_F(FleetStateTest, FormationMembersStartAfterTheirOwnQueues) {
   // T_d of a member: its leg to the first pick + the centre's route pick -> drop (6 m).
   EXPECT_DOUBLE_EQ(s.summary(0).travel_time, 2.0 + 6.0);
   EXPECT_DOUBLE_EQ(s.summary(2).travel_time, 5.0 + 6.0);
+}
+
+// Chu2024 eq. (3)'s n_c counts the picks only; the drop's work is drop_time: by default the
+// order's t_w (or the override), as at a pick; 0 is the seed's model.
+TEST_F(FleetStateTest, TaskOfWorksAtTheDropAsConfigured) {
+  AllocationConfig c;
+  const auto task_of = [&](const AllocationConfig& config) {
+    return MakeFleet(map_, routes_, {{"A", Pt(*map_, "0,0"), 0.0}}, config)
+        .TaskOf({Pt(*map_, "2,0"), Pt(*map_, "4,0")}, Pt(*map_, "0,3"), 4.0);
+  };
+  PlanTask t = task_of(c);
+  EXPECT_EQ(t.work_time, 4.0);
+  EXPECT_EQ(t.drop_time, 4.0);
+  EXPECT_EQ(TaskPointCount(t), 2);
+  EXPECT_DOUBLE_EQ(TaskWorkTime(t), 12.0);
+  c.work_time_override = 3.0;
+  EXPECT_DOUBLE_EQ(TaskWorkTime(task_of(c)), 9.0);
+  c.drop_time = 0.0;
+  EXPECT_DOUBLE_EQ(TaskWorkTime(task_of(c)), 6.0);
+  c.drop_time = 1.5;
+  EXPECT_DOUBLE_EQ(TaskWorkTime(task_of(c)), 7.5);
 }
 
 TEST_F(FleetStateTest, FailedAssignChangesNothing) {

@@ -18,7 +18,8 @@ using testing_util::Pt;
 using testing_util::Routes;
 
 // Independent model of the batch cost: each robot's final queue timed by BuildPlan; with no
-// waiting, T_t = plan duration, T_w = sum n_c t_w, T_d = T_t - T_w (Chu2024 eqs. (1)-(3)).
+// waiting, T_t = plan duration, T_w = sum n_c t_w plus the drops' work, T_d = T_t - T_w
+// (Chu2024 eqs. (1)-(3); n_c counts the picks).
 double ModelCost(const FleetState& s, const std::vector<Order>& orders,
                  const std::vector<std::size_t>& map, const AllocationConfig& c) {
   double total = 0.0;
@@ -27,8 +28,9 @@ double ModelCost(const FleetState& s, const std::vector<Order>& orders,
     double work = 0.0;
     for (std::size_t k = 0; k < orders.size(); ++k) {
       if (map[k] != r) continue;
-      tasks.push_back({orders[k].picks, orders[k].drop, orders[k].work_time});
-      work += (orders[k].picks.size() + 1) * orders[k].work_time;
+      const double drop = c.drop_time.value_or(orders[k].work_time);
+      tasks.push_back({orders[k].picks, orders[k].drop, orders[k].work_time, drop});
+      work += orders[k].picks.size() * orders[k].work_time + drop;
     }
     Result<Plan> plan = BuildPlan(s.map(), s.routes(), s.robot(r).start, 0.0, c.speed, tasks);
     if (!plan.ok()) return INFINITY;
@@ -53,6 +55,8 @@ TEST(OptimalAssignmentTest, RandomTinyInstances) {
     c.zeta = 0.0;
     c.alpha = 0.5;
     c.beta = 0.5;
+    // Work at the drop: the order's t_w (default), the seed's none, or its own.
+    if (seed % 3 != 0) c.drop_time = seed % 3 == 1 ? 0.0 : 1.5;
     std::vector<FleetRobot> robots;
     for (int i = 0; i < m; ++i) {
       robots.push_back({"R" + std::to_string(i), static_cast<PointId>(rng() % map->point_count()), 0.0});

@@ -93,8 +93,8 @@ class LFormationTest : public ::testing::Test {
 };
 
 TEST_F(LFormationTest, RendezvousWaitsForTheSlowestThenMovesRigidly) {
-  const double v = 2.0, t_w = 3.0, t0 = 5.0;
-  const PlanTask task{{Id("A")}, Id("C"), t_w};
+  const double v = 2.0, t_w = 3.0, t_drop = 1.5, t0 = 5.0;
+  const PlanTask task{{Id("A")}, Id("C"), t_w, t_drop};
   const Result<FormationPlans> f =
       BuildFormationPlans(*map_, *routes_, {Id("M1"), Id("M2"), Id("M3")}, t0, v, task);
   ASSERT_TRUE(f.ok()) << f.error().message;
@@ -127,12 +127,12 @@ TEST_F(LFormationTest, RendezvousWaitsForTheSlowestThenMovesRigidly) {
     EXPECT_TRUE((Eigen::Rotation2Dd(std::numbers::pi / 2) * east[i]).isApprox(north[i]));
   }
   EXPECT_TRUE(f->members[0].waypoints.back().xy.isApprox(Eigen::Vector2d(10, 10 + d_f)));
-  // Work at A, 10 m east, rotation at B (D_f * pi/2 at v), 10 m north, work at C.
+  // Work at A, 10 m east, rotation at B (D_f * pi/2 at v), 10 m north, the drop's work at C.
   const double rotation = d_f * std::numbers::pi / 2 / v;
   ASSERT_EQ(c.waypoints.back().action, WaypointAction::kDrop);
   EXPECT_NEAR(c.waypoints.back().eta,
               f->rendezvous_time + t_w + 10.0 / v + rotation + 10.0 / v, kTol);
-  EXPECT_NEAR(c.end_time(), f->rendezvous_time + 2 * t_w + 20.0 / v + rotation, kTol);
+  EXPECT_NEAR(c.end_time(), f->rendezvous_time + t_w + 20.0 / v + rotation + t_drop, kTol);
   // The rotation at B happens in place: the centre holds B while the members turn.
   int turns = 0;
   for (std::size_t k = 1; k < c.waypoints.size(); ++k) {

@@ -38,7 +38,7 @@ TEST_F(PlanTest, StopEtasAreRouteLengthOverSpeedPlusWorkTimes) {
   // Seed table 1, tasks 4 and 5, for one robot.
   const std::vector<PlanTask> tasks = {
       {{Pick(29, 13), Pick(30.5, 13), Pick(29, 10.5)}, Drop(32.25, 5), 5.0},
-      {{Pick(10.5, 13), Pick(10.5, 9)}, Drop(11.5, 2.75), 3.0}};
+      {{Pick(10.5, 13), Pick(10.5, 9)}, Drop(11.5, 2.75), 3.0, 2.0}};
   const double v = 1.5, t0 = 100.0;
   const Result<Plan> plan = BuildPlan(*map_, *routes_, start, t0, v, tasks);
   ASSERT_TRUE(plan.ok()) << plan.error().message;
@@ -50,7 +50,10 @@ TEST_F(PlanTest, StopEtasAreRouteLengthOverSpeedPlusWorkTimes) {
     stops.emplace_back(task.drop, WaypointAction::kDrop);
   }
   std::vector<double> work;
-  for (const PlanTask& task : tasks) work.insert(work.end(), task.picks.size() + 1, task.work_time);
+  for (const PlanTask& task : tasks) {
+    work.insert(work.end(), task.picks.size(), task.work_time);
+    work.push_back(task.drop_time);
+  }
 
   double expected = t0;
   PointId at = start;
@@ -71,9 +74,9 @@ TEST_F(PlanTest, StopEtasAreRouteLengthOverSpeedPlusWorkTimes) {
   }
   EXPECT_EQ(next, w.size());
   EXPECT_NEAR(plan->end_time(), expected, 1e-9);
-  // Eq. (3): T_w = n_c * t_w with n_c = picks + drop.
-  EXPECT_EQ(TaskPointCount(tasks[0]), 4);
-  EXPECT_DOUBLE_EQ(TaskWorkTime(tasks[0]) + TaskWorkTime(tasks[1]), 4 * 5.0 + 3 * 3.0);
+  // Eq. (3): T_w = n_c * t_w with n_c = the picks (the seed's task points), plus the drop time.
+  EXPECT_EQ(TaskPointCount(tasks[0]), 3);
+  EXPECT_DOUBLE_EQ(TaskWorkTime(tasks[0]) + TaskWorkTime(tasks[1]), 3 * 5.0 + 2 * 3.0 + 2.0);
 }
 
 TEST_F(PlanTest, EveryRoutePointIsAWaypointJoinedByArcs) {
@@ -117,6 +120,12 @@ TEST_F(PlanTest, RejectsBadInput) {
                 .error()
                 .code,
             ErrorCode::kInvalidArgument);
+  for (double drop_time : {-1.0, std::nan("")}) {
+    const Result<Plan> bad = BuildPlan(*map_, *routes_, start, 0, 1.0, {{{Pick(19, 17)}, Drop(6.5, 2.75), 1.0, drop_time}});
+    ASSERT_FALSE(bad.ok());
+    EXPECT_EQ(bad.error().code, ErrorCode::kInvalidArgument);
+    EXPECT_NE(bad.error().message.find("drop time"), std::string::npos) << bad.error().message;
+  }
   EXPECT_EQ(BuildPlan(*map_, *routes_, 100000, 0, 1.0, {good}).error().code, ErrorCode::kNotFound);
   EXPECT_EQ(BuildPlan(*map_, *routes_, start, 0, 1.0, {{{Pick(19, 17)}, 100000, 1.0}}).error().code,
             ErrorCode::kNotFound);

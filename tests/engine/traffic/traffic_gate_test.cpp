@@ -73,6 +73,7 @@ class TrafficGateTest : public ::testing::Test {
     for (const auto& p : picks) task.picks.push_back(P(p));
     task.drop = P(drop);
     task.work_time = 2.0;
+    task.drop_time = 2.0;
     auto built = BuildPlan(*map_, *routes_, P(start), 0.0, 1.0, {task});
     ASSERT_TRUE(built.ok()) << built.error().message;
     std::vector<Waypoint> plan = built->waypoints;
