@@ -3,7 +3,7 @@
 // Every robot bids for the order appended to its queue:
 //   T_d = (queue travel time) + (leg from the queue's end to the first pick) + (the order's
 //         own route pick -> ... -> drop), all from the route table's Floyd costs (= S_d / v);
-//   T_w = n_c * t_w over the whole queue and the order (n_c = picks + drop, eq. (3));
+//   T_w = n_c * t_w + drop time over the whole queue and the order (n_c = picks, eq. (3));
 //   T_t = T_d + T_w (eq. (2));  F = sum_p N_p,max / S_p over the order's candidate route,
 //   sampled every h metres (RouteSampler) at the times the robot would be there, counting
 //   the other robots' predicted positions (eqs. (6)-(8));  B = alpha T_t + beta T_d + zeta F

@@ -25,7 +25,7 @@ struct Bid {
   bool queue_full = false;  // not bidding: its queue is full (AllocationConfig::max_queue); reachable = false
   bool priced = true;  // F_i evaluated; false: flow, x and bid are lower bounds
   double t_d = 0.0;   // T_d,i: travel time of the whole queue + this order, s (eq. (3))
-  double t_w = 0.0;   // T_w,i: work time n_c * t_w of the whole queue + this order, s (eq. (3))
+  double t_w = 0.0;   // T_w,i: work time n_c * t_w + drop times of the whole queue + this order, s (eq. (3))
   double t_t = 0.0;   // T_t,i = T_d,i + T_w,i (eq. (2))
   double flow = 0.0;  // F_i (eq. (8))
   double x = 0.0;     // x_i = zeta * F_i (eq. (5))

@@ -5,7 +5,7 @@
 // and ready time, the queue of awarded tasks, its timed Plan (SPEC §3.4) and a summary of the
 // queue for O(1) bids: where and when the queue ends, and its accumulated travel time T_d
 // (sum of route-table costs between consecutive stops, i.e. Floyd distances / v) and work
-// time T_w (n_c * t_w per task, Chu2024 eq. (3)). The TrafficPredictor holds every robot's
+// time T_w (n_c * t_w + drop time per task, Chu2024 eq. (3)). The TrafficPredictor holds every robot's
 // current plan followed by a wait of AllocationConfig::hold_seconds where it ends (so idle,
 // parked and finished robots still count; an idle robot's plan is its start waypoint).
 //

@@ -15,7 +15,7 @@ struct BatchTask {
   PointId first = kNoPoint;
   PointId drop = kNoPoint;
   double travel = 0.0;  // pick -> ... -> drop
-  double work = 0.0;    // n_c * t_w
+  double work = 0.0;    // n_c * t_w + drop times
 };
 
 Result<std::vector<BatchTask>> Prepare(const FleetState& state, const std::vector<Order>& orders) {

@@ -263,7 +263,8 @@ TEST_F(OrderFlowTest, EveryConnectedRobotBidsAndTheLowestBidWins) {
   EXPECT_EQ(assigned_b->robot_ids(0), best.robot_id());
   EXPECT_TRUE(best.winner());
   // R1's bid counts the order already in its queue (Chu2024 eq. 3: n_c over the whole
-  // queue, t_w = 5 s per pick and drop): 4 task points against R2's 2.
+  // queue, t_w = 5 s per pick, and by default t_w at each drop too): 2 picks and 2 drops
+  // against R2's 1 and 1.
   EXPECT_DOUBLE_EQ(why.bids(0).work_time(), 20.0);
   EXPECT_DOUBLE_EQ(why.bids(1).work_time(), 10.0);
 }
