@@ -155,7 +155,10 @@ bool RoundRunner::ReplayQueue(FleetState& fleet, std::size_t index, const RoundR
     std::vector<Waypoint> segment;
     segment.reserve(stop - std::min(begin, stop) + 1);
     const PointId from = fleet.summary(index).end_point;
-    segment.push_back({0, from, map_->point(from).position, 0.0, WaypointAction::kMove, 0.0});
+    Waypoint anchor;  // a move at the queue's end point, at time 0 (seq 0)
+    anchor.point = from;
+    anchor.xy = map_->point(from).position;
+    segment.push_back(anchor);
     for (std::size_t w = begin; w < stop; ++w) {
       Waypoint wp = stored[w];
       if (k == 0 && static_cast<std::uint64_t>(wp.seq) <= r.last_reached) continue;

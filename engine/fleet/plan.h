@@ -29,6 +29,7 @@
 
 #include "engine/common/result.h"
 #include "engine/map/warehouse_map.h"
+#include "engine/motion/motion_path.h"
 #include "engine/routing/route_table.h"
 
 namespace dispatch::engine {
@@ -47,6 +48,12 @@ struct Waypoint {
   double eta = 0.0;    // arrival time, seconds
   WaypointAction action = WaypointAction::kMove;
   double dwell = 0.0;  // seconds standing still after arrival (t_w at pick/drop), >= 0
+  // A four-wheel-steer robot's pose and motion inside a free-space region
+  // (engine/motion/free_space_plan.h): the heading it holds at this waypoint (radians,
+  // counter-clockwise from +x) and how it gets here from the previous waypoint. Unset on the
+  // road graph, where a robot drives along each arc.
+  std::optional<double> heading;
+  std::optional<MotionMode> mode;
 
   double departure() const { return eta + dwell; }
 };

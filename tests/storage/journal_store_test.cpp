@@ -58,8 +58,8 @@ std::vector<JournalEntry> SampleEntries() {
   a.plan_id = 4;
   a.order_ids = {"ord-7"};
   a.plan.robot_id = "R2";
-  a.plan.waypoints = {{5, 3, {1.25, 1.5}, 0.7, engine::WaypointAction::kPick, 5.0},
-                      {6, 12, {2.0, 1.5}, 6.4, engine::WaypointAction::kDrop, 5.0}};
+  a.plan.waypoints = {{5, 3, {1.25, 1.5}, 0.7, engine::WaypointAction::kPick, 5.0, {}, {}},
+                      {6, 12, {2.0, 1.5}, 6.4, engine::WaypointAction::kDrop, 5.0, {}, {}}};
   a.released_up_to = 5;
   a.updated_time = 0.7;
   restore.plan = a;

@@ -180,7 +180,7 @@ TEST_F(SqliteStoreTest, RobotsAssignmentsAndMapVersions) {
   AssignmentRecord a;
   a.robot_id = "R1";
   a.plan_id = 1;
-  a.plan.waypoints = {{0, 1, {0.0, 0.0}, 0.0, engine::WaypointAction::kMove, 0.0}};
+  a.plan.waypoints = {{0, 1, {0.0, 0.0}, 0.0, engine::WaypointAction::kMove, 0.0, {}, {}}};
   ASSERT_TRUE(store->SaveAssignment(a).ok());
   a.plan_id = 2;
   ASSERT_TRUE(store->SaveAssignment(a).ok());

@@ -105,9 +105,9 @@ TEST_F(SqliteStoreTest, EverythingSurvivesCloseAndReopen) {
   robot.battery = 0.875;
   engine::Plan plan;
   plan.robot_id = "R7";
-  plan.waypoints = {{0, 42, {19.0, 16.5}, 10.0, engine::WaypointAction::kMove, 0.0},
-                    {1, 43, {20.0, 16.5}, 11.0, engine::WaypointAction::kPick, 5.0},
-                    {2, 12, {21.0, 16.5}, 17.0, engine::WaypointAction::kDrop, 5.0}};
+  plan.waypoints = {{0, 42, {19.0, 16.5}, 10.0, engine::WaypointAction::kMove, 0.0, {}, {}},
+                    {1, 43, {20.0, 16.5}, 11.0, engine::WaypointAction::kPick, 5.0, {}, {}},
+                    {2, 12, {21.0, 16.5}, 17.0, engine::WaypointAction::kDrop, 5.0, {}, {}}};
   {
     auto store = OpenOrDie(db_path());
     ASSERT_NE(store, nullptr);

@@ -369,8 +369,8 @@ TEST_F(TrafficPredictionModelTest, PlanCountsAtEveryBucketStartWithinItsSpan) {
   config.bucket_seconds = 1.0;
   TrafficPredictor pred(*map_, config);
   Plan plan;
-  plan.waypoints = {{0, kNoPoint, {5, 5}, 2.0, WaypointAction::kPark, 1.0},  // Z1, 2 .. 3
-                    {1, kNoPoint, {30, 5}, 8.0, WaypointAction::kMove, 0.0}};  // Z3 at 8
+  plan.waypoints = {{0, kNoPoint, {5, 5}, 2.0, WaypointAction::kPark, 1.0, {}, {}},  // Z1, 2 .. 3
+                    {1, kNoPoint, {30, 5}, 8.0, WaypointAction::kMove, 0.0, {}, {}}};  // Z3 at 8
   pred.SetPlan("R1", plan);
   const ZoneId z1 = map_->FindZone("Z1").value(), z3 = map_->FindZone("Z3").value();
   EXPECT_EQ(pred.bucket_count(), 9u);  // buckets 2 .. 8
@@ -384,7 +384,7 @@ TEST_F(TrafficPredictionModelTest, PlanCountsAtEveryBucketStartWithinItsSpan) {
 
   // A plan inside one bucket (no bucket start in its span) predicts nothing.
   Plan blip;
-  blip.waypoints = {{0, kNoPoint, {5, 5}, 20.2, WaypointAction::kPark, 0.5}};
+  blip.waypoints = {{0, kNoPoint, {5, 5}, 20.2, WaypointAction::kPark, 0.5, {}, {}}};
   pred.SetPlan("R2", blip);
   EXPECT_EQ(pred.CountAt(z1, 20.5), 0);
   EXPECT_EQ(pred.bucket_count(), 9u);
@@ -400,7 +400,7 @@ TEST_F(TrafficPredictionModelTest, PlanCountsAtEveryBucketStartWithinItsSpan) {
 
 Plan ParkedPlan(const Eigen::Vector2d& xy, double from, double until) {
   Plan plan;
-  plan.waypoints = {{0, kNoPoint, xy, from, WaypointAction::kPark, until - from}};
+  plan.waypoints = {{0, kNoPoint, xy, from, WaypointAction::kPark, until - from, {}, {}}};
   return plan;
 }
 
@@ -419,7 +419,7 @@ TEST(TrafficPredictionDensityTest, PeaksPerZoneOverOtherRobotsOnly) {
   // R1 and R2 park in Z1 (R1 leaves for Z4 at t = 200), R4 parks in Z2, and the bidder R3
   // itself parks in Z1: it must not count itself.
   Plan r1 = ParkedPlan({5, 5}, 0.0, 200.0);
-  r1.waypoints.push_back({1, kNoPoint, {5, 20}, 210.0, WaypointAction::kPark, 790.0});
+  r1.waypoints.push_back({1, kNoPoint, {5, 20}, 210.0, WaypointAction::kPark, 790.0, {}, {}});
   pred.SetPlan("R1", r1);
   pred.SetPlan("R2", ParkedPlan({6, 5}, 0.0, 1000.0));
   pred.SetPlan("R3", ParkedPlan({7, 5}, 0.0, 1000.0));
@@ -463,8 +463,8 @@ TEST(TrafficPredictionDensityTest, SampledPlanThroughACrowdedZone) {
   pred.SetPlan("B", ParkedPlan({6, 5}, 0.0, 100.0));
   // The bidder drives from (2, 4) in Z1 to (20, 4) in Z2, 1 m/s from t = 10.
   Plan candidate;
-  candidate.waypoints = {{0, kNoPoint, {2, 4}, 10.0, WaypointAction::kMove, 0.0},
-                         {1, kNoPoint, {20, 4}, 28.0, WaypointAction::kDrop, 5.0}};
+  candidate.waypoints = {{0, kNoPoint, {2, 4}, 10.0, WaypointAction::kMove, 0.0, {}, {}},
+                         {1, kNoPoint, {20, 4}, 28.0, WaypointAction::kDrop, 5.0, {}, {}}};
   const DensityTerm d = pred.Density(SamplePlan(candidate, 1.0), "C");
   const std::vector<std::pair<ZoneId, int>> want = {{z1, 2}, {z2, 0}};
   EXPECT_EQ(d.peaks, want);
@@ -476,9 +476,9 @@ TEST(TrafficPredictionDensityTest, SampledPlanThroughACrowdedZone) {
 Plan ThreeWaypointPlan() {
   Plan plan;
   // 3 m east at 1 m/s after a 2 s dwell, a 4 s pick, 4 m north at 0.5 m/s, a 1 s drop.
-  plan.waypoints = {{0, kNoPoint, {0, 0}, 10.0, WaypointAction::kMove, 2.0},
-                    {1, kNoPoint, {3, 0}, 15.0, WaypointAction::kPick, 4.0},
-                    {2, kNoPoint, {3, 4}, 27.0, WaypointAction::kDrop, 1.0}};
+  plan.waypoints = {{0, kNoPoint, {0, 0}, 10.0, WaypointAction::kMove, 2.0, {}, {}},
+                    {1, kNoPoint, {3, 0}, 15.0, WaypointAction::kPick, 4.0, {}, {}},
+                    {2, kNoPoint, {3, 4}, 27.0, WaypointAction::kDrop, 1.0, {}, {}}};
   return plan;
 }
 
@@ -515,7 +515,7 @@ TEST(SamplePlanTest, SpacingFirstLastAndDwellAwareTimes) {
 TEST(SamplePlanTest, DegeneratePlans) {
   EXPECT_TRUE(SamplePlan(Plan{}, 1.0).empty());
   Plan one;
-  one.waypoints = {{0, kNoPoint, {1, 2}, 5.0, WaypointAction::kPark, 10.0}};
+  one.waypoints = {{0, kNoPoint, {1, 2}, 5.0, WaypointAction::kPark, 10.0, {}, {}}};
   const std::vector<RouteSample> s = SamplePlan(one, 0.5);
   ASSERT_EQ(s.size(), 1u);
   ExpectSample(s[0], 1, 2, 5.0);
@@ -523,7 +523,7 @@ TEST(SamplePlanTest, DegeneratePlans) {
   // Standing still between two waypoints (same xy): no extra samples, time keeps moving.
   Plan still = ThreeWaypointPlan();
   still.waypoints.insert(still.waypoints.begin() + 2,
-                         {2, kNoPoint, {3, 0}, 20.0, WaypointAction::kWait, 0.0});
+                         {2, kNoPoint, {3, 0}, 20.0, WaypointAction::kWait, 0.0, {}, {}});
   still.waypoints[3].eta = 28.0;  // departs the wait at 20, 4 m in 8 s
   const std::vector<RouteSample> w = SamplePlan(still, 2.0);
   ASSERT_EQ(w.size(), 5u);
