@@ -136,6 +136,10 @@ void SimRobot::ArriveAt(Waypoint& w, double time, std::vector<v1::RobotMessage>&
   w.arrived = true;
   w.reported = now_;
   position_ = Xy(w.wp);
+  if (w.wp.has_heading()) {  // a planned pose (four-wheel steer): reached with its heading
+    heading_ = w.wp.heading();
+    has_heading_ = true;
+  }
   last_reached_ = std::max(last_reached_, w.wp.sequence());
   v1::RobotMessage m;
   m.mutable_waypoint_reached()->set_sequence(w.wp.sequence());
@@ -212,16 +216,20 @@ void SimRobot::Step(double now, std::vector<v1::RobotMessage>& out) {
     }
     if (v <= 0.0 || t >= now_) break;
     const double want = std::atan2(d.y(), d.x());
+    const bool posed = front.wp.has_heading();  // four-wheel steer: its modes, no turn first
     if (turning_to_ != front.wp.sequence()) {  // a new leg: turn to it first
       turning_to_ = front.wp.sequence();
-      const double angle = has_heading_ ? std::abs(std::remainder(want - heading_, 2.0 * std::numbers::pi)) : 0.0;
+      leg_from_ = position_;
+      leg_from_heading_ = heading_;
+      const double angle =
+          has_heading_ && !posed ? std::abs(std::remainder(want - heading_, 2.0 * std::numbers::pi)) : 0.0;
       turn_end_ = t + turn_time_ * angle / (std::numbers::pi / 2.0);
     }
     if (turn_end_ > t) {
       if (turn_end_ >= now_) break;  // still turning, standing
       t = turn_end_;
     }
-    heading_ = want;
+    if (!posed) heading_ = want;
     has_heading_ = true;
     current_speed_ = v;
     const double reach = v * (now_ - t);
@@ -231,6 +239,13 @@ void SimRobot::Step(double now, std::vector<v1::RobotMessage>& out) {
       continue;
     }
     position_ += d * (reach / dist);
+    if (posed) {  // the heading turns evenly over the leg (unchanged on a straight or a crab)
+      const double leg = (to - leg_from_).norm();
+      const double done = leg > 0.0 ? (position_ - leg_from_).norm() / leg : 1.0;
+      heading_ = std::remainder(
+          leg_from_heading_ + done * std::remainder(front.wp.heading() - leg_from_heading_, 2.0 * std::numbers::pi),
+          2.0 * std::numbers::pi);
+    }
     break;
   }
 }

@@ -28,6 +28,12 @@
 // none before its first move), as the engine's simulated robot (engine/sim/waypoint_robot.h)
 // and the dispatcher's --turn-time plans it.
 //
+// Four-wheel-steer motion (a waypoint with a heading: the dispatcher plans such robots by the
+// hybrid A* inside free-space regions, engine/motion/free_space_plan.h): the robot drives the
+// leg without turning first and without facing along it — a crab keeps its heading, an arc
+// or a spin turns it evenly over the leg (a spin, a leg of no length, at once) — and reaches
+// the waypoint with the planned heading.
+//
 // Faults for tests of the server: a stalled robot does not move (it still talks); a slow
 // robot drives at speed * slow_factor; a muted robot is dead: it neither moves nor produces
 // events from then on (fleet-sim also stops sending anything for it, see fleet_sim.cpp).
@@ -127,6 +133,8 @@ class SimRobot {
   bool has_heading_ = false;        // it has moved (before, its heading is not known)
   std::uint64_t turning_to_ = 0;    // the waypoint (sequence) it turned, or turns, towards
   double turn_end_ = 0.0;           // when that turn is done
+  Eigen::Vector2d leg_from_ = Eigen::Vector2d::Zero();  // where the leg being driven began
+  double leg_from_heading_ = 0.0;   // and the heading it began with
   bool muted_ = false;
   // Drops finished (waypoint sequence -> order id), the most recent kMaxFinishedDrops.
   std::deque<std::pair<std::uint64_t, std::string>> finished_drops_;

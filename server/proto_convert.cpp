@@ -26,6 +26,22 @@ pb::WaypointAction ActionToProto(engine::WaypointAction a) {
   return pb::WAYPOINT_ACTION_UNSPECIFIED;
 }
 
+pb::MotionMode MotionModeToProto(engine::MotionMode m) {
+  switch (m) {
+    case engine::MotionMode::kForward: return pb::MOTION_MODE_FORWARD;
+    case engine::MotionMode::kReverse: return pb::MOTION_MODE_REVERSE;
+    case engine::MotionMode::kCrabLeft: return pb::MOTION_MODE_CRAB_LEFT;
+    case engine::MotionMode::kCrabRight: return pb::MOTION_MODE_CRAB_RIGHT;
+    case engine::MotionMode::kSpinLeft: return pb::MOTION_MODE_SPIN_LEFT;
+    case engine::MotionMode::kSpinRight: return pb::MOTION_MODE_SPIN_RIGHT;
+    case engine::MotionMode::kArcForwardLeft: return pb::MOTION_MODE_ARC_FORWARD_LEFT;
+    case engine::MotionMode::kArcForwardRight: return pb::MOTION_MODE_ARC_FORWARD_RIGHT;
+    case engine::MotionMode::kArcReverseLeft: return pb::MOTION_MODE_ARC_REVERSE_LEFT;
+    case engine::MotionMode::kArcReverseRight: return pb::MOTION_MODE_ARC_REVERSE_RIGHT;
+  }
+  return pb::MOTION_MODE_UNSPECIFIED;
+}
+
 namespace {
 
 engine::Result<engine::StopSpec> StopFromProto(const pb::StopSpec& stop, const std::string& what) {
@@ -73,6 +89,8 @@ void WaypointToProto(const OutboundWaypoint& w, pb::TimedWaypoint* out) {
   out->set_dwell(w.waypoint.dwell);
   out->set_released(w.released);
   out->set_order_id(w.order_id);
+  if (w.waypoint.heading) out->set_heading(*w.waypoint.heading);
+  if (w.waypoint.mode) out->set_motion_mode(MotionModeToProto(*w.waypoint.mode));
 }
 
 pb::PointKind KindToProto(engine::PointKind k) {

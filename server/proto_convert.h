@@ -29,6 +29,7 @@ engine::Result<RobotInbound> RobotInboundFromProto(const pb::RobotMessage& messa
 // --- engine/server -> proto ------------------------------------------------------------
 pb::OrderState OrderStateToProto(engine::OrderState state);
 pb::WaypointAction ActionToProto(engine::WaypointAction action);
+pb::MotionMode MotionModeToProto(engine::MotionMode mode);
 // The point's id, name and position (only the id when it is not on the map).
 void StopToProto(engine::PointId point, const engine::WarehouseMap& map, pb::ResolvedStop* out);
 void OrderToProto(const OrderView& order, const engine::WarehouseMap& map, pb::Order* out);

@@ -2,6 +2,9 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
+#include <numbers>
 #include <vector>
 
 namespace dispatch::clients {
@@ -102,6 +105,55 @@ TEST(SimRobotTest, TurnsInPlaceBeforeANewHeading) {
   // Without turning: 4 m, 3 s pick, 3 m -> at the drop by 10 s (its planned eta). With it,
   // the 90-degree turn after the pick adds 1 s.
   EXPECT_NEAR(reached_drop[1] - reached_drop[0], 1.0, 0.1);
+}
+
+// A four-wheel-steer plan in a free space: east 2 m facing east, crab 1 m north still facing
+// east, spin to face north, then an arc-like leg turning back east. No turn in place before a
+// leg (turn_time is for lanes); the heading is the plan's, not the direction of travel.
+TEST(SimRobotTest, DrivesTheFourWheelSteerModesWithThePlannedHeadings) {
+  SimRobot r("R1", {0, 0}, 1.0);
+  r.set_turn_time(1.0);
+  v1::ServerMessage m;
+  m.set_sequence(1);
+  v1::Assignment* a = m.mutable_assignment();
+  a->set_plan_id(1);
+  auto posed = [&](std::uint64_t seq, double x, double y, double eta, double heading, v1::MotionMode mode) {
+    v1::TimedWaypoint w = Wp(seq, x, y, eta);
+    w.set_heading(heading);
+    w.set_motion_mode(mode);
+    *a->add_waypoints() = w;
+  };
+  posed(1, 0, 0, 0, 0.0, v1::MOTION_MODE_UNSPECIFIED);
+  posed(2, 2, 0, 2, 0.0, v1::MOTION_MODE_FORWARD);
+  posed(3, 2, 1, 3, 0.0, v1::MOTION_MODE_CRAB_LEFT);
+  posed(4, 2, 1, 4.6, std::numbers::pi / 2, v1::MOTION_MODE_SPIN_LEFT);
+  posed(5, 3, 2, 6.2, 0.0, v1::MOTION_MODE_ARC_FORWARD_RIGHT);
+  a->set_released_up_to_sequence(5);
+  ASSERT_TRUE(r.Apply(m));
+  Events run;
+  double crab_heading_max = 0.0, arc_mid_heading = -1.0;
+  for (double t = 0; t <= 8 + 1e-9; t += 0.05) {
+    r.Step(t, run.events);
+    if (r.position().x() > 1.99 && r.position().x() < 2.01 && r.position().y() > 0.2 && r.position().y() < 0.8) {
+      crab_heading_max = std::max(crab_heading_max, std::abs(r.heading()));
+    }
+    const double along = (r.position() - Eigen::Vector2d(2, 1)).norm() / std::sqrt(2.0);
+    if (r.position().x() > 2.01 && along > 0.45 && along < 0.55) arc_mid_heading = r.heading();
+  }
+  EXPECT_EQ(run.Names(), (std::vector<std::string>{"wp1", "wp2", "wp3", "wp4", "wp5"}));
+  EXPECT_LT(crab_heading_max, 1e-9) << "a crab keeps the heading";
+  EXPECT_NEAR(arc_mid_heading, std::numbers::pi / 4, 0.1) << "an arc turns evenly";
+  EXPECT_NEAR(r.heading(), 0.0, 1e-9);
+  EXPECT_TRUE(r.position().isApprox(Eigen::Vector2d(3, 2)));
+  // The spin's pose was reported at its waypoint, facing north.
+  for (const auto& e : run.events) {
+    if (e.has_waypoint_reached() && e.waypoint_reached().sequence() == 4) {
+      EXPECT_NEAR(e.waypoint_reached().pose().theta(), std::numbers::pi / 2, 1e-9);
+    }
+    if (e.has_waypoint_reached() && e.waypoint_reached().sequence() == 3) {
+      EXPECT_NEAR(e.waypoint_reached().pose().theta(), 0.0, 1e-9);
+    }
+  }
 }
 
 TEST(SimRobotTest, WaitsForPlannedDepartureWhenAhead) {

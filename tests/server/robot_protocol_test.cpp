@@ -1,11 +1,16 @@
 // The rules of a robot's stream the dispatcher applies itself (server/robot_protocol.h): Hello
 // first and once, a live stream is not taken over, acks only of what was sent, the heartbeat
-// timeout and the offline grace.
+// timeout and the offline grace; and what a waypoint says on the wire.
 #include "server/robot_protocol.h"
 
 #include <gtest/gtest.h>
 
+#include <cctype>
 #include <chrono>
+#include <numbers>
+#include <string>
+
+#include "server/proto_convert.h"
 
 namespace dispatch::server {
 namespace {
@@ -76,6 +81,41 @@ TEST(RobotProtocolTest, ARobotOfflineWithOrdersLosesThemAfterTheGrace) {
   EXPECT_FALSE(GraceOver("R1", s, nullptr, t0 + seconds(60), 10.0).has_value());  // unknown to the core
   s.offline_since.reset();  // its orders went back already
   EXPECT_FALSE(GraceOver("R1", s, &robot, t0 + seconds(60), 10.0).has_value());
+}
+
+// A four-wheel-steer robot's waypoint in a free-space region carries its heading and motion
+// mode; a waypoint on the road graph has neither (so older robots see nothing new).
+TEST(RobotProtocolTest, AWaypointCarriesHeadingAndModeOnlyInAFreeSpace) {
+  OutboundWaypoint w;
+  w.waypoint.seq = 7;
+  w.waypoint.point = 3;
+  w.waypoint.xy = {4.5, 1.825};
+  w.waypoint.action = engine::WaypointAction::kPick;
+  RobotOutbound m;
+  m.kind = RobotOutbound::Kind::kAssignment;
+  m.waypoints = {w};
+  w.waypoint.heading = std::numbers::pi / 2;
+  w.waypoint.mode = engine::MotionMode::kCrabLeft;
+  m.waypoints.push_back(w);
+  pb::ServerMessage out;
+  OutboundToProto(m, &out);
+  ASSERT_EQ(out.assignment().waypoints_size(), 2);
+  const pb::TimedWaypoint& lane = out.assignment().waypoints(0);
+  EXPECT_FALSE(lane.has_heading());
+  EXPECT_EQ(lane.motion_mode(), pb::MOTION_MODE_UNSPECIFIED);
+  const pb::TimedWaypoint& slot = out.assignment().waypoints(1);
+  ASSERT_TRUE(slot.has_heading());
+  EXPECT_DOUBLE_EQ(slot.heading(), std::numbers::pi / 2);
+  EXPECT_EQ(slot.motion_mode(), pb::MOTION_MODE_CRAB_LEFT);
+  EXPECT_EQ(slot.action(), pb::WAYPOINT_ACTION_PICK);
+  for (int m = 0; m <= static_cast<int>(engine::MotionMode::kArcReverseRight); ++m) {
+    const auto mode = static_cast<engine::MotionMode>(m);
+    EXPECT_EQ(pb::MotionMode_Name(MotionModeToProto(mode)), "MOTION_MODE_" + [&] {
+      std::string name = engine::MotionModeName(mode);
+      for (char& c : name) c = static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
+      return name;
+    }()) << engine::MotionModeName(mode);
+  }
 }
 
 }  // namespace
