@@ -24,6 +24,9 @@
 // stderr; EOF just ends the commands.
 // --turn-time S: robots turn in place S seconds per 90 degrees before a new heading (run
 // dispatchd with the same --turn-time so that its plans count the turns).
+// --kinds K1,K2,...: the robots' kinds in their Hellos (differential, four_wheel_steer),
+// taken in turn over this process's robots: "four_wheel_steer" makes every robot one,
+// "differential,four_wheel_steer" every second one.
 // Runs until SIGINT/SIGTERM or --duration wall seconds. --ready-fd N: once every robot has
 // been welcomed, writes "connected N" to the inherited descriptor N and closes it (scripts
 // wait on it, no polling).
@@ -207,7 +210,7 @@ int Main(int argc, char** argv) {
   int delay_ms = 0;
   int ready_fd = -1, control_fd = -1;
   std::size_t first = 1;
-  std::vector<std::string> stall, slow, mute;
+  std::vector<std::string> stall, slow, mute, kinds{"differential"};
   std::string stats_out, robot_tokens_file;
   FleetStats stats;
   ClientSecurity security;
@@ -239,6 +242,8 @@ int Main(int argc, char** argv) {
   app.add_option("--slow", slow, "Fault: ID:FACTOR drives at FACTOR x speed (repeat)");
   app.add_option("--turn-time", turn_time, "Seconds per 90 degrees a robot turns in place before a new heading")
       ->capture_default_str()->check(CLI::NonNegativeNumber);
+  app.add_option("--kinds", kinds, "Robot kinds, taken in turn over R1, R2, ...: differential, four_wheel_steer")
+      ->delimiter(',')->capture_default_str()->check(CLI::IsMember({"differential", "four_wheel_steer"}));
   app.add_option("--mute", mute,
                  "Fault: ID:AFTER - after AFTER wall seconds robot ID stops moving and sending anything, "
                  "keeping its stream open (the server's heartbeat timeout must notice); it never "
@@ -293,7 +298,11 @@ int Main(int argc, char** argv) {
         id, Eigen::Vector2d(starts[i].position().x(), starts[i].position().y()), speed);
     by_id[id] = i;
   }
-  for (auto& slot : slots) slot.robot->set_turn_time(turn_time);
+  for (std::size_t i = 0; i < slots.size(); ++i) {
+    slots[i].robot->set_turn_time(turn_time);
+    const bool steer = !kinds.empty() && kinds[i % kinds.size()] == "four_wheel_steer";
+    slots[i].robot->set_kind(steer ? v1::ROBOT_KIND_FOUR_WHEEL_STEER : v1::ROBOT_KIND_DIFFERENTIAL);
+  }
   if (!robot_certs.empty()) {  // each robot shows its own certificate: a channel each
     for (auto& slot : slots) {
       ClientSecurity own = security;

@@ -36,7 +36,7 @@ v1::RobotMessage SimRobot::Hello() const {
   v1::RobotMessage m;
   v1::Hello* h = m.mutable_hello();
   h->set_robot_id(id_);
-  h->set_kind(v1::ROBOT_KIND_DIFFERENTIAL);
+  h->set_kind(kind_);
   h->mutable_pose()->set_x(position_.x());
   h->mutable_pose()->set_y(position_.y());
   h->mutable_pose()->set_theta(heading_);

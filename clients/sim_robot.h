@@ -78,6 +78,8 @@ class SimRobot {
   void set_stalled(bool stalled) { stalled_ = stalled; }
   void set_slow_factor(double factor) { slow_factor_ = factor; }
   void set_turn_time(double seconds_per_90) { turn_time_ = seconds_per_90; }
+  // What its Hello says it is (differential by default; four-wheel steer: see above).
+  void set_kind(v1::RobotKind kind) { kind_ = kind; }
   // Permanent: a muted robot stands still and Step produces nothing.
   void set_muted() { muted_ = true; }
   bool muted() const { return muted_; }
@@ -130,6 +132,7 @@ class SimRobot {
   bool stalled_ = false;
   double slow_factor_ = 1.0;
   double turn_time_ = 0.0;          // s per 90 degrees
+  v1::RobotKind kind_ = v1::ROBOT_KIND_DIFFERENTIAL;
   bool has_heading_ = false;        // it has moved (before, its heading is not known)
   std::uint64_t turning_to_ = 0;    // the waypoint (sequence) it turned, or turns, towards
   double turn_end_ = 0.0;           // when that turn is done

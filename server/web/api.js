@@ -19,7 +19,8 @@ window.WebMap = window.WebMap || {};
   function robot(j) {
     const pose = j.pose || {};
     return {
-      id: j.id, state: robotState(j.state), connected: j.connected, x: pose.x, y: pose.y, heading: pose.theta,
+      id: j.id, state: robotState(j.state), kind: lower(j.kind, /^ROBOT_KIND_/), connected: j.connected,
+      x: pose.x, y: pose.y, heading: pose.theta,
       orders: list(j.order_ids), held: !!j.held, hold_reason: j.hold_reason || "",
       formation: j.formation_order_id || null, point: stop(j.point), battery: j.battery ?? null,
       paused_by: j.paused_by || "", out_of_service_by: j.out_of_service_by || "", off_floor: !!j.off_floor,

@@ -2,7 +2,8 @@
 // waits, and the selected order's remaining routes. Everything here is redrawn on each live
 // update, so its cost is proportional to robots, grants and route waypoints, never to the
 // floor. Each robot is a <g class="robot" data-robot-id data-x data-y data-state>, with
-// data-x/data-y the map coordinates it was drawn at (what the browser test reads).
+// data-x/data-y the map coordinates it was drawn at (what the browser test reads) and
+// data-kind its kind (a four-wheel-steer robot is drawn as its footprint, rect.footprint).
 "use strict";
 window.WebMap = window.WebMap || {};
 
@@ -15,6 +16,9 @@ window.WebMap = window.WebMap || {};
   const UNKNOWN_STATE = "#a855f7";
   const FORMATION = "#7c3aed";
   const STOP_ACTIONS = new Set(["pick", "drop", "park", "charge"]);  // marked on a route
+  // A four-wheel-steer robot's rectangle, metres: the engine's default footprint
+  // (engine/motion/footprint.h; the robots do not send theirs).
+  const FOOTPRINT = { length: 0.8, width: 0.5 };
 
   function stateColour(state) { return STATE_COLOURS[state] || UNKNOWN_STATE; }
 
@@ -85,9 +89,20 @@ window.WebMap = window.WebMap || {};
           class: classes.join(" "), "data-x": r.x, "data-y": r.y, "data-state": state,
           transform: `translate(${f1(px)},${f1(py)})`,
         });
-        setAttrs(e.body, { r: f1(radius), fill: stateColour(state) });
-        setAttrs(e.hold, { r: f1(radius + 3) });
         const h = Number(r.heading) || 0;  // radians, counter-clockwise from +x in map axes
+        // A four-wheel-steer robot: its rectangular footprint, turned to its heading (it may
+        // crab, so the heading is not where it drives); every other robot: a disc.
+        const steer = r.kind === "four_wheel_steer";
+        e.g.setAttribute("data-kind", r.kind || "unknown");
+        e.body.style.display = steer ? "none" : "";
+        e.footprint.style.display = steer ? "" : "none";
+        setAttrs(e.body, { r: f1(radius), fill: stateColour(state) });
+        if (steer) {
+          const len = Math.max(10, FOOTPRINT.length * v.scale), wid = Math.max(6, FOOTPRINT.width * v.scale);
+          setAttrs(e.footprint, { x: f1(-len / 2), y: f1(-wid / 2), width: f1(len), height: f1(wid),
+            transform: `rotate(${f1(-h * 180 / Math.PI)})`, fill: stateColour(state) });
+        }
+        setAttrs(e.hold, { r: f1(radius + 3) });
         setAttrs(e.heading, { x2: f1(Math.cos(h) * radius), y2: f1(-Math.sin(h) * radius) });
         e.tag.style.display = labels ? "" : "none";
         setAttrs(e.tag, { transform: `translate(0,${f1(-radius - 3)})` });
@@ -107,13 +122,15 @@ window.WebMap = window.WebMap || {};
       const g = el("g", { class: "robot", "data-robot-id": id }, this.layers.robots);
       const title = el("title", {}, g);
       const body = el("circle", { class: "body", cx: 0, cy: 0, stroke: robotColour(id) }, g);
+      const footprint = el("rect", { class: "footprint", rx: 1, stroke: robotColour(id) }, g);
+      footprint.style.display = "none";
       const heading = el("line", { class: "heading", x1: 0, y1: 0 }, g);
       const hold = el("circle", { class: "hold-mark", cx: 0, cy: 0 }, g);
       const tag = el("g", { class: "tag" }, g);
       const w = 7 * id.length + 6;
       el("rect", { x: -w / 2, y: -13, width: w, height: 13, rx: 3, fill: robotColour(id) }, tag);
       const label = el("text", { x: 0, y: -3, "text-anchor": "middle" }, tag);
-      const e = { g, body, heading, hold, tag, label, title };
+      const e = { g, body, footprint, heading, hold, tag, label, title };
       this.robotEls.set(id, e);
       return e;
     }

@@ -154,7 +154,9 @@ window.WebMap = window.WebMap || {};
     const html = [
       `<div class="row"><b>robots</b> ${states.join("")}` +
         `<span class="item"><span class="rtag" style="background:${WM.Live.robotColour("R7")}">R7</span>own colour (ring, route, grant)</span>` +
-        sw("", "held", "sw dot heldsw") + "</div>",
+        sw("", "held", "sw dot heldsw") +
+        sw("background:#9ca3af;border:1.5px solid #374151;width:16px;height:10px;border-radius:1px", "four-wheel steer (footprint)") +
+        "</div>",
       `<div class="row"><b>floor</b> ${sw(`border-top:2px solid ${C.oneWay}`, "one-way lane →", "sw line")}` +
         sw(`border-top:2px dashed ${C.bidirectional}`, "bidirectional lane ↔", "sw line") +
         sw(`background:${C.pick};transform:rotate(45deg) scale(.8)`, "pick") + sw(`background:${C.drop}`, "drop") +

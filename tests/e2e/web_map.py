@@ -2,7 +2,9 @@
 """The live web map in a real browser (issue 6 §1, SPEC §4): dispatchd (time scale 10) with 18
 fleet-sim robots and seed Table 1 submitted; Debian's headless Chromium, driven over the
 DevTools protocol, opens the page dispatchd serves at `/` and must show: all 18 robots (DOM
-elements with data-robot-id) and then at least one of them at a new position, a non-empty
+elements with data-robot-id; every second one a four-wheel-steer robot, fleet-sim --kinds, drawn
+as its turned footprint rectangle, the others as discs) and then at least one of them at a new
+position, a non-empty
 floor canvas and zone heat layer, a formation drawn as one, a held intersection, the status
 line, every submitted order in the order list; a click on an order opens its allocation
 explanation with the same bids, winners and reason as GET /api/v1/orders/{id}, and its
@@ -197,6 +199,18 @@ def browser_checks(h, server, page, base_url, orders, out):
     check(ids == sorted(f"R{k}" for k in range(1, ROBOTS + 1)), f"robots drawn: {ids}")
     api = page.evaluate("dispatchMap.robots().map(r => r.id).sort().join()")
     check(api == ",".join(ids), f"dispatchMap.robots() = {api}, DOM has {ids}")
+    # Kinds from the robots' Hellos: R2, R4, ... are four-wheel steer, drawn as footprints.
+    kinds = page.evaluate("""[...document.querySelectorAll('#robots [data-robot-id]')].map(e => {
+        const f = e.querySelector('rect.footprint'), b = e.querySelector('circle.body');
+        return [e.dataset.robotId, e.dataset.kind, f.style.display !== 'none', b.style.display !== 'none',
+                f.getAttribute('transform') || '', +f.getAttribute('width') > +f.getAttribute('height')]; })""")
+    h.log("footprints drawn: " + " ".join(k[0] for k in kinds if k[2]))
+    for rid, kind, footprint, disc, turn, long_side in kinds:
+        steer = int(rid[1:]) % 2 == 0
+        check(kind == ("four_wheel_steer" if steer else "differential"), f"{rid} drawn as kind {kind}")
+        check(footprint == steer and disc != steer, f"{rid} ({kind}): footprint shown {footprint}, disc {disc}")
+        if steer:
+            check(turn.startswith("rotate(") and long_side, f"{rid}: footprint transform {turn!r}")
     frames0 = page.evaluate("dispatchMap.frames")
     first = {r[0]: (r[1], r[2]) for r in drawn}
     h.log(f"{len(first)} robots drawn after {frames0} live updates")
@@ -324,7 +338,7 @@ def main():
     with Harness(args, "webmap") as h:
         extra = ["--time-scale", "10"] + (["--web-root", args.web_root] if args.web_root else [])
         server = h.start_server(extra)
-        h.start_fleet(server, ROBOTS)
+        h.start_fleet(server, ROBOTS, extra=["--kinds", "differential,four_wheel_steer"])
         rows = h.submit_file(server, os.path.join(args.scenarios, "chu2024-table1.csv"))
         check(len(rows) == 6, f"submitted {len(rows)} orders of Table 1, want 6")
         in_browser(h, args, "web_map.png", lambda page: browser_checks(
