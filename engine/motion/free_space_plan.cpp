@@ -1,9 +1,11 @@
 #include "engine/motion/free_space_plan.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <limits>
 #include <numbers>
+#include <optional>
 #include <string>
 #include <utility>
 
@@ -128,15 +130,6 @@ Result<Plan> FreeSpaceMotion::Refine(const Plan& plan, double speed,
     double t = first_departure;  // departure from the last anchor
     const FreeSpace& space = map_->free_spaces()[r];
     const Region& region = *regions_[r];
-    auto nearest_point = [&](const MotionPose& pose) {
-      PointId best = in[i].point;
-      double best_d = std::numeric_limits<double>::infinity();
-      for (PointId p : space.points) {
-        const double d = (map_->point(p).position - Eigen::Vector2d(pose.x, pose.y)).squaredNorm();
-        if (d < best_d) best_d = d, best = p;
-      }
-      return best;
-    };
     for (std::size_t a = 0; a + 1 < anchors.size(); ++a) {
       const Waypoint& from = in[anchors[a]];
       const Waypoint& to = in[anchors[a + 1]];
@@ -149,6 +142,14 @@ Result<Plan> FreeSpaceMotion::Refine(const Plan& plan, double speed,
                                             PoseText(map_->point(to.point).name, goal) + ": " +
                                             path.error().message};
       }
+      // The poses kept, timed; the last pose is the next anchor's.
+      struct Kept {
+        MotionPose pose;
+        double t;
+        MotionMode mode;
+      };
+      std::vector<Kept> kept;
+      std::optional<MotionMode> last_mode;
       const std::vector<MotionPose>& poses = path->poses;
       const std::vector<MotionMode>& modes = path->modes;
       double progress = 0.0;  // since the last kept pose
@@ -166,34 +167,56 @@ Result<Plan> FreeSpaceMotion::Refine(const Plan& plan, double speed,
           t += amount / speed;
         }
         progress += amount;
+        last_mode = mode;
         const bool last = k + 2 == poses.size();
-        const bool mode_ends = !last && modes[k + 1] != mode;
-        if (last) {
-          Waypoint w = to;
-          w.eta = t;
-          w.heading = goal.theta;
-          w.mode = mode;
-          t += w.dwell;
-          push(std::move(w));
-        } else if (mode_ends || progress >= options_.keep_every) {
-          Waypoint w;
-          w.point = nearest_point(q);
-          w.xy = Eigen::Vector2d(q.x, q.y);
-          w.eta = t;
-          w.action = WaypointAction::kMove;
-          w.heading = q.theta;
-          w.mode = mode;
-          push(std::move(w));
+        if (!last && (modes[k + 1] != mode || progress >= options_.keep_every)) {
+          kept.push_back({q, t, mode});
           progress = 0.0;
         }
       }
-      if (poses.size() < 2) {  // already there: the anchor as it is, at once
-        Waypoint w = to;
-        w.eta = t;
-        w.heading = goal.theta;
-        t += w.dwell;
-        push(std::move(w));
+      // Names: the graph route between the anchors (anchors[a] .. anchors[a + 1] of the input,
+      // consecutive points joined by arcs) in order, each on the kept pose nearest to it (not
+      // before the previous one's), so the traffic gate sees the robot pass the route's points
+      // one after another. A route point no pose is nearest to gets a waypoint of its own at
+      // the same pose and time.
+      const std::size_t first_index = anchors[a], last_index = anchors[a + 1];
+      std::vector<std::size_t> pose_of(last_index - first_index, kept.size());  // by m - first_index
+      for (std::size_t m = first_index + 1, from_pose = 0; m < last_index; ++m) {
+        double best_d = std::numeric_limits<double>::infinity();
+        for (std::size_t q = from_pose; q < kept.size(); ++q) {
+          const double d = (Eigen::Vector2d(kept[q].pose.x, kept[q].pose.y) - in[m].xy).squaredNorm();
+          if (d < best_d) best_d = d, pose_of[m - first_index] = q;
+        }
+        from_pose = std::min(pose_of[m - first_index], kept.size());
       }
+      auto emit = [&](const Kept& k, PointId point) {
+        Waypoint w;
+        w.point = point;
+        w.xy = Eigen::Vector2d(k.pose.x, k.pose.y);
+        w.eta = k.t;
+        w.action = WaypointAction::kMove;
+        w.heading = k.pose.theta;
+        w.mode = k.mode;
+        push(std::move(w));
+      };
+      PointId label = from.point;
+      std::size_t m = first_index + 1;  // the next route point to name
+      for (std::size_t q = 0; q < kept.size(); ++q) {
+        while (m < last_index && pose_of[m - first_index] == q) {
+          if (m + 1 < last_index && pose_of[m + 1 - first_index] == q) emit(kept[q], in[m].point);
+          label = in[m++].point;
+        }
+        emit(kept[q], label);
+      }
+      for (; m < last_index; ++m) {  // route points no kept pose is nearest to: just before the anchor
+        emit(kept.empty() ? Kept{goal, t, last_mode.value_or(MotionMode::kForward)} : kept.back(), in[m].point);
+      }
+      Waypoint w = to;
+      w.eta = t;
+      w.heading = goal.theta;
+      w.mode = last_mode;
+      t += w.dwell;
+      push(std::move(w));
     }
     shift = out.waypoints.back().eta - in[j].eta;
     i = j + 1;

@@ -13,9 +13,12 @@
 // outside the region, faces down the arc it leaves by, so the robot leaves along its lane.
 // A leg's waypoints: the path's poses every `keep_every` (metres driven, or radians spun)
 // and wherever its mode changes, each a kMove waypoint with its heading and the mode that
-// reaches it, named after the nearest of the region's graph points (where the traffic gate
-// sees the robot); the next anchor closes the leg at its own point and position with the
-// anchor's heading. Times: translations and arcs at `speed`, spins at `spin_rate`; anchors
+// reaches it; the next anchor closes the leg at its own point and position with the anchor's
+// heading. The waypoints are named after the graph route the leg replaces, in its order:
+// each route point from the pose nearest to it on (not before the previous point's; a point
+// no pose is nearest to gets a waypoint of its own at the same pose and time), so the traffic
+// gate, which reasons on points and arcs, sees the robot pass the route's points one after
+// another while it drives its own path. Times: translations and arcs at `speed`, spins at `spin_rate`; anchors
 // keep their action and dwell, and every later waypoint moves by the change in duration.
 // Sequence numbers run on from the plan's first. A stretch of one waypoint is left as it is
 // (its heading set), and a plan that touches no region comes back unchanged.

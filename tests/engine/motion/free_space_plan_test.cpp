@@ -16,9 +16,9 @@ namespace dispatch::engine {
 namespace {
 
 // A corridor bay (x 2-8 m, y 0.1-1.5 m) with a crab slot beside it (x 4-5, y 1.5-2.15: 1.0 m by
-// 0.65 m, the robot 0.8 by 0.5), as the narrow floor's. The road graph: park - w - E - X - o - D
-// along y = 0.8, E and X inside the bay, and the slot's pick P joined to E and X. Lanes carry
-// every robot; a 4WIS robot is planned by the hybrid A* between E, P and X.
+// 0.65 m, the robot 0.8 by 0.5), as the narrow floor's. The road graph: park - w - E - m1 - m2 -
+// X - o - D along y = 0.8, E to X inside the bay, and the slot's pick P joined to m1 below it.
+// Lanes carry every robot; a 4WIS robot is planned by the hybrid A* between E, P and X.
 class FreeSpacePlanTest : public ::testing::Test {
  protected:
   void SetUp() override {
@@ -29,10 +29,13 @@ class FreeSpacePlanTest : public ::testing::Test {
     b.AddPoint("w", {1.5, 0.8}, PointKind::kLane);
     b.AddPoint("E", {2.8, 0.8}, PointKind::kLane);
     b.AddPoint("P", {4.5, 1.825}, PointKind::kPick);
+    b.AddPoint("m1", {4.5, 0.8}, PointKind::kLane);
+    b.AddPoint("m2", {5.8, 0.8}, PointKind::kLane);
     b.AddPoint("X", {7.2, 0.8}, PointKind::kLane);
     b.AddPoint("o", {8.8, 0.8}, PointKind::kLane);
     b.AddPoint("D", {10.0, 0.8}, PointKind::kDrop);
-    for (auto [a, c] : {std::pair{"park", "w"}, {"w", "E"}, {"E", "X"}, {"X", "o"}, {"o", "D"}, {"E", "P"}, {"P", "X"}}) {
+    for (auto [a, c] : {std::pair{"park", "w"}, {"w", "E"}, {"E", "m1"}, {"m1", "m2"}, {"m2", "X"}, {"X", "o"},
+                        {"o", "D"}, {"m1", "P"}}) {
       b.AddPath(a, c, std::nullopt, 0.0, true);
     }
     b.AddFreeSpace("bay", {{2, 0.1}, {8, 0.1}, {8, 1.5}, {5, 1.5}, {5, 2.15}, {4, 2.15}, {4, 1.5}, {2, 1.5}});
@@ -70,12 +73,12 @@ TEST_F(FreeSpacePlanTest, TheRobotCrabsIntoTheSlotWithTheTasksHeadingAndLeavesAl
   const Plan graph = GraphPlan();
   std::vector<std::string> names;
   for (const Waypoint& w : graph.waypoints) names.push_back(map_->point(w.point).name);
-  ASSERT_EQ(names, (std::vector<std::string>{"park", "w", "E", "P", "X", "o", "D"}));
+  ASSERT_EQ(names, (std::vector<std::string>{"park", "w", "E", "m1", "P", "m1", "m2", "X", "o", "D"}));
   EXPECT_EQ(motion_->RegionOf(P("E")), 0u);
   EXPECT_EQ(motion_->RegionOf(P("w")), static_cast<std::size_t>(-1));
 
-  // The pick faces east, as the slot demands (the arc E -> P would have the robot at 31 deg).
-  auto refined = motion_->Refine(graph, 1.0, {{3, 0.0}});
+  // The pick faces east, as the slot demands (the arc m1 -> P would have the robot face north).
+  auto refined = motion_->Refine(graph, 1.0, {{4, 0.0}});
   ASSERT_TRUE(refined.ok()) << refined.error().message;
   const std::vector<Waypoint>& w = refined->waypoints;
   ASSERT_GT(w.size(), graph.waypoints.size());
@@ -89,7 +92,7 @@ TEST_F(FreeSpacePlanTest, TheRobotCrabsIntoTheSlotWithTheTasksHeadingAndLeavesAl
   EXPECT_FALSE(w[0].heading.has_value());
   EXPECT_NEAR(*w[2].heading, 0.0, 1e-9);  // E, entered heading east
   const double shift = w.back().eta - graph.waypoints.back().eta;
-  EXPECT_NEAR(w[w.size() - 2].eta - graph.waypoints[5].eta, shift, 1e-9);  // o
+  EXPECT_NEAR(w[w.size() - 2].eta - graph.waypoints[8].eta, shift, 1e-9);  // o
   EXPECT_EQ(w.back().point, P("D"));
   EXPECT_EQ(w.back().action, WaypointAction::kDrop);
 
@@ -109,6 +112,16 @@ TEST_F(FreeSpacePlanTest, TheRobotCrabsIntoTheSlotWithTheTasksHeadingAndLeavesAl
   ASSERT_LT(x, w.size());
   EXPECT_TRUE(w[x].xy.isApprox(map_->point(P("X")).position));
   EXPECT_NEAR(*w[x].heading, 0.0, 1e-9);
+
+  // The traffic gate's view: the graph route's points in its order, one arc at a time.
+  std::vector<std::string> passed;
+  for (std::size_t k = 0; k < w.size(); ++k) {
+    if (k > 0 && w[k].point != w[k - 1].point) {
+      EXPECT_TRUE(map_->FindArc(w[k - 1].point, w[k].point).has_value()) << k;
+    }
+    if (passed.empty() || passed.back() != map_->point(w[k].point).name) passed.push_back(map_->point(w[k].point).name);
+  }
+  EXPECT_EQ(passed, names);
 
   // Every pose inside the bay fits it; times grow by the motion at 1 m/s (spins at 1 rad/s),
   // the pick's work included; sequences run on.
@@ -145,7 +158,7 @@ TEST_F(FreeSpacePlanTest, APlanThatTouchesNoRegionComesBackUnchanged) {
 
 TEST_F(FreeSpacePlanTest, ErrorsNameTheRegionAndThePoints) {
   const Plan graph = GraphPlan();
-  // The graph's own heading at the pick (the arc from E, 31 deg) does not fit the slot.
+  // The graph's own heading at the pick (north, up the arc from m1) does not fit the slot.
   auto skewed = motion_->Refine(graph, 1.0);
   ASSERT_FALSE(skewed.ok());
   EXPECT_EQ(skewed.error().code, ErrorCode::kInvalidArgument);
@@ -158,7 +171,7 @@ TEST_F(FreeSpacePlanTest, ErrorsNameTheRegionAndThePoints) {
   car.search.limits.max_expansions = 20000;
   auto baseline = FreeSpaceMotion::Create(map_, car);
   ASSERT_TRUE(baseline.ok());
-  auto parked = baseline->Refine(graph, 1.0, {{3, 0.0}});
+  auto parked = baseline->Refine(graph, 1.0, {{4, 0.0}});
   ASSERT_FALSE(parked.ok());
   EXPECT_TRUE(parked.error().code == ErrorCode::kUnreachable || parked.error().code == ErrorCode::kFailedPrecondition)
       << parked.error().message;
