@@ -79,6 +79,7 @@ storage::RobotRecord HelloRecord(storage::RobotRecord record, const RobotInbound
     record.robot.battery.reset();  // stored by an older server that took any report
   }
   record.kind = hello.robot_kind.empty() ? "differential" : hello.robot_kind;
+  record.robot.kind = engine::ParseRobotKind(record.kind).value_or(engine::RobotKind::kDifferential);
   record.last_seen = now;
   record.last_acked_sequence = std::max(record.last_acked_sequence, hello.last_acked_sequence);
   if (record.next_sequence <= record.last_acked_sequence) record.next_sequence = record.last_acked_sequence + 1;

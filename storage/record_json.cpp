@@ -132,6 +132,7 @@ Result<std::string> EncodeRobotBody(const engine::Robot& robot, const engine::Op
   }
   json j;
   j["diameter"] = robot.diameter;
+  if (robot.kind != engine::RobotKind::kDifferential) j["kind"] = engine::RobotKindName(robot.kind);
   j["max_speed"] = robot.max_speed;
   j["pose"] = {p.position.x(), p.position.y(), p.heading};
   j["current_point"] = robot.current_point;
@@ -148,6 +149,10 @@ Result<std::string> EncodeRobotBody(const engine::Robot& robot, const engine::Op
 Status DecodeRobotBody(const std::string& body, engine::Robot& robot, engine::OperatorMarks* marks) {
   return ReadJson("robot", body, [&](const json& j) -> Status {
     robot.diameter = j.at("diameter").get<double>();
+    const std::string kind = j.value("kind", std::string("differential"));  // older bodies: none
+    const auto parsed = engine::ParseRobotKind(kind);
+    if (!parsed) return Corrupt("robot", "unknown kind '" + kind + "'");
+    robot.kind = *parsed;
     robot.max_speed = j.at("max_speed").get<double>();
     const json& pose = j.at("pose");
     if (!pose.is_array() || pose.size() != 3) return Corrupt("robot", "pose is not [x, y, heading]");
@@ -174,9 +179,17 @@ Result<std::string> EncodeWaypoints(const std::vector<engine::Waypoint>& waypoin
       return engine::InvalidArgument("waypoint " + std::to_string(w.seq) +
                                      ": non-finite position, eta or dwell");
     }
-    // [seq, point, x, y, eta, action, dwell]: compact, plans can be long.
-    list.push_back(
-        {w.seq, w.point, w.xy.x(), w.xy.y(), w.eta, engine::WaypointActionName(w.action), w.dwell});
+    // [seq, point, x, y, eta, action, dwell]: compact, plans can be long; a four-wheel-steer
+    // robot's pose in a free space adds [heading, mode] (null for what is not set).
+    json row = {w.seq, w.point, w.xy.x(), w.xy.y(), w.eta, engine::WaypointActionName(w.action), w.dwell};
+    if (w.heading || w.mode) {
+      if (w.heading && !std::isfinite(*w.heading)) {
+        return engine::InvalidArgument("waypoint " + std::to_string(w.seq) + ": non-finite heading");
+      }
+      row.push_back(w.heading ? json(*w.heading) : json(nullptr));
+      row.push_back(w.mode ? json(engine::MotionModeName(*w.mode)) : json(nullptr));
+    }
+    list.push_back(std::move(row));
   }
   return list.dump();
 }
@@ -186,7 +199,9 @@ Result<std::vector<engine::Waypoint>> DecodeWaypoints(const std::string& text) {
   Status status = ReadJson("plan", text, [&](const json& list) -> Status {
     if (!list.is_array()) return Corrupt("plan", "waypoints are not a list");
     for (const json& row : list) {
-      if (!row.is_array() || row.size() != 7) return Corrupt("plan", "waypoint is not a 7-tuple");
+      if (!row.is_array() || (row.size() != 7 && row.size() != 9)) {
+        return Corrupt("plan", "waypoint is not a 7- or 9-tuple");
+      }
       engine::Waypoint w;
       w.seq = row[0].get<int>();
       w.point = row[1].get<engine::PointId>();
@@ -196,6 +211,14 @@ Result<std::vector<engine::Waypoint>> DecodeWaypoints(const std::string& text) {
       if (!action) return Corrupt("plan", "unknown action " + row[5].dump());
       w.action = *action;
       w.dwell = row[6].get<double>();
+      if (row.size() == 9) {
+        if (!row[7].is_null()) w.heading = row[7].get<double>();
+        if (!row[8].is_null()) {
+          const auto mode = engine::ParseMotionMode(row[8].get<std::string>());
+          if (!mode) return Corrupt("plan", "unknown motion mode " + row[8].dump());
+          w.mode = *mode;
+        }
+      }
       out.push_back(w);
     }
     return engine::Ok{};

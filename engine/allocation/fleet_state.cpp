@@ -130,6 +130,20 @@ Status FleetState::AssignSingle(std::size_t robot, const std::string& order_id,
     return Error{segment.error().code,
                  "order " + order_id + " for robot " + e.info.id + ": " + segment.error().message};
   }
+  if (free_space_ && e.info.kind == RobotKind::kFourWheelSteer) {
+    Result<Plan> refined = free_space_->Refine(*segment, config_.speed);
+    if (!refined.ok()) {
+      ++free_space_fallbacks_;
+    } else {
+      for (const Waypoint& w : refined->waypoints) {
+        if (w.mode) {
+          ++free_space_refined_;
+          break;
+        }
+      }
+      segment = std::move(refined);
+    }
+  }
   const double travel = routes_->Cost(s.end_point, task.picks.front()) + TaskTravelTime(task);
   AppendTask(e, order_id, task, segment->waypoints, travel);
   return Ok{};

@@ -34,7 +34,9 @@
 #include "engine/allocation/traffic_prediction.h"
 #include "engine/common/result.h"
 #include "engine/fleet/plan.h"
+#include "engine/fleet/robot.h"
 #include "engine/map/warehouse_map.h"
+#include "engine/motion/free_space_plan.h"
 #include "engine/routing/route_table.h"
 
 namespace dispatch::engine {
@@ -43,6 +45,7 @@ struct FleetRobot {
   std::string id;
   PointId start = kNoPoint;
   double ready_time = 0.0;  // seconds; when the robot can start its first task
+  RobotKind kind = RobotKind::kDifferential;
 };
 
 struct QueuedTask {
@@ -132,6 +135,15 @@ class FleetState {
   Status AssignFormation(const std::array<std::size_t, 3>& team, const std::string& order_id,
                          const PlanTask& task);
 
+  // From now on AssignSingle plans a four-wheel-steer robot's segment through the map's
+  // free-space regions (FreeSpaceMotion::Refine, with the graph's headings at its stops); null:
+  // on the lanes, as every robot. A segment the hybrid A* cannot refine (an anchor pose that
+  // does not fit the region, no path, the search limits) keeps its lanes and is counted. The
+  // bids still price the lanes' times (the refined legs are usually a few seconds longer).
+  void UseFreeSpace(std::shared_ptr<const FreeSpaceMotion> motion) { free_space_ = std::move(motion); }
+  std::size_t free_space_refined() const { return free_space_refined_; }
+  std::size_t free_space_fallbacks() const { return free_space_fallbacks_; }
+
  private:
   struct RobotEntry {
     FleetRobot info;
@@ -156,6 +168,9 @@ class FleetState {
   std::vector<RobotEntry> robots_;
   std::unordered_map<std::string, std::size_t> index_;
   std::unique_ptr<TrafficPredictor> predictor_;
+  std::shared_ptr<const FreeSpaceMotion> free_space_;
+  std::size_t free_space_refined_ = 0;
+  std::size_t free_space_fallbacks_ = 0;
 };
 
 }  // namespace dispatch::engine

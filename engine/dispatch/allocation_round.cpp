@@ -45,10 +45,22 @@ RoundRunner::RoundRunner(std::shared_ptr<const WarehouseMap> map, std::shared_pt
       allocator_(std::move(allocator)),
       stopwatch_(std::move(stopwatch)) {}
 
+std::shared_ptr<const FreeSpaceMotion> RoundRunner::FreeSpace(std::vector<std::string>& notes) {
+  if (free_space_tried_ || map_->free_spaces().empty()) return free_space_;
+  free_space_tried_ = true;
+  auto motion = FreeSpaceMotion::Create(map_);
+  if (!motion.ok()) {
+    notes.push_back("allocation: free-space regions not used: " + motion.error().message);
+    return nullptr;
+  }
+  free_space_ = std::make_shared<const FreeSpaceMotion>(std::move(motion).value());
+  return free_space_;
+}
+
 RoundResult RoundRunner::Run(const RoundInput& input) {
   RoundResult out;
   std::vector<FleetRobot> fleet_robots;
-  for (const RoundRobot& r : input.robots) fleet_robots.push_back({r.id, r.start, input.now});
+  for (const RoundRobot& r : input.robots) fleet_robots.push_back({r.id, r.start, input.now, r.kind});
   // The prediction's buckets start at the round's bucket, not at time 0: the same bucket
   // times (a whole number of buckets later), without counts for the hours already past (a
   // round late in a run allocated and cleared zones x buckets since the start).
@@ -63,7 +75,8 @@ RoundResult RoundRunner::Run(const RoundInput& input) {
     return out;
   }
   FleetState state = std::move(fleet).value();
-  zone_index_ = state.zone_index();  // one floor, one index: the next round skips the grid
+  zone_index_ = state.zone_index();
+  if (config_.planner == PlannerKind::kRules) state.UseFreeSpace(FreeSpace(out.notes));  // one floor, one index: the next round skips the grid
   // The predictor sees each robot once: its replayed queue (not once per order, nor its
   // start first), or its start.
   for (std::size_t i = 0; i < input.robots.size(); ++i) {

@@ -41,6 +41,7 @@ struct RoundRobot {
   bool has_queue() const { return assignment && !assignment->order_ids.empty(); }
   std::uint64_t last_reached = 0;
   std::vector<std::shared_ptr<const Order>> queue;  // the orders of assignment.order_ids
+  RobotKind kind = RobotKind::kDifferential;        // four-wheel steer: see FleetState::UseFreeSpace
 };
 
 struct RoundInput {
@@ -81,6 +82,10 @@ class RoundRunner {
   // replayed.
   bool ReplayQueue(FleetState& fleet, std::size_t index, const RoundRobot& robot,
                    std::vector<std::string>& notes) const;
+  // The map's free-space regions for four-wheel-steer robots (engine/motion/free_space_plan.h),
+  // built by the first round that needs them; null on a map without any (or when they cannot
+  // be built: a note says why, once).
+  std::shared_ptr<const FreeSpaceMotion> FreeSpace(std::vector<std::string>& notes);
 
   std::shared_ptr<const WarehouseMap> map_;
   std::shared_ptr<const RouteTable> routes_;
@@ -88,6 +93,8 @@ class RoundRunner {
   std::unique_ptr<Allocator> allocator_;
   std::function<double()> stopwatch_;
   std::shared_ptr<const ZoneIndex> zone_index_;  // built by the first round, kept
+  std::shared_ptr<const FreeSpaceMotion> free_space_;
+  bool free_space_tried_ = false;
 };
 
 }  // namespace dispatch::engine

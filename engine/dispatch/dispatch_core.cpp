@@ -235,6 +235,7 @@ std::optional<RoundInput> DispatchCore::MakeRound(double now, RoundCommit& commi
     const BookRobot& r = *robot;
     RoundRobot rr;
     rr.id = id;
+    rr.kind = r.robot.kind;
     rr.start = StartOf(r);
     if (r.has_assignment && !r.assignment.order_ids.empty()) {
       if (!r.round_copy) r.round_copy = std::make_shared<const Assignment>(r.assignment);

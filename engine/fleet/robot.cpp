@@ -27,6 +27,17 @@ std::optional<RobotState> ParseRobotState(std::string_view name) {
   return std::nullopt;
 }
 
+const char* RobotKindName(RobotKind kind) {
+  return kind == RobotKind::kFourWheelSteer ? "four_wheel_steer" : "differential";
+}
+
+std::optional<RobotKind> ParseRobotKind(std::string_view name) {
+  for (RobotKind k : {RobotKind::kDifferential, RobotKind::kFourWheelSteer}) {
+    if (name == RobotKindName(k)) return k;
+  }
+  return std::nullopt;
+}
+
 Status ValidateRobot(const Robot& robot) {
   if (robot.id.empty()) return InvalidArgument("robot id is empty");
   const std::string who = "robot '" + robot.id + "': ";

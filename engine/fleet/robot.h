@@ -24,6 +24,14 @@ enum class RobotState { kIdle, kMoving, kWorking, kWaiting, kParked, kCharging, 
 const char* RobotStateName(RobotState state);
 std::optional<RobotState> ParseRobotState(std::string_view name);
 
+// How a robot moves (its Hello says): a differential drive follows the road graph; a
+// four-wheel-steer (4WIS) robot follows it too, and inside the map's free-space regions the
+// hybrid A*'s paths (crab, spin, steer; engine/motion/free_space_plan.h).
+enum class RobotKind { kDifferential, kFourWheelSteer };
+// "differential", "four_wheel_steer".
+const char* RobotKindName(RobotKind kind);
+std::optional<RobotKind> ParseRobotKind(std::string_view name);
+
 struct Pose {
   Eigen::Vector2d position = Eigen::Vector2d::Zero();  // metres
   double heading = 0.0;                                // radians, counter-clockwise from +x
@@ -31,6 +39,7 @@ struct Pose {
 
 struct Robot {
   std::string id;
+  RobotKind kind = RobotKind::kDifferential;
   double diameter = 0.4;   // metres (Chu2024 §4.1)
   double max_speed = 1.0;  // v, m/s
   RobotState state = RobotState::kIdle;

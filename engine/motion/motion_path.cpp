@@ -21,6 +21,13 @@ const char* MotionModeName(MotionMode mode) {
   return "?";
 }
 
+std::optional<MotionMode> ParseMotionMode(std::string_view name) {
+  for (int m = 0; m <= static_cast<int>(MotionMode::kArcReverseRight); ++m) {
+    if (name == MotionModeName(static_cast<MotionMode>(m))) return static_cast<MotionMode>(m);
+  }
+  return std::nullopt;
+}
+
 DriveClass DriveClassOf(MotionMode mode) {
   switch (mode) {
     case MotionMode::kForward:

@@ -9,7 +9,9 @@
 #pragma once
 
 #include <cstddef>
+#include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 namespace dispatch::engine {
@@ -36,6 +38,7 @@ enum class MotionMode {
 // "forward", "reverse", "crab_left", "crab_right", "spin_left", "spin_right",
 // "arc_forward_left", "arc_forward_right", "arc_reverse_left", "arc_reverse_right".
 const char* MotionModeName(MotionMode mode);
+std::optional<MotionMode> ParseMotionMode(std::string_view name);
 
 // What a change of mode costs the robot: a stop and a new wheel setting. Straight and arcs in
 // the same direction of travel share a class (steering on the move needs no stop; the turn

@@ -41,6 +41,7 @@ class CoreRun {
       }
       Robot r;
       r.id = fr.id;
+      r.kind = fr.kind;
       r.max_speed = config_.allocation.speed;
       r.current_point = fr.start;
       r.pose.position = map_->point(fr.start).position;

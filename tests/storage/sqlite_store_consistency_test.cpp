@@ -162,7 +162,9 @@ TEST_F(SqliteStoreTest, RobotsAssignmentsAndMapVersions) {
   ASSERT_NE(store, nullptr);
   RobotRecord r;
   r.robot.id = "R2";
+  r.robot.kind = engine::RobotKind::kFourWheelSteer;
   ASSERT_TRUE(store->UpsertRobot(r).ok());
+  r.robot.kind = engine::RobotKind::kDifferential;
   r.robot.id = "R1";
   ASSERT_TRUE(store->UpsertRobot(r).ok());
   r.robot.state = engine::RobotState::kOffline;
@@ -173,6 +175,8 @@ TEST_F(SqliteStoreTest, RobotsAssignmentsAndMapVersions) {
   EXPECT_EQ(robots[0].robot.id, "R1");
   EXPECT_EQ(robots[0].robot.state, engine::RobotState::kOffline);
   EXPECT_EQ(robots[0].last_acked_sequence, 9u);
+  EXPECT_EQ(robots[0].robot.kind, engine::RobotKind::kDifferential);
+  EXPECT_EQ(robots[1].robot.kind, engine::RobotKind::kFourWheelSteer);
   EXPECT_EQ(store->GetRobot("R9").error().code, ErrorCode::kNotFound);
   RobotRecord nameless;
   EXPECT_EQ(store->UpsertRobot(nameless).error().code, ErrorCode::kInvalidArgument);
@@ -185,6 +189,20 @@ TEST_F(SqliteStoreTest, RobotsAssignmentsAndMapVersions) {
   a.plan_id = 2;
   ASSERT_TRUE(store->SaveAssignment(a).ok());
   EXPECT_EQ(store->GetAssignment("R1")->plan_id, 2u);
+  // A four-wheel-steer robot's poses in a free space keep their heading and mode.
+  a.plan.waypoints.push_back({1, 1, {0.5, 0.2}, 1.0, engine::WaypointAction::kMove, 0.0, 0.25,
+                              engine::MotionMode::kCrabLeft});
+  a.plan.waypoints.push_back({2, 1, {0.5, 0.2}, 2.0, engine::WaypointAction::kMove, 0.0, 1.5, std::nullopt});
+  ASSERT_TRUE(store->SaveAssignment(a).ok());
+  const auto posed = store->GetAssignment("R1")->plan.waypoints;
+  ASSERT_EQ(posed.size(), 3u);
+  EXPECT_FALSE(posed[0].heading.has_value());
+  EXPECT_FALSE(posed[0].mode.has_value());
+  EXPECT_EQ(posed[1].heading, 0.25);
+  EXPECT_EQ(posed[1].mode, engine::MotionMode::kCrabLeft);
+  EXPECT_EQ(posed[2].heading, 1.5);
+  EXPECT_FALSE(posed[2].mode.has_value());
+  a.plan.waypoints.resize(1);
   EXPECT_EQ(store->ListAssignments().value().size(), 1u);
   a.plan.robot_id = "R2";
   EXPECT_EQ(store->SaveAssignment(a).error().code, ErrorCode::kInvalidArgument);

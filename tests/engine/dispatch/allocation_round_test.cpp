@@ -48,7 +48,7 @@ TEST(AllocationRound, AwardsEveryOrderWithWholePlansForRobotsWithoutQueues) {
   const auto drops = PointsOfKind(map, PointKind::kDrop);
   RoundInput input;
   input.now = 100.0;
-  for (int i = 0; i < 3; ++i) input.robots.push_back({"R" + std::to_string(i + 1), parks.at(static_cast<std::size_t>(i) * 6), {}, 0, {}});
+  for (int i = 0; i < 3; ++i) input.robots.push_back({"R" + std::to_string(i + 1), parks.at(static_cast<std::size_t>(i) * 6), {}, 0, {}, {}});
   input.pending = {MakeOrder("o1", picks.at(3), drops.at(0), 1.0), MakeOrder("o2", picks.at(90), drops.at(9), 2.0)};
   RoundRunner runner = Runner();
   const RoundResult result = runner.Run(input);
@@ -82,7 +82,7 @@ TEST(AllocationRound, QueuesAreReplayedFromStoredPlansAndNewWorkFollowsThem) {
   RoundRunner runner = Runner();
   // Round 1: one robot gets o1.
   RoundInput first;
-  first.robots = {{"R1", parks.at(0), {}, 0, {}}};
+  first.robots = {{"R1", parks.at(0), {}, 0, {}, {}}};
   auto o1 = MakeOrder("o1", picks.at(3), drops.at(0), 0.0);
   first.pending = {o1};
   RoundResult r1 = runner.Run(first);
@@ -93,7 +93,7 @@ TEST(AllocationRound, QueuesAreReplayedFromStoredPlansAndNewWorkFollowsThem) {
   // Round 2, a few seconds later, with the robot past its first waypoints: o2 goes behind o1.
   RoundInput second;
   second.now = 5.0;
-  RoundRobot robot{"R1", book.plan.waypoints.at(2).point, std::make_shared<const Assignment>(book), 2, {o1}};
+  RoundRobot robot{"R1", book.plan.waypoints.at(2).point, std::make_shared<const Assignment>(book), 2, {o1}, {}};
   second.robots = {robot};
   second.pending = {MakeOrder("o2", picks.at(40), drops.at(5), 4.0)};
   RoundResult r2 = runner.Run(second);
@@ -124,7 +124,7 @@ TEST_P(BatchStrategyRound, EachAwardHoldsThePartOfThePlanItAdded) {
   const auto drops = PointsOfKind(map, PointKind::kDrop);
   RoundInput input;
   input.now = 10.0;
-  for (int i = 0; i < 2; ++i) input.robots.push_back({"R" + std::to_string(i + 1), parks.at(static_cast<std::size_t>(i) * 9), {}, 0, {}});
+  for (int i = 0; i < 2; ++i) input.robots.push_back({"R" + std::to_string(i + 1), parks.at(static_cast<std::size_t>(i) * 9), {}, 0, {}, {}});
   for (int k = 0; k < 5; ++k) {
     const auto u = static_cast<std::size_t>(k);
     input.pending.push_back(MakeOrder("o" + std::to_string(k), picks.at(7 * u + 2), drops.at(u % drops.size()), k));
