@@ -161,6 +161,8 @@ void RoutesToProto(const OrderRoutes& routes, pb::OrderDetail* out) {
       p->mutable_position()->set_y(w.xy.y());
       p->set_action(ActionToProto(w.action));
       p->set_released(w.released);
+      if (w.heading) p->set_heading(*w.heading);
+      if (w.mode) p->set_motion_mode(MotionModeToProto(*w.mode));
     }
   }
 }

@@ -87,7 +87,7 @@ OrderRoutes DispatchCore::RoutesOf(const std::string& order_id) const {
       const Waypoint& w = a.plan.waypoints[i];
       const auto seq = static_cast<std::uint64_t>(w.seq);
       if (order_of[i] == order_id && seq > r->progress.last_reached) {
-        route.push_back({seq, w.xy, w.action, seq <= released});
+        route.push_back({seq, w.xy, w.action, seq <= released, w.heading, w.mode});
       }
     }
   }

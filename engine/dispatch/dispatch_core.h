@@ -200,6 +200,8 @@ struct RouteWaypoint {
   Eigen::Vector2d xy = Eigen::Vector2d::Zero();
   WaypointAction action = WaypointAction::kMove;
   bool released = false;
+  std::optional<double> heading;   // a four-wheel-steer robot's pose in a free space (Waypoint)
+  std::optional<MotionMode> mode;
 };
 using OrderRoutes = std::map<std::string, std::vector<RouteWaypoint>>;  // by robot id
 

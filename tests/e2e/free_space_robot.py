@@ -1,0 +1,76 @@
+#!/usr/bin/env python3
+"""A four-wheel-steer robot through the service (issue 17 §3): dispatchd on a JSON map with a
+free-space region (bay_map.json: a 1.4 m wide dead-end bay, its pick K at the closed end, the
+drop outside), fleet-sim with two robots, R1 saying in its Hello that it is four-wheel steer
+(--kinds) and R2 a differential drive; REST lists them so. An order into the bay goes to R1
+(nearer); the route the service shows for it (GET /api/v1/orders/{id}) holds poses with a
+heading and a motion mode inside the bay, a turn among them (the robot turns round there; on
+the lanes it would just drive back), fleet-sim drives them, and the order completes with the
+robots never closer than eps1. (That a differential robot keeps its lanes is the core test's,
+FreeSpaceRound; two robots picking at the closed end of one bay lock each other up, see the
+closing note of 2026-12-06.)
+
+    free_space_robot.py --stubs DIR --dispatchd BIN --fleet-sim BIN --wmsctl BIN --scenarios DIR
+"""
+import os
+import sys
+import uuid
+
+sys.dont_write_bytecode = True  # no __pycache__ in the source tree
+sys.path.insert(0, sys.argv[sys.argv.index("--stubs") + 1])
+from e2e_harness import (ASSIGNED, COMPLETED, IN_PROGRESS, Harness, check,  # noqa: E402
+                         common_arguments, state_name)
+from warehouse.dispatch.v1 import common_pb2, orders_pb2  # noqa: E402
+
+MAP = os.path.join(os.path.dirname(os.path.abspath(__file__)), "bay_map.json")
+PICK, DROP = (6.5, 0.8), (1.5, 2.8)  # K at the bay's end, D outside
+TURNS = {"MOTION_MODE_SPIN_LEFT", "MOTION_MODE_SPIN_RIGHT", "MOTION_MODE_REVERSE",
+         "MOTION_MODE_ARC_REVERSE_LEFT", "MOTION_MODE_ARC_REVERSE_RIGHT"}
+
+
+def submit(server, tag):
+    r = orders_pb2.SubmitOrderRequest(
+        client_order_id=f"bay-{tag}-{uuid.uuid4().hex[:8]}",
+        picks=[orders_pb2.StopSpec(position=common_pb2.Vec2(x=PICK[0], y=PICK[1]))],
+        drop=orders_pb2.StopSpec(position=common_pb2.Vec2(x=DROP[0], y=DROP[1])))
+    return server.orders.SubmitOrder(r, timeout=10).order.id
+
+
+def route_of(server, order_id):
+    """(robot, waypoints) of the order's remaining route, once it has one."""
+    routes = server.rest(f"/api/v1/orders/{order_id}").get("routes") or {}
+    return next(((robot, route.get("waypoints", [])) for robot, route in routes.items()), None)
+
+
+def main():
+    args = common_arguments(__doc__).parse_args()
+    with Harness(args, "freespace") as h:
+        server = h.start_server(["--map", MAP, "--time-scale", "2"])
+        h.start_fleet(server, 2, ["--kinds", "four_wheel_steer,differential"])
+        kinds = h.wait_for(lambda: (lambda k: len(k) == 2 and k)(
+            {r["id"]: r.get("kind") for r in server.rest("/api/v1/robots")["robots"]}), 10, "both robots listed")
+        check(kinds == {"R1": "ROBOT_KIND_FOUR_WHEEL_STEER", "R2": "ROBOT_KIND_DIFFERENTIAL"},
+              f"robot kinds listed: {kinds}")
+
+        first = submit(server, "1")
+        h.watch(server, lambda o: first in o and o[first].state in (ASSIGNED, IN_PROGRESS),
+                timeout=20, what="the first order assigned", order_ids=[first])
+        robot, waypoints = h.wait_for(lambda: route_of(server, first), 10, "the first order's route")
+        check(robot == "R1", f"the first order went to {robot}, not the nearer R1")
+        posed = [w for w in waypoints if "heading" in w]
+        modes = {w.get("motion_mode", "MOTION_MODE_UNSPECIFIED") for w in posed} - {"MOTION_MODE_UNSPECIFIED"}
+        h.log(f"{first} on {robot}: {len(waypoints)} waypoints left, {len(posed)} posed, modes {sorted(modes)}")
+        check(len(posed) >= 5 and modes, f"poses with a heading: {len(posed)}, modes {sorted(modes)}")
+        check(modes & TURNS, f"no turn in the bay among {sorted(modes)}")
+        for w in posed:  # inside the bay
+            x, y = w["position"].get("x", 0.0), w["position"].get("y", 0.0)
+            check(2.0 <= x <= 8.0 and 0.1 <= y <= 1.5, f"a pose at ({x}, {y}) is outside the bay")
+
+        done = h.watch(server, lambda o: first in o and o[first].state == COMPLETED,
+                       timeout=60, what="the order completed", order_ids=[first])
+        h.log("states: " + ", ".join(f"{k}={state_name(v.state)}" for k, v in sorted(done.items())))
+        h.check_min_distance(server)
+
+
+if __name__ == "__main__":
+    main()
