@@ -75,8 +75,8 @@ RoundResult RoundRunner::Run(const RoundInput& input) {
     return out;
   }
   FleetState state = std::move(fleet).value();
-  zone_index_ = state.zone_index();
-  if (config_.planner == PlannerKind::kRules) state.UseFreeSpace(FreeSpace(out.notes));  // one floor, one index: the next round skips the grid
+  zone_index_ = state.zone_index();  // one floor, one index: the next round skips the grid
+  if (config_.planner == PlannerKind::kRules) state.UseFreeSpace(FreeSpace(out.notes));
   // The predictor sees each robot once: its replayed queue (not once per order, nor its
   // start first), or its start.
   for (std::size_t i = 0; i < input.robots.size(); ++i) {
