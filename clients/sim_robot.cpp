@@ -216,7 +216,9 @@ void SimRobot::Step(double now, std::vector<v1::RobotMessage>& out) {
     }
     if (v <= 0.0 || t >= now_) break;
     const double want = std::atan2(d.y(), d.x());
-    const bool posed = front.wp.has_heading();  // four-wheel steer: its modes, no turn first
+    // Four-wheel steer in a free space: its modes, no turn first. (A waypoint with a heading
+    // and no mode, where the robot enters a free space, is reached along its lane.)
+    const bool posed = front.wp.has_heading() && front.wp.motion_mode() != v1::MOTION_MODE_UNSPECIFIED;
     if (turning_to_ != front.wp.sequence()) {  // a new leg: turn to it first
       turning_to_ = front.wp.sequence();
       leg_from_ = position_;

@@ -28,8 +28,9 @@
 // none before its first move), as the engine's simulated robot (engine/sim/waypoint_robot.h)
 // and the dispatcher's --turn-time plans it.
 //
-// Four-wheel-steer motion (a waypoint with a heading: the dispatcher plans such robots by the
-// hybrid A* inside free-space regions, engine/motion/free_space_plan.h): the robot drives the
+// Four-wheel-steer motion (a waypoint with a heading and a motion mode: the dispatcher plans
+// such robots by the hybrid A* inside free-space regions, engine/motion/free_space_plan.h;
+// reached, any waypoint with a heading sets the robot's): the robot drives the
 // leg without turning first and without facing along it — a crab keeps its heading, an arc
 // or a spin turns it evenly over the leg (a spin, a leg of no length, at once) — and reaches
 // the waypoint with the planned heading.
