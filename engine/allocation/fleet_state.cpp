@@ -132,17 +132,7 @@ Status FleetState::AssignSingle(std::size_t robot, const std::string& order_id,
   }
   if (free_space_ && e.info.kind == RobotKind::kFourWheelSteer) {
     Result<Plan> refined = free_space_->Refine(*segment, config_.speed);
-    if (!refined.ok()) {
-      ++free_space_fallbacks_;
-    } else {
-      for (const Waypoint& w : refined->waypoints) {
-        if (w.mode) {
-          ++free_space_refined_;
-          break;
-        }
-      }
-      segment = std::move(refined);
-    }
+    if (refined.ok()) segment = std::move(refined);  // else: its lanes
   }
   const double travel = routes_->Cost(s.end_point, task.picks.front()) + TaskTravelTime(task);
   AppendTask(e, order_id, task, segment->waypoints, travel);

@@ -138,11 +138,9 @@ class FleetState {
   // From now on AssignSingle plans a four-wheel-steer robot's segment through the map's
   // free-space regions (FreeSpaceMotion::Refine, with the graph's headings at its stops); null:
   // on the lanes, as every robot. A segment the hybrid A* cannot refine (an anchor pose that
-  // does not fit the region, no path, the search limits) keeps its lanes and is counted. The
-  // bids still price the lanes' times (the refined legs are usually a few seconds longer).
+  // does not fit the region, no path, the search limits) keeps its lanes. The bids still
+  // price the lanes' times (the refined legs are usually a few seconds longer).
   void UseFreeSpace(std::shared_ptr<const FreeSpaceMotion> motion) { free_space_ = std::move(motion); }
-  std::size_t free_space_refined() const { return free_space_refined_; }
-  std::size_t free_space_fallbacks() const { return free_space_fallbacks_; }
 
  private:
   struct RobotEntry {
@@ -169,8 +167,6 @@ class FleetState {
   std::unordered_map<std::string, std::size_t> index_;
   std::unique_ptr<TrafficPredictor> predictor_;
   std::shared_ptr<const FreeSpaceMotion> free_space_;
-  std::size_t free_space_refined_ = 0;
-  std::size_t free_space_fallbacks_ = 0;
 };
 
 }  // namespace dispatch::engine
