@@ -191,11 +191,25 @@ bool TrafficController::Impl::StartAllowed(std::size_t r,
   return true;
 }
 
+PointId TrafficController::Impl::StickyBan(std::size_t r) {
+  RobotState& x = robots[r];
+  if (x.avoiding == kNoPoint) return kNoPoint;
+  if (x.avoiding != x.at && (x.route.empty() || x.avoiding != x.route.back()) &&
+      PointBlocker(x.avoiding, r) == x.avoiding_holder) {
+    return x.avoiding;
+  }
+  x.avoiding = kNoPoint;
+  x.avoiding_holder = -1;
+  return kNoPoint;
+}
+
 // Re-plans robot r's route to its goal avoiding what it waits for; true when applied.
 bool TrafficController::Impl::TryDetour(std::size_t r, PointId ban_point, int ban_corridor,
                                         int ban_guard, bool need_free_first_hop) {
   RobotState& x = robots[r];
   if (x.pos + 1 >= x.route.size()) return false;
+  const int holder = ban_point != kNoPoint ? PointBlocker(ban_point, r) : -1;
+  if (ban_point == kNoPoint) ban_point = StickyBan(r);
   // Detours more than blocked_after longer than the current route are not worth taking
   // (and bounding keeps a failing search from sweeping the whole floor).
   const double bound = RouteCost(x) + config.blocked_after;
@@ -203,14 +217,29 @@ bool TrafficController::Impl::TryDetour(std::size_t r, PointId ban_point, int ba
   if (d.points.size() < 2 || !StartAllowed(r, d.points)) return false;
   if (need_free_first_hop && PointBlocker(d.points[1], r) >= 0) return false;
   if (!Assign(r, std::move(d.points)).ok()) return false;
+  if (holder >= 0) {
+    x.avoiding = ban_point;
+    x.avoiding_holder = holder;
+  }
   Replanned(x);
   ClearWait(x);
   return true;
 }
 
+int TrafficController::Impl::NextCorridor(std::size_t w) const {
+  const RobotState& x = robots[w];
+  if (x.wait == WaitKind::kCorridor && x.wait_corridor >= 0) return x.wait_corridor;
+  return x.pos < x.arcs.size() ? CorridorOf(x.arcs[x.pos]) : -1;
+}
+
 // Steps robot r to a free neighbour (not `avoid`, not an intersection point) and re-plans
-// from there to its goal (if it has one), preferring routes that avoid `ban_point`.
-bool TrafficController::Impl::TryBackOff(std::size_t r, PointId avoid, PointId ban_point) {
+// from there to its goal (if it has one), preferring routes that avoid `ban_point`. Not to a
+// point inside corridor `keep_out` when its route from there comes back through where it
+// stood: it would hold that corridor against the other again at once. Found on a dense grid
+// with the time-window planner: a robot inside a one-cell aisle backed off one cell and drove
+// back, thousands of times, while the robot at the aisle's end waited on it until both were
+// blocked (the one at the end had a way round).
+bool TrafficController::Impl::TryBackOff(std::size_t r, PointId avoid, PointId ban_point, int keep_out) {
   RobotState& x = robots[r];
   const PointId goal = x.pos + 1 < x.route.size() ? x.route.back() : kNoPoint;
   for (ArcId a : M().out_arcs(x.at)) {
@@ -229,6 +258,12 @@ bool TrafficController::Impl::TryBackOff(std::size_t r, PointId avoid, PointId b
       Detour d = Route(n, goal, ban_point, -1, -1, bound);
       if (d.points.empty()) d = Route(n, goal, kNoPoint, -1, -1, bound);
       if (d.points.empty()) continue;
+      // Inside the corridor the other must enter and back through where it stood: it would
+      // hold that corridor the other way again at once.
+      if (keep_out >= 0 && lanes.interior_of[static_cast<std::size_t>(n)] == keep_out &&
+          std::find(d.points.begin(), d.points.end(), x.at) != d.points.end()) {
+        continue;
+      }
       route.insert(route.end(), d.points.begin(), d.points.end());
     } else {
       route.push_back(n);
@@ -320,6 +355,13 @@ bool TrafficController::Impl::BreakCycle(const std::vector<std::size_t>& members
   std::vector<std::size_t> order = members;
   std::sort(order.begin(), order.end(),
             [&](std::size_t a, std::size_t b) { return Lower(a, b); });
+  // A robot in a detour livelock acts last: re-planned by every cycle it meets it never
+  // waits, and so is never found blocked (Request), while the others wait on it. Found on a
+  // dense grid with the time-window planner: a robot drove round two cycles in turn, each
+  // broken by its detour into the other, for 1,900 s while five robots waited on it (the run
+  // ended at its limit with 25 orders open). Skipping it altogether had it blocked where the
+  // re-plan would still have got it through.
+  std::stable_partition(order.begin(), order.end(), [&](std::size_t v) { return !Livelocked(robots[v], t); });
   for (std::size_t v : order) {
     RobotState& x = robots[v];
     if (x.working || x.next != kNoPoint || t < x.next_break_try) continue;
@@ -331,7 +373,11 @@ bool TrafficController::Impl::BreakCycle(const std::vector<std::size_t>& members
         x.wait == WaitKind::kCorridor ? TryDetour(v, kNoPoint, x.wait_corridor, -1, true)
         : x.wait == WaitKind::kGrant  ? TryDetour(v, kNoPoint, -1, M().IntersectionOf(want), true)
                                       : TryDetour(v, want, -1, -1, true);
-    if (ok || TryBackOff(v, want, want)) return true;
+    int keep_out = -1;  // the corridor the robot waiting on it must enter
+    for (std::size_t u : members) {
+      if (robots[u].waits_on == static_cast<int>(v)) keep_out = NextCorridor(u);
+    }
+    if (ok || TryBackOff(v, want, want, keep_out)) return true;
     x.next_break_try = t + 1.0;
   }
   return false;
@@ -386,7 +432,7 @@ std::size_t TrafficController::Impl::ResolveDeadlocks(double t) {
           ++stats.nudges;
         } else {
           const PointId want = w.pos + 1 < w.route.size() ? w.route[w.pos + 1] : kNoPoint;
-          if (TryBackOff(h, w.at, want) || MakeRoom(h, keep)) ++stats.nudges;
+          if (TryBackOff(h, w.at, want, NextCorridor(path[path.size() - 2])) || MakeRoom(h, keep)) ++stats.nudges;
         }
       }
     }

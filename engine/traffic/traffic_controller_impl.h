@@ -56,6 +56,10 @@ struct RobotState {
   PointId wait_point = kNoPoint;
   int wait_corridor = -1;
   int head_on_decided = -1;  // corridor whose head-on was decided in this wait
+  // The point its last detour went round, and the robot that held it then (-1: none): later
+  // detours keep going round it while that robot holds it (StickyBan).
+  PointId avoiding = kNoPoint;
+  int avoiding_holder = -1;
   std::string why;
   // Giving way (Wang2019 §3.3 case ②, GiveWay): to this robot (-1: none), until then at most.
   int give_way_to = -1;
@@ -141,6 +145,11 @@ struct TrafficController::Impl {
   // (RobotState::progress_*), measured on the bound route table (not without one).
   void NoteProgress(RobotState& x, double t);
   static void ForgetProgress(RobotState& x) { x.progress_goal = kNoPoint; }
+  // A detour livelock: re-planned back and forth (three times again at points it had
+  // re-planned at) and no closer to its goal for blocked_after.
+  bool Livelocked(const RobotState& x, double t) const {
+    return x.progress_goal != kNoPoint && x.replans_again >= 3 && t - x.progress_since >= config.blocked_after;
+  }
   // A re-plan of robot x (a detour, a back-off) at the point it stands at.
   void Replanned(RobotState& x) {
     ++stats.replans;
@@ -217,6 +226,12 @@ struct TrafficController::Impl {
 
   // Points, corridors, grants and waits (traffic_controller_requests.cpp).
   int PointBlocker(PointId q, std::size_t r) const { return PointBlocker(q, r, robots[r].envelope); }
+  // The point robot r's last detour went round while the robot that held it holds it still
+  // (else kNoPoint, and forgotten), to be avoided by its next detours too. Found on a dense
+  // grid: a robot that went round a point held by a robot standing at a drop met a third
+  // head-on on the way, and the head-on's detour, shorter than the one it drove, led back to
+  // the held point: round and back every 8 s until it was blocked.
+  PointId StickyBan(std::size_t r);
   // With r's envelope taken as `envelope` (an agent about to be placed with another one).
   int PointBlocker(PointId q, std::size_t r, double envelope) const;
   int CorridorBlocker(int c, int d, std::size_t r) const;
@@ -273,7 +288,11 @@ struct TrafficController::Impl {
   bool StartAllowed(std::size_t r, const std::vector<PointId>& points) const;
   bool TryDetour(std::size_t r, PointId ban_point, int ban_corridor, int ban_guard,
                  bool need_free_first_hop);
-  bool TryBackOff(std::size_t r, PointId avoid, PointId ban_point);
+  // Steps r back to a free neighbour outside `keep_out` (the corridor a robot waiting for r
+  // must enter, -1: none) and re-plans from there.
+  bool TryBackOff(std::size_t r, PointId avoid, PointId ban_point, int keep_out = -1);
+  // The corridor robot w's next arc runs in (the one it waits to enter, or holds), else -1.
+  int NextCorridor(std::size_t w) const;
   bool Siding(PointId p) const;
   bool StepAside(std::size_t r, const std::vector<PointId>& keep_clear);
   // An idle robot standing next to idle robot h steps aside (keeping `keep` and h's point

@@ -206,7 +206,7 @@ TrafficDecision TrafficController::Impl::Request(std::size_t r, double t) {
   // A detour livelock: re-planned back and forth (twice again at points it had re-planned at)
   // and no closer to its goal for blocked_after. Its alternatives are taken by robots that
   // wait for it: it has none left, like a robot blocked after waiting (Wang2019 §3.2 step 4).
-  if (x.progress_goal != kNoPoint && x.replans_again >= 3 && t - x.progress_since >= config.blocked_after) {
+  if (Livelocked(x, t)) {
     char buf[160];
     std::snprintf(buf, sizeof buf, "blocked after %.0f s at %s re-planning back and forth, no closer to %s: ",
                   t - x.progress_since, M().point(x.at).name.c_str(), M().point(x.progress_goal).name.c_str());

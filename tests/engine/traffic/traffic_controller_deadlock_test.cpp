@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <string>
 #include <vector>
@@ -109,6 +110,67 @@ TEST(TrafficControllerTest, AWaitingRobotOfLowerPriorityGivesWayOffTheOthersWay)
     EXPECT_GT(a_done, 0.0);
     EXPECT_GT(b_done, a_done);
   }
+}
+
+// A robot inside a corridor that the robot it waits for must enter does not back off inside
+// that corridor when its way on leads back through where it stood: it would still hold the
+// corridor the other way, and come straight back. X (lower priority) drives east down the
+// bottom corridor c16-c18 to the stub c20; Y stands at the junction c19, bound west down the
+// same corridor to c14. X has no way but through c19; Y has one round the top. Before, X backed
+// off to c17 and returned, again and again, while Y waited on it (found on a dense grid with
+// the time-window planner, until both were blocked); now Y goes round and both arrive.
+TEST(TrafficControllerTest, ABackOffInsideTheCorridorTheOtherNeedsIsNotTaken) {
+  auto map = Grid({"@.....@", "@.@@@.@", "......."});
+  TrafficController ctl = Make(map);
+  const std::size_t y = *ctl.AddRobot("Y", P(*map, "c19"));
+  const std::size_t x = *ctl.AddRobot("X", P(*map, "c18"));
+  ASSERT_TRUE(ctl.SetRoute(y, Route(*map, {"c19", "c18", "c17", "c16", "c15", "c14"})).ok());
+  ASSERT_TRUE(ctl.SetRoute(x, Route(*map, {"c18", "c19", "c20"})).ok());
+  double t = 0.0;
+  bool x_backed = false;
+  for (int i = 0; i < 40 && (ctl.At(x) != P(*map, "c20") || ctl.At(y) != P(*map, "c14")); ++i) {
+    Step(ctl, t += 1.0);
+    x_backed = x_backed || ctl.At(x) == P(*map, "c17") || ctl.Next(x) == P(*map, "c17");
+  }
+  EXPECT_FALSE(x_backed);
+  EXPECT_EQ(ctl.At(x), P(*map, "c20"));
+  EXPECT_EQ(ctl.At(y), P(*map, "c14"));
+  EXPECT_GE(ctl.stats().deadlocks_resolved, 1u);
+}
+
+// A detour keeps going round the point its robot last went round while the robot there holds
+// it: a later head-on's detour does not lead back to it. R, bound for c15, waits at c13 for
+// c14, where H works; after T_w2 it goes round by the top. Coming to the right-hand corridor
+// (c2 ... c16) it meets O driving the other way in it; the way round that corridor, c2-c8-c14,
+// is far shorter than the way on, but runs through c14 again, where H still works: R waits for
+// O instead. Before, it took it and came back to wait at c14 (found on a dense grid: round and
+// back every 8 s until it was blocked).
+TEST(TrafficControllerTest, AHeadOnDetourDoesNotLeadBackToThePointWentRound) {
+  auto map = Grid({"......", ".@.@@.", "......", "@@@@.@"});
+  TrafficController ctl = Make(map);
+  const std::size_t h = *ctl.AddRobot("H", P(*map, "c14"));
+  ctl.SetWorking(h, true, 1e9);
+  ctl.SetIdle(h, false);
+  const std::size_t r = *ctl.AddRobot("R", P(*map, "c12"));
+  const std::size_t o = *ctl.AddRobot("O", P(*map, "c22"));
+  ASSERT_TRUE(ctl.SetRoute(r, Route(*map, {"c12", "c13", "c14", "c15"})).ok());
+  double t = 0.0;
+  bool went_round = false;
+  for (int i = 0; i < 60 && ctl.stats().head_on.empty(); ++i) {
+    Step(ctl, t += 1.0);
+    if (!went_round && ctl.RemainingRoute(r).size() > 4) {  // gone round by the top: O sets off
+      went_round = true;
+      ASSERT_TRUE(ctl.SetRoute(o, Route(*map, {"c22", "c16", "c17", "c11", "c5", "c4", "c3", "c2", "c8"})).ok());
+    }
+  }
+  ASSERT_TRUE(went_round);
+  ASSERT_FALSE(ctl.stats().head_on.empty());
+  const HeadOnRecord& met = ctl.stats().head_on.front();
+  EXPECT_EQ(met.robot, "R");
+  EXPECT_EQ(met.oncoming, "O");
+  EXPECT_FALSE(met.replanned) << "wait " << met.wait_estimate << " s, detour +" << met.replan_extra << " s";
+  const auto route = ctl.RemainingRoute(r);
+  EXPECT_EQ(std::find(route.begin(), route.end(), P(*map, "c14")), route.end());
 }
 
 TEST(TrafficControllerTest, IdleRobotInTheWayIsNudgedToASiding) {
