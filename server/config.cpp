@@ -11,6 +11,7 @@
 #include <sstream>
 
 #include "engine/dispatch/strategy.h"
+#include "engine/traffic/traffic_controller.h"
 
 namespace dispatch::server {
 namespace {
@@ -66,6 +67,9 @@ std::vector<Key> Keys() {
       MakeKey("priority", &ServerConfig::priority),
       MakeKey("head_on_priority", &ServerConfig::head_on_priority),
       MakeKey("head_on_give_way", &ServerConfig::head_on_give_way),
+      {"execution",  // a name, or null: the planner's default
+       [](const nlohmann::json& j, ServerConfig& c) { c.execution = j.is_null() ? std::string() : j.get<std::string>(); },
+       [](const ServerConfig& c) { return c.execution.empty() ? nlohmann::json(nullptr) : nlohmann::json(c.execution); }},
       MakeKey("route_cache_mb", &ServerConfig::route_cache_mb),
       MakeKey("finished_retained", &ServerConfig::finished_retained),
       MakeKey("journal_runs", &ServerConfig::journal_runs),
@@ -149,6 +153,9 @@ engine::Status ValidateServerConfig(const ServerConfig& c) {
     for (const std::string& n : engine::PlannerNames()) names += (names.empty() ? "" : ", ") + n;
     return InvalidArgument("planner must be one of " + names + ", got '" + c.planner + "'");
   }
+  if (!c.execution.empty() && !engine::ParsePlanExecution(c.execution)) {
+    return InvalidArgument("execution must be times, claim or order, got '" + c.execution + "'");
+  }
   if (c.priority != "index" && c.priority != "release") {
     return InvalidArgument("priority must be index or release, got '" + c.priority + "'");
   }
@@ -220,6 +227,9 @@ engine::Result<ParsedCommandLine> ParseCommandLine(int argc, char** argv) {
   app.add_option("--head-on-give-way", flags.head_on_give_way,
                  "A waiting robot met head-on by a higher-priority one drives off its way (Wang2019 case 2)")
       ->capture_default_str();
+  app.add_option("--execution", flags.execution,
+                 "When a robot asks for its next point: times | claim | order (Wang2019 3.2); default: times "
+                 "with the rules planner, claim with the others");
   app.add_option("--routing", flags.routing, "floyd | heat (Wang2019 path heat, rules planner)")->capture_default_str();
   app.add_option("--heat-period", flags.heat_period, "Path heat: the period δ the lanes' use is counted over, s")
       ->capture_default_str();

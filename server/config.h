@@ -68,6 +68,10 @@ struct ServerConfig {
   // Wang2019 §3.3 case ②: a waiting robot met head-on by one of higher priority drives to the
   // nearest free point off its way and waits there (TrafficControllerConfig::head_on_give_way).
   bool head_on_give_way = false;
+  // When the traffic gate asks for a robot's next point (TrafficControllerConfig::execution):
+  // times, claim or order (Wang2019 §3.2); "" (the default; null in a config file): times with
+  // the rules planner, claim with the planned ones (engine::DefaultPlanExecution).
+  std::string execution;
   // Bound of the lazy route table's per-destination cache (large grid floors, where a dense
   // all-pairs table does not fit), MiB. It should hold the destinations in use at once (every
   // robot's next stop): on a 38k-cell floor one destination takes 0.46 MB.

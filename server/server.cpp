@@ -209,6 +209,8 @@ engine::Result<std::unique_ptr<DispatchServer>> DispatchServer::Start(const Serv
   options.traffic.priority_by_release = config.priority == "release";
   options.traffic.head_on_priority = config.head_on_priority;
   options.traffic.head_on_give_way = config.head_on_give_way;
+  options.traffic.execution =
+      engine::ParsePlanExecution(config.execution).value_or(engine::DefaultPlanExecution(allocation.planner));
   options.map_version = recorded->content_hash;
   options.metrics = s->metrics_.get();
   if (!store && config.journal_runs > 0) {

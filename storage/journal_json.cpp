@@ -160,7 +160,8 @@ Result<std::string> EncodeRunSetup(const RunSetup& s) {
                  {"head_on", HeadOnName(t.head_on)},
                  {"priority_by_release", t.priority_by_release},
                  {"head_on_priority", t.head_on_priority},
-                 {"head_on_give_way", t.head_on_give_way}};
+                 {"head_on_give_way", t.head_on_give_way},
+                 {"execution", engine::PlanExecutionName(t.execution)}};
     j["route_cache_bytes"] = s.route_cache_bytes;
     j["time_scale"] = s.time_scale;
     return j.dump();
@@ -227,6 +228,10 @@ Result<RunSetup> DecodeRunSetup(const std::string& text) {
     t.priority_by_release = k.value("priority_by_release", false);  // journals before it: by index
     t.head_on_priority = k.value("head_on_priority", false);        // journals before it: first come
     t.head_on_give_way = k.value("head_on_give_way", false);        // journals before it: no give-way
+    const std::string execution = k.value("execution", std::string("times"));  // journals before it: times
+    const auto parsed_execution = engine::ParsePlanExecution(execution);
+    if (!parsed_execution) return Corrupt("run setup", "unknown execution " + execution);
+    t.execution = *parsed_execution;
     const std::string head_on = k.at("head_on").get<std::string>();
     bool known = false;
     for (auto p : {engine::HeadOnPolicy::kChooseFaster, engine::HeadOnPolicy::kAlwaysWait,

@@ -108,6 +108,7 @@ StreamConfig ConfigOf(const StreamArgs& a, const std::string& strategy, double z
   c.traffic.priority_by_release = a.priority == "release";
   c.traffic.head_on_priority = a.head_on_priority;
   c.traffic.head_on_give_way = a.head_on_give_way;
+  c.traffic.execution = ParsePlanExecution(a.execution).value_or(DefaultPlanExecution(c.allocation.planner));
   c.one_formation_per_pick = a.one_formation_per_pick;
   c.blocked_recovery = a.blocked_recovery;
   c.check_safety = a.check_safety;
@@ -313,6 +314,11 @@ StreamCommands AddStreamCommands(CLI::App& app, StreamArgs& stream_args, StreamA
     c->add_option("--head-on-give-way", a.head_on_give_way,
                   "Wang2019 case 2: a waiting robot met head-on by a higher-priority one drives off its way (true|false)")
         ->capture_default_str();
+    c->add_option("--execution", a.execution,
+                  "When a robot asks for its next point: times (at its planned departure), claim (once its work "
+                  "is done) or order (claim, each point passed in the plans' order, Wang2019 3.2); default: times "
+                  "with the rules planner, claim with the others")
+        ->check(CLI::IsMember({"times", "claim", "order"}));
     c->add_option("--heat-period", a.heat_period, "Path heat: the period δ the lanes' use is counted over, s")
         ->capture_default_str()->check(CLI::PositiveNumber);
     c->add_option("--max-queue", a.max_queue, "Orders a robot may hold and still bid (0: no limit)")

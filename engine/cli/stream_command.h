@@ -38,6 +38,7 @@ struct StreamArgs {
   std::string priority = "index";          // TrafficControllerConfig::priority_by_release
   bool head_on_priority = false;           // TrafficControllerConfig::head_on_priority
   bool head_on_give_way = false;           // TrafficControllerConfig::head_on_give_way
+  std::string execution;                   // TrafficControllerConfig::execution ("": the planner's default)
 };
 
 struct StreamCommands {

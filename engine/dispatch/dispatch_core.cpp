@@ -9,6 +9,10 @@
 
 namespace dispatch::engine {
 
+PlanExecution DefaultPlanExecution(PlannerKind planner) {
+  return planner == PlannerKind::kRules ? PlanExecution::kTimes : PlanExecution::kClaim;
+}
+
 std::map<std::string, std::uint64_t> Change::MessageCounts() const {
   std::map<std::string, std::uint64_t> out;
   for (const PlanSend& s : sends) ++out[s.robot];

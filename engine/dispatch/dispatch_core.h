@@ -48,6 +48,13 @@
 
 namespace dispatch::engine {
 
+// When the gate asks for robots' next points if a configuration does not say
+// (TrafficControllerConfig::execution): at their planned departures with the rules planner; as
+// soon as their work is done (kClaim) with the planned planners (time windows, conflict
+// elimination), whose plans wait: measured 2026-12-06 on the Chu2024 streams with 20%
+// formations, seeds 1-3, 599 of 600 orders completed instead of 586.
+PlanExecution DefaultPlanExecution(PlannerKind planner);
+
 struct CoreOptions {
   // Metres a reported pose may be from the waypoint or stop it claims (report_check.h).
   double robot_snap_tolerance = 1.0;

@@ -16,6 +16,22 @@
 
 namespace dispatch::engine {
 
+const char* PlanExecutionName(PlanExecution execution) {
+  switch (execution) {
+    case PlanExecution::kTimes: return "times";
+    case PlanExecution::kClaim: return "claim";
+    case PlanExecution::kOrder: return "order";
+  }
+  return "times";
+}
+
+std::optional<PlanExecution> ParsePlanExecution(std::string_view name) {
+  for (PlanExecution e : {PlanExecution::kTimes, PlanExecution::kClaim, PlanExecution::kOrder}) {
+    if (name == PlanExecutionName(e)) return e;
+  }
+  return std::nullopt;
+}
+
 Status TrafficControllerConfig::Validate() const {
   if (!std::isfinite(max_envelope) || max_envelope < 0) {
     return InvalidArgument("traffic controller: max_envelope must be finite and >= 0");

@@ -44,7 +44,9 @@
 #include <cstddef>
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "engine/common/result.h"
@@ -60,6 +62,25 @@ enum class HeadOnPolicy {
   kAlwaysWait,    // the paper's "single waiting strategy" (for comparison, §4.3)
   kAlwaysReplan,  // always detour when a detour exists
 };
+
+// When the TrafficGate asks the controller for a standing robot's next point. Robots leave a
+// waypoint no earlier than its planned departure (eta + dwell) in every case: that is the
+// robots' side of the protocol. Wang2019 §3.2: the offline stage (the time-window planner)
+// gives each robot a route with the times it passes each point; its online stage controls the
+// robots at the points.
+enum class PlanExecution {
+  // At the robot's planned departure: until then the point ahead stays free for others.
+  kTimes,
+  // As soon as its work at the waypoint is done: a robot that waits out its plan's time holds
+  // the point it goes to next (granted, as any other) until it leaves.
+  kClaim,
+  // kClaim, and each point is passed in the plans' order (Wang2019 §3.2 steps 1-3,
+  // traffic_gate_order.cpp): a robot waits (at most T_w1) while one planned to pass its next
+  // point before it is on its way there; one that is not loses its turn.
+  kOrder,
+};
+const char* PlanExecutionName(PlanExecution execution);  // "times", "claim", "order"
+std::optional<PlanExecution> ParsePlanExecution(std::string_view name);
 
 // Defaults: Wang2019 names T_w1 / T_w2 but gives no values. T_w1 = 10 s is about the time a
 // robot needs to drive a 10-cell aisle at 1 m/s; T_w2 = 20 s is longer than a pick (5 s) plus
@@ -86,6 +107,8 @@ struct TrafficControllerConfig {
   // lower priority drives to the nearest free point off the other's way and waits there until
   // it has passed (at most T_w1); false: the wait-for cycle's detour or one-point back-off.
   bool head_on_give_way = false;
+  // How the TrafficGate executes the robots' plans (PlanExecution).
+  PlanExecution execution = PlanExecution::kTimes;
   Status Validate() const;
 };
 

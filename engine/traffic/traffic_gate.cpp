@@ -89,6 +89,9 @@ long GateImpl::GrantedRunEnd(const GateBot& b, PointId at, PointId next) {
 double GateImpl::Departure(const GateBot& b, long i) const {
   if (i < 0) return 0.0;
   const Waypoint& w = b.plan.waypoints[static_cast<std::size_t>(i)];
+  // Claiming its next point early, it asks once its work there is done (the robot still leaves
+  // at its planned departure).
+  if (config.execution != PlanExecution::kTimes && i == b.idx) return b.reach_time + w.dwell;
   double t = w.departure();
   if (i == b.idx) t = std::max(t, b.reach_time + w.dwell);
   return t;

@@ -83,6 +83,11 @@ struct GateBot {
   std::uint64_t leg_epoch = 0;
   long leg_stop = -1;     // plan index of the leg's last waypoint (-1: none)
   bool leg_stale = true;  // recompute the leg before the next request
+  // Waiting for its turn at a point (PlanExecution::kOrder): since when it has stood at plan index
+  // order_idx with point order_point next.
+  long order_idx = -2;
+  PointId order_point = kNoPoint;
+  double order_since = 0.0;
   // Per formation order of the plan, its segment (none: no pick of it left); kept by Reindex.
   std::map<std::string, std::optional<GateTeamSpan>> spans;
 };
@@ -186,6 +191,7 @@ struct GateImpl {
   std::size_t distance_cols = 0, distance_rows = 0;
   std::vector<int> distance_head, distance_next;
   std::vector<std::string> notes;  // TrafficGate::TakeNotes
+  std::vector<PointId> order_route;  // AwaitsItsTurn's scratch: the robot's remaining route
   // The earliest planned departure (dispatcher seconds) a standing robot or team waits for,
   // seen by the last Step: nothing else may change by then (+inf: none).
   double next_wake = std::numeric_limits<double>::infinity();
@@ -236,6 +242,9 @@ struct GateImpl {
   void PlaceStrays();
   void StepSolo(GateBot& b, double t, std::vector<GateEffect>& out);
   void RequestSolo(GateBot& b, double t, std::vector<GateEffect>& out);
+  // PlanExecution::kOrder (traffic_gate_order.cpp): true when standing robot
+  // b waits for a robot planned to pass its next point before it (held, saying so).
+  bool AwaitsItsTurn(GateBot& b, double t, std::vector<GateEffect>& out);
   void AdoptRoute(GateBot& b, double t, std::vector<GateEffect>& out);
   void OnReached(GateBot& b, std::uint64_t seq, double t);
   GateTeamKeys TeamKeys(const GateBot& b) const;

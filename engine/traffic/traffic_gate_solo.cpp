@@ -217,6 +217,7 @@ void GateImpl::StepSolo(GateBot& b, double t, std::vector<GateEffect>& out) {
     b.leg_stale = false;
     if (!ctl.HasRoute(r)) return;
   }
+  if (AwaitsItsTurn(b, t, out)) return;
   RequestSolo(b, t, out);
 }
 

@@ -86,6 +86,7 @@ void Simulate(benchmark::State& state, double formation_share, PlannerKind plann
   config.strategy = strategy;
   config.allocation.planner = planner;
   config.allocation.routing = routing;
+  config.traffic.execution = DefaultPlanExecution(planner);  // as dispatchd and dispatch-sim drive it
   double simulated = 0;
   std::size_t completed = 0, total = 0, deadlocks = 0, replans = 0, blocked = 0;
   double waiting = 0.0, completion = 0.0, recovered = 0.0, head_on = 0.0, distance = 0.0, planning = 0.0;

@@ -22,11 +22,13 @@ TEST(ServerConfigTest, FlagsSetTheConfig) {
                        "--time-scale", "10", "--bind", "127.0.0.1", "--ports-file", "p.json",
                        "--planner", "time-windows", "--turn-time", "1.5", "--drop-time", "0", "--routing", "heat",
                        "--heat-period", "30", "--priority", "release", "--formation-max-queue", "0",
-                       "--one-formation-per-pick", "false", "--head-on-priority", "true", "--head-on-give-way", "true"});
+                       "--one-formation-per-pick", "false", "--head-on-priority", "true", "--head-on-give-way", "true",
+                       "--execution", "order"});
   ASSERT_TRUE(parsed.ok()) << parsed.error().message;
   const ServerConfig& c = parsed->config;
   EXPECT_TRUE(c.head_on_priority);
   EXPECT_TRUE(c.head_on_give_way);
+  EXPECT_EQ(c.execution, "order");
   EXPECT_EQ(c.grpc_port, 0);
   EXPECT_EQ(c.http_port, 8081);
   EXPECT_EQ(c.db, "x.db");
@@ -51,13 +53,15 @@ TEST(ServerConfigTest, FlagsSetTheConfig) {
 TEST(ServerConfigTest, FileKeysApplyAndFlagsWin) {
   TempDir dir;
   const std::string file = dir.File("dispatchd.json");
-  std::ofstream(file) << R"({"grpc_port": 7000, "http_port": 7001, "db": "file.db", "zeta": 50, "drop_time": 2.5})";
+  std::ofstream(file) << R"({"grpc_port": 7000, "http_port": 7001, "db": "file.db", "zeta": 50, "drop_time": 2.5,
+                              "execution": "claim"})";
   auto parsed = Parse({"--config", file, "--http-port", "9000"});
   ASSERT_TRUE(parsed.ok()) << parsed.error().message;
   EXPECT_EQ(parsed->config.grpc_port, 7000);
   EXPECT_EQ(parsed->config.http_port, 9000);
   EXPECT_EQ(parsed->config.db, "file.db");
   EXPECT_DOUBLE_EQ(parsed->config.zeta, 50.0);
+  EXPECT_EQ(parsed->config.execution, "claim");
   EXPECT_EQ(parsed->config.drop_time, 2.5);
   EXPECT_FALSE(Parse({}).value().config.drop_time.has_value()) << "by default the order's t_w";
   EXPECT_EQ(Parse({"--config", file, "--drop-time", "1"}).value().config.drop_time, 1.0);
@@ -94,6 +98,9 @@ TEST(ServerConfigTest, BadValuesAreNamed) {
   EXPECT_NE(routing.error().message.find("routing must be floyd or heat, got 'astar'"), std::string::npos);
   EXPECT_FALSE(Parse({"--heat-period", "0"}).ok());
   EXPECT_FALSE(Parse({"--priority", "fifo"}).ok());
+  auto execution = Parse({"--execution", "eager"});
+  ASSERT_FALSE(execution.ok());
+  EXPECT_EQ(execution.error().message, "execution must be times, claim or order, got 'eager'");
   auto queue = Parse({"--formation-max-queue", "-1"});
   ASSERT_FALSE(queue.ok());
   EXPECT_NE(queue.error().message.find("formation_max_queue must be >= 0"), std::string::npos);

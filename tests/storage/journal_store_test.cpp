@@ -306,6 +306,7 @@ TEST(JournalStoreTest, ARunSetupRoundTrips) {
   s.core.traffic.priority_by_release = true;
   s.core.traffic.head_on_priority = true;
   s.core.traffic.head_on_give_way = true;
+  s.core.traffic.execution = engine::PlanExecution::kOrder;
   s.core.traffic_control = false;
   s.route_cache_bytes = 1 << 20;
   s.time_scale = 10;
@@ -328,6 +329,7 @@ TEST(JournalStoreTest, ARunSetupRoundTrips) {
   EXPECT_TRUE(back->core.traffic.priority_by_release);
   EXPECT_TRUE(back->core.traffic.head_on_priority);
   EXPECT_TRUE(back->core.traffic.head_on_give_way);
+  EXPECT_EQ(back->core.traffic.execution, engine::PlanExecution::kOrder);
   EXPECT_FALSE(back->core.traffic_control);
   EXPECT_EQ(back->route_cache_bytes, std::size_t{1} << 20);
   auto map = engine::ParseMapJson(back->map_json);
@@ -354,6 +356,11 @@ TEST(JournalStoreTest, ARunSetupRoundTrips) {
   old["core"].erase("head_on_give_way");
   EXPECT_FALSE(DecodeRunSetup(old.dump()).value().core.traffic.head_on_priority);
   EXPECT_FALSE(DecodeRunSetup(old.dump()).value().core.traffic.head_on_give_way);
+  old["core"].erase("execution");  // at the planned departures, as before it
+  EXPECT_EQ(DecodeRunSetup(old.dump()).value().core.traffic.execution, engine::PlanExecution::kTimes);
+  old["core"]["execution"] = "whenever";
+  EXPECT_FALSE(DecodeRunSetup(old.dump()).ok());
+  old["core"].erase("execution");
   old["allocation"]["planner"] = "magic";
   EXPECT_FALSE(DecodeRunSetup(old.dump()).ok());
 }

@@ -42,6 +42,7 @@ std::pair<std::size_t, std::size_t> CoreDenseGridLiveness(double formation_share
         c.allocation.formation_max_queue = 1;  // the product's formation settings
         c.one_formation_per_pick = true;
         c.allocation.planner = planner;
+        c.traffic.execution = DefaultPlanExecution(planner);  // as dispatchd and dispatch-sim drive it
         auto r = SimulateOnCore(w.map, w.routes, *robots, *orders, c);
         EXPECT_TRUE(r.ok()) << r.error().message;
         if (!r.ok()) continue;
