@@ -24,9 +24,10 @@ namespace dispatch::engine {
 namespace {
 
 // How far ahead in a robot's plan its next pass of a point is looked for, in waypoints (and
-// never beyond its current leg): "on its way there" is the seed's "within the next driving
-// section through the point". Measured on the Chu2024 streams with 20% formations (seeds
-// 1-3, time windows): 1, 2, 4, 8 and 24 waypoints completed 577, 573, 591, 576 and 579 of 600.
+// never beyond its next stop): "on its way there" is the seed's "within the next driving
+// section through the point". Measured on the Chu2024 streams with 20% formations (seeds 1-3,
+// time windows, before the intersection and next-stop rules): 1, 2, 4, 8 and 24 waypoints
+// completed 577, 573, 591, 576 and 579 of 600.
 constexpr long kOrderLookAhead = 4;
 
 }  // namespace
