@@ -44,19 +44,38 @@ void GateImpl::BecomeFormer(GateBot& b, const std::string& order, PointId at) {
   b.former_at = at;
 }
 
+namespace {
+
+// o is in team `order`, approaches it or has left it.
+bool OfTeam(const GateBot& o, const std::string& order) {
+  return o.team == order || o.former_team == order || o.older_former == order || o.oldest_former == order ||
+         o.approach == order;
+}
+
+}  // namespace
+
 bool GateImpl::TeammateBeside(const GateBot& b, const std::string& order) const {
-  return TeammateDistance(b, order) < config.point_clearance + FormationRadius() - 1e-9;
+  const double envelope = config.point_clearance + FormationRadius() - 1e-9;
+  if (TeammateDistance(b, order) < envelope) return true;
+  // Or it drives to a point beside one: granted while it was exempt from them, it arrives
+  // there all the same (found through the service, the burst three at a time: a member on its
+  // way to its rendezvous, its order given back as it drove up to a teammate, arrived a
+  // stranger 0.400 m from it).
+  if (!OnFloor(b)) return false;
+  const PointId next = ctl.Next(static_cast<std::size_t>(b.ctl));
+  if (next == kNoPoint) return false;
+  const Eigen::Vector2d& p = map->point(next).position;
+  for (const auto& [id, o] : bots) {
+    if (&o != &b && o.has_xy && OfTeam(o, order) && (o.xy - p).norm() < envelope) return true;
+  }
+  return false;
 }
 
 double GateImpl::TeammateDistance(const GateBot& b, const std::string& order) const {
   double best = std::numeric_limits<double>::infinity();
   if (!b.has_xy) return best;
   for (const auto& [id, o] : bots) {
-    if (&o == &b || !o.has_xy) continue;
-    if (o.team == order || o.former_team == order || o.older_former == order || o.oldest_former == order ||
-        o.approach == order) {
-      best = std::min(best, (o.xy - b.xy).norm());
-    }
+    if (&o != &b && o.has_xy && OfTeam(o, order)) best = std::min(best, (o.xy - b.xy).norm());
   }
   return best;
 }

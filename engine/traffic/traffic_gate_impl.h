@@ -283,7 +283,8 @@ struct GateImpl {
   // those with one beside it (TeammateBeside), then the newer.
   void BecomeFormer(GateBot& b, const std::string& order, PointId at);
   // A robot of team `order` (in it, approaching it or having left it) other than b stands
-  // within the formation's envelope (eps1 + the formation's radius) of b.
+  // within the formation's envelope (eps1 + the formation's radius) of b, or of the point b
+  // drives to.
   bool TeammateBeside(const GateBot& b, const std::string& order) const;
   // The distance from b to the nearest other robot of team `order` (infinity: none known).
   double TeammateDistance(const GateBot& b, const std::string& order) const;
