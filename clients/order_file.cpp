@@ -38,6 +38,12 @@ std::optional<v1::StopSpec> JsonStop(const json& j, const std::string& where, st
     return out;
   }
   if (!j.is_object()) return Fail(why, where + ": a stop is a point name or {\"x\", \"y\"}");
+  if (j.contains("heading")) {
+    if (!j["heading"].is_number() || !std::isfinite(j["heading"].get<double>())) {
+      return Fail(why, where + ".heading: must be a finite number (radians)");
+    }
+    out.set_heading(j["heading"].get<double>());
+  }
   if (j.contains("point")) {
     if (!j["point"].is_string() || j["point"].get<std::string>().empty()) {
       return Fail(why, where + ".point: must be a non-empty string");

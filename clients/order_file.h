@@ -6,7 +6,9 @@
 //  - JSON: one order object or an array of them (or {"orders": [...]}):
 //      {"client_order_id": "A-17", "priority": 2, "formation": false, "work_time": 5,
 //       "release_time": 30, "picks": [{"x": 19, "y": 17}, "K2-4-3S"], "drop": {"x": 6.5, "y": 2.75}}
-//    A stop is a point name (string) or {"x": .., "y": ..} (or {"point": "name"});
+//    A stop is a point name (string) or {"x": .., "y": ..} (or {"point": "name"}); an object
+//    may add "heading": radians, the heading the robot must have there (a point inside a
+//    free-space region of the map; the server says so otherwise);
 //    client_order_id defaults to `<prefix><index>` (1-based).
 // Errors name the file and the line (CSV) or the order index and field (JSON). The CSV
 // parser is formats/task_table_text.h, the one the engine reads task tables with; the

@@ -136,11 +136,13 @@ engine::Result<engine::OrderRequest> OrderRequestFromProto(const pb::SubmitOrder
     auto stop = StopFromProto(r.picks(i), "pick " + std::to_string(i + 1));
     if (!stop.ok()) return stop.error();
     out.picks.push_back(*stop);
+    if (r.picks(i).has_heading()) out.stop_headings[static_cast<std::size_t>(i)] = r.picks(i).heading();
   }
   if (!r.has_drop()) return engine::InvalidArgument("drop is required");
   auto drop = StopFromProto(r.drop(), "drop");
   if (!drop.ok()) return drop.error();
   out.drop = *drop;
+  if (r.drop().has_heading()) out.stop_headings[out.picks.size()] = r.drop().heading();
   out.formation = r.formation();
   if (r.has_work_time()) out.work_time = r.work_time();
   if (r.has_release_time()) {
@@ -246,6 +248,10 @@ void OrderToProto(const OrderView& view, const engine::WarehouseMap& map, pb::Or
   out->set_priority(o.priority);
   for (engine::PointId p : o.picks) StopToProto(p, map, out->add_picks());
   StopToProto(o.drop, map, out->mutable_drop());
+  for (const auto& [k, heading] : o.stop_headings) {
+    if (k < o.picks.size()) out->mutable_picks(static_cast<int>(k))->set_heading(heading);
+    if (k == o.picks.size()) out->mutable_drop()->set_heading(heading);
+  }
   out->set_formation(o.formation);
   out->set_work_time(o.work_time);
   out->set_created_time(o.created_time);

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
+#include <map>
 
 #include "engine/common/fnv1a.h"
 
@@ -15,6 +16,13 @@ using nlohmann::json;
 
 Error Corrupt(const char* what, const std::string& detail) {
   return engine::IoError(std::string("stored ") + what + " is corrupt: " + detail);
+}
+
+// Order::stop_headings as [[stop index, radians], ...] in index order.
+json HeadingsJson(const std::map<std::size_t, double>& headings) {
+  json out = json::array();
+  for (const auto& [k, heading] : headings) out.push_back(json::array({k, heading}));
+  return out;
 }
 
 bool AllFinite(std::initializer_list<double> values) {
@@ -94,6 +102,8 @@ std::string OrderContentHash(const engine::Order& order) {
   content.push_back(order.formation);
   content.push_back(order.work_time);
   content.push_back(order.release_time ? json(*order.release_time) : json(nullptr));
+  // Only when given: the hashes of orders without headings stay what they were.
+  if (!order.stop_headings.empty()) content.push_back(HeadingsJson(order.stop_headings));
   const std::string text =
       std::to_string(order.client_id.size()) + ":" + order.client_id + content.dump();
   return engine::Hex64(engine::Fnv1a64(text));
@@ -104,11 +114,15 @@ Result<std::string> EncodeOrderBody(const engine::Order& order) {
     return engine::InvalidArgument("order '" + order.id +
                                    "': work_time and release_time must be finite");
   }
+  for (const auto& [k, heading] : order.stop_headings) {
+    if (!std::isfinite(heading)) return engine::InvalidArgument("order '" + order.id + "': stop headings must be finite");
+  }
   json j;
   j["picks"] = order.picks;
   j["drop"] = order.drop;
   j["work_time"] = order.work_time;
   j["release_time"] = order.release_time ? json(*order.release_time) : json(nullptr);
+  if (!order.stop_headings.empty()) j["stop_headings"] = HeadingsJson(order.stop_headings);
   return j.dump();
 }
 
@@ -120,6 +134,12 @@ Status DecodeOrderBody(const std::string& body, engine::Order& order) {
     const json& release = j.at("release_time");
     order.release_time =
         release.is_null() ? std::nullopt : std::optional<double>(release.get<double>());
+    order.stop_headings.clear();
+    if (j.contains("stop_headings")) {  // [[stop index, radians], ...]; absent in older bodies
+      for (const json& e : j.at("stop_headings")) {
+        order.stop_headings[e.at(0).get<std::size_t>()] = e.at(1).get<double>();
+      }
+    }
     return engine::Ok{};
   });
 }

@@ -23,6 +23,7 @@ Result<PlanTask> PrepareOrder(const Order& order, const FleetState& state) {
     return NotFound(what + "drop is an unknown point id " + std::to_string(order.drop));
   }
   PlanTask task = state.TaskOf(order.picks, order.drop, order.work_time);
+  task.stop_headings = order.stop_headings;
   if (!std::isfinite(task.work_time) || task.work_time < 0.0) {
     return InvalidArgument(what + "work time must be finite and >= 0 s, got " +
                            std::to_string(task.work_time));
@@ -31,6 +32,15 @@ Result<PlanTask> PrepareOrder(const Order& order, const FleetState& state) {
     return Error{ErrorCode::kFailedPrecondition,
                  what + "a formation needs " + std::to_string(kFormationTeamSize) +
                      " robots, the fleet has " + std::to_string(state.robot_count())};
+  }
+  if (!task.stop_headings.empty()) {
+    bool any = false;
+    for (std::size_t i = 0; i < state.robot_count() && !any; ++i) any = state.CanServe(i, task);
+    if (!any) {
+      return Error{ErrorCode::kFailedPrecondition,
+                   what + "a stop asks for a heading, and no robot can be planned into it (a four-wheel-steer robot, "
+                          "planned through the map's free-space regions by the rules planner)"};
+    }
   }
   const RouteTable& routes = state.routes();
   auto name = [&](PointId p) { return "'" + map.point(p).name + "'"; };

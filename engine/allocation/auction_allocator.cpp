@@ -309,6 +309,10 @@ std::vector<Bid> AuctionAllocator::ComputeBids(const FleetState& state, const Pl
       bids.push_back(FullQueueBid(state.robot_id(i), s.end_time));
       continue;
     }
+    if (!state.CanServe(i, task)) {  // cannot be planned into a stop's heading
+      bids.push_back(UnreachableBid(state.robot_id(i), s.end_time));
+      continue;
+    }
     const double leg = routes.Cost(s.end_point, first);
     if (legs_are_times && std::isfinite(leg)) legs_[i] = leg;
     if (!std::isfinite(leg) || !std::isfinite(task_travel)) {

@@ -20,6 +20,10 @@ BatchSingles TakeSingles(const std::vector<const Order*>& orders, FleetState& st
       sink(*o, task.error());
       continue;
     }
+    if (!task->stop_headings.empty()) {  // only some robots can serve it: the auction's bids say which
+      sink(*o, formations.Allocate(*o, state));
+      continue;
+    }
     out.orders.push_back(o);
     out.tasks.push_back(std::move(task).value());
   }
@@ -29,7 +33,7 @@ BatchSingles TakeSingles(const std::vector<const Order*>& orders, FleetState& st
 std::vector<std::size_t> SoonestRobots(const FleetState& state, const PlanTask& task, std::size_t count) {
   std::vector<std::pair<double, std::size_t>> ranked;
   for (std::size_t i = 0; i < state.robot_count(); ++i) {
-    if (!state.HasRoom(i)) continue;
+    if (!state.HasRoom(i) || !state.CanServe(i, task)) continue;
     const QueueSummary& s = state.summary(i);
     const double start = s.end_time + state.routes().Cost(s.end_point, task.picks.front());
     if (std::isfinite(start)) ranked.emplace_back(start, i);

@@ -16,8 +16,9 @@ struct BatchSingles {
   std::vector<PlanTask> tasks;       // orders[k]'s task
 };
 
-// Formation orders go to `formations` (the auction) and their awards to `sink`, in batch
-// order; so do PrepareOrder's errors. The rest are returned.
+// Formation orders and orders asking for a stop heading (only four-wheel-steer robots can
+// serve them, FleetState::CanServe) go to `formations` (the auction) and their awards to
+// `sink`, in batch order; so do PrepareOrder's errors. The rest are returned.
 BatchSingles TakeSingles(const std::vector<const Order*>& orders, FleetState& state,
                          Allocator& formations, const AwardSink& sink);
 

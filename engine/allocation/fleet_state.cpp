@@ -118,12 +118,36 @@ void FleetState::Publish(RobotEntry& e) {
   e.plan.waypoints.pop_back();
 }
 
+namespace {
+
+// Stop headings keyed by stop index (picks, then the drop) re-keyed by the index of each
+// stop's waypoint in `segment` (BuildPlan's one-task plan: its stops in order after the start).
+std::map<std::size_t, double> StopWaypoints(const Plan& segment, const std::map<std::size_t, double>& by_stop) {
+  std::map<std::size_t, double> out;
+  if (by_stop.empty()) return out;
+  std::size_t stop = 0;
+  for (std::size_t w = 1; w < segment.waypoints.size(); ++w) {
+    const WaypointAction a = segment.waypoints[w].action;
+    if (a != WaypointAction::kPick && a != WaypointAction::kDrop) continue;
+    if (auto it = by_stop.find(stop); it != by_stop.end()) out[w] = it->second;
+    ++stop;
+  }
+  return out;
+}
+
+}  // namespace
+
 Status FleetState::AssignSingle(std::size_t robot, const std::string& order_id,
                                 const PlanTask& task) {
   if (robot >= robots_.size()) {
     return NotFound("order " + order_id + ": unknown robot index " + std::to_string(robot));
   }
   RobotEntry& e = robots_[robot];
+  if (!CanServe(robot, task)) {
+    return Error{ErrorCode::kFailedPrecondition,
+                 "order " + order_id + " for robot " + e.info.id +
+                     ": a stop's heading needs a four-wheel-steer robot planned through a free-space region"};
+  }
   const QueueSummary& s = e.summary;
   Result<Plan> segment = BuildPlan(*map_, *routes_, s.end_point, s.end_time, config_.speed, {task}, config_.turn_time);
   if (!segment.ok()) {
@@ -131,8 +155,13 @@ Status FleetState::AssignSingle(std::size_t robot, const std::string& order_id,
                  "order " + order_id + " for robot " + e.info.id + ": " + segment.error().message};
   }
   if (free_space_ && e.info.kind == RobotKind::kFourWheelSteer) {
-    Result<Plan> refined = free_space_->Refine(*segment, config_.speed);
-    if (refined.ok()) segment = std::move(refined);  // else: its lanes
+    Result<Plan> refined = free_space_->Refine(*segment, config_.speed, StopWaypoints(*segment, task.stop_headings));
+    if (refined.ok()) {
+      segment = std::move(refined);
+    } else if (!task.stop_headings.empty()) {  // its lanes cannot give the heading
+      return Error{refined.error().code, "order " + order_id + " for robot " + e.info.id +
+                                             ": the heading asked for cannot be planned: " + refined.error().message};
+    }  // else: its lanes
   }
   const double travel = routes_->Cost(s.end_point, task.picks.front()) + TaskTravelTime(task);
   AppendTask(e, order_id, task, segment->waypoints, travel);

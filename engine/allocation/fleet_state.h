@@ -96,6 +96,13 @@ class FleetState {
     if (config().max_queue != 0 && held >= config().max_queue) return false;
     return !formation || config().formation_max_queue == 0 || held < config().formation_max_queue;
   }
+  // False when `task` asks for a heading at a stop (PlanTask::stop_headings) and the robot
+  // cannot be planned into it: it is not a four-wheel-steer robot, or no free-space motion is
+  // in use (UseFreeSpace). Such a robot does not bid for it (every strategy asks).
+  bool CanServe(std::size_t robot, const PlanTask& task) const {
+    return task.stop_headings.empty() ||
+           (free_space_ != nullptr && robots_.at(robot).info.kind == RobotKind::kFourWheelSteer);
+  }
   const Plan& plan(std::size_t robot) const { return robots_.at(robot).plan; }
 
   const WarehouseMap& map() const { return *map_; }
@@ -136,10 +143,11 @@ class FleetState {
                          const PlanTask& task);
 
   // From now on AssignSingle plans a four-wheel-steer robot's segment through the map's
-  // free-space regions (FreeSpaceMotion::Refine, with the graph's headings at its stops); null:
-  // on the lanes, as every robot. A segment the hybrid A* cannot refine (an anchor pose that
-  // does not fit the region, no path, the search limits) keeps its lanes. The bids still
-  // price the lanes' times (the refined legs are usually a few seconds longer).
+  // free-space regions (FreeSpaceMotion::Refine, with the task's stop headings, else the
+  // graph's headings at its stops); null: on the lanes, as every robot. A segment the hybrid
+  // A* cannot refine (an anchor pose that does not fit the region, no path, the search limits)
+  // keeps its lanes, unless its task asks for a heading: then AssignSingle fails saying why.
+  // The bids still price the lanes' times (the refined legs are usually a few seconds longer).
   void UseFreeSpace(std::shared_ptr<const FreeSpaceMotion> motion) { free_space_ = std::move(motion); }
 
  private:

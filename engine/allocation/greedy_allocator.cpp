@@ -23,7 +23,7 @@ Result<AwardExplanation> GreedyAllocator::Allocate(const Order& order, FleetStat
     b.ready_time = s.end_time;
     b.t_d = state.routes().Cost(s.end_point, first);
     b.queue_full = !state.HasRoom(i, order.formation);
-    b.reachable = std::isfinite(b.t_d) && !b.queue_full;
+    b.reachable = std::isfinite(b.t_d) && !b.queue_full && state.CanServe(i, *task);
     b.bid = b.t_d;
     if (b.reachable) ranked.push_back(i);
     ex.bids.push_back(std::move(b));

@@ -182,7 +182,10 @@ bool RoundRunner::ReplayQueue(FleetState& fleet, std::size_t index, const RoundR
       }
       segment.push_back(wp);
     }
-    const PlanTask task = fleet.TaskOf(picks, order.drop, order.work_time);
+    PlanTask task = fleet.TaskOf(picks, order.drop, order.work_time);
+    // The stored waypoints keep the poses; the headings matter only to AssignSingle below (a
+    // whole order: the first one's stops ahead are no longer the order's stop indices).
+    if (k > 0) task.stop_headings = order.stop_headings;
     Status assigned = InvalidArgument("no stored waypoints");
     // Unpublished: the caller gives the predictor the whole replayed queue once.
     if (segment.size() >= 2) assigned = fleet.AssignPlanned(index, order.id, task, std::move(segment), false);

@@ -1,8 +1,11 @@
 #include "engine/fleet/order.h"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <sstream>
+
+#include "engine/fleet/formation.h"
 
 namespace dispatch::engine {
 namespace {
@@ -158,6 +161,27 @@ Result<Order> ResolveOrder(const WarehouseMap& map, const OrderRequest& request,
   Result<PointId> drop = ResolveStop(map, request.drop, PointKind::kDrop, options);
   if (!drop.ok()) return Error{drop.error().code, what + "drop: " + drop.error().message};
   order.drop = *drop;
+  // Headings: only a free-space region lets a robot choose its pose (hybrid A*); on a lane
+  // the arc decides it. A formation keeps its members' lanes.
+  for (const auto& [k, heading] : request.stop_headings) {
+    const std::string stop = k < order.picks.size() ? "pick " + std::to_string(k + 1) : "drop";
+    if (k > order.picks.size()) {
+      return InvalidArgument(what + "a heading for stop " + std::to_string(k + 1) + " of " +
+                             std::to_string(order.picks.size() + 1));
+    }
+    if (!std::isfinite(heading)) return InvalidArgument(what + stop + ": heading must be finite, got " + Num(heading));
+    if (request.formation) return InvalidArgument(what + stop + ": a formation order's stops cannot ask for a heading");
+    const PointId p = k < order.picks.size() ? order.picks[k] : order.drop;
+    const auto& regions = map.free_spaces();
+    const bool in_region = std::any_of(regions.begin(), regions.end(), [&](const FreeSpace& f) {
+      return std::binary_search(f.points.begin(), f.points.end(), p);
+    });
+    if (!in_region) {
+      return InvalidArgument(what + stop + ": a heading can only be given at a point inside a free-space region; '" +
+                             map.point(p).name + "' is on the lanes, where its arc decides the heading");
+    }
+    order.stop_headings[k] = WrapAngle(heading);
+  }
   return order;
 }
 

@@ -8,12 +8,16 @@
 // `CanTransition` allows nothing else (no skipping ahead, nothing leaves a terminal state).
 //
 // Invariants of a resolved Order: at least one pick, every pick is a kPick point, the drop
-// is a kDrop point, work_time > 0 and finite. Plain values: not thread-safe to mutate
+// is a kDrop point, work_time > 0 and finite; a stop's heading (issue 17 §3, "tasks have a
+// position and a heading") is finite, in (-pi, pi], at a point inside one of the map's
+// free-space regions, and only in a single-robot order. Plain values: not thread-safe to mutate
 // concurrently, safe to share once built. All functions here are pure.
 #pragma once
 
 #include <Eigen/Core>
 
+#include <cstddef>
+#include <map>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -55,6 +59,10 @@ struct Order {
   double created_time = 0.0;            // seconds
   std::optional<double> release_time;   // earliest start, seconds; none = on acceptance
   OrderState state = OrderState::kAccepted;
+  // The heading a robot must have at a stop (radians counter-clockwise from +x, in
+  // (-pi, pi]), keyed by the stop's index: the picks 0..picks.size()-1 in order, then the drop.
+  // Stops without one are reached with the heading of the arc into them.
+  std::map<std::size_t, double> stop_headings{};
 
   int team_size() const { return formation ? kFormationTeamSize : 1; }
 };
@@ -73,6 +81,7 @@ struct OrderRequest {
   double work_time = kDefaultWorkTime;
   double created_time = 0.0;
   std::optional<double> release_time;
+  std::map<std::size_t, double> stop_headings{};  // as Order's, any finite value (ResolveOrder wraps it)
 };
 
 // "(19, 16.5)" or "'X3-4'": how a stop is named in error messages.
@@ -103,7 +112,8 @@ inline constexpr double kMaxReleaseTime = 1e9;
 //    not finite or beyond kMaxReleaseTime; a non-finite coordinate; a
 //    coordinate farther than the tolerance from every candidate (names the coordinate, the
 //    nearest candidate and its distance) or within tolerance of two (names both); a named
-//    point of the wrong kind;
+//    point of the wrong kind; a stop heading that is not finite, names no stop, is at a point
+//    outside every free-space region, or is in a formation order;
 //  - kNotFound: an unknown point name; a map without points of the required kind.
 Result<Order> ResolveOrder(const WarehouseMap& map, const OrderRequest& request,
                            const SnapOptions& options = {});

@@ -22,6 +22,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <map>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -82,6 +83,10 @@ struct PlanTask {
   PointId drop = kNoPoint;
   double work_time = 0.0;  // t_w, seconds at each pick, >= 0
   double drop_time = 0.0;  // seconds at the drop, >= 0
+  // Order::stop_headings: radians by stop index (picks in order, then the drop). Only a
+  // four-wheel-steer robot refined through a free-space region can serve a task with one
+  // (FleetState::CanServe).
+  std::map<std::size_t, double> stop_headings{};
 };
 
 // n_c of one task: its picks (Chu2024 eq. (3)).

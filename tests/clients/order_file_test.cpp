@@ -42,7 +42,7 @@ TEST(OrderFileTest, SameFileGivesTheSameClientIds) {
 TEST(OrderFileTest, JsonOrdersWithNamesAndCoordinates) {
   auto orders = ParseOrderText(R"([
       {"client_order_id": "A-1", "priority": 2, "picks": [{"x": 19, "y": 17}, "K2-4-3S"],
-       "drop": {"point": "D-T3"}, "formation": true, "work_time": 3, "release_time": 30},
+       "drop": {"point": "D-T3", "heading": -1.5}, "formation": true, "work_time": 3, "release_time": 30},
       {"picks": ["P1"], "drop": {"x": 6.5, "y": 2.75}}])",
                                true, "file-");
   ASSERT_TRUE(orders.ok()) << orders.error;
@@ -55,6 +55,8 @@ TEST(OrderFileTest, JsonOrdersWithNamesAndCoordinates) {
   EXPECT_EQ(a.release_time(), 30.0);
   EXPECT_EQ(a.picks(1).point_name(), "K2-4-3S");
   EXPECT_EQ(a.drop().point_name(), "D-T3");
+  EXPECT_EQ(a.drop().heading(), -1.5);
+  EXPECT_FALSE(a.picks(0).has_heading());
   EXPECT_EQ(orders.orders[1].client_order_id(), "file-2");
   auto single = ParseOrderText(R"({"picks": ["P1"], "drop": "D1"})", true, "s-");
   ASSERT_TRUE(single.ok());
@@ -71,6 +73,8 @@ TEST(OrderFileTest, BadFilesNameTheProblem) {
       {"[{\"picks\": [], \"drop\": \"D1\"}]", true, "order 1.picks"},
       {"[{\"picks\": [\"P1\"]}]", true, "order 1.drop: missing"},
       {"[{\"picks\": [{\"x\": 1}], \"drop\": \"D1\"}]", true, "order 1.picks[0].y"},
+      {"[{\"picks\": [{\"x\": 1, \"y\": 2, \"heading\": \"north\"}], \"drop\": \"D1\"}]", true,
+       "order 1.picks[0].heading: must be a finite number"},
       {"[{\"picks\": [\"P1\"], \"drop\": \"D1\", \"colour\": 3}]", true, "unknown field 'colour'"},
       {"[{\"picks\": [\"P1\"], \"drop\": \"D1\", \"priority\": \"high\"}]", true, "priority"},
       {"[{\"picks\": [\"P1\"], \"drop\": \"D1\", \"work_time\": -1}]", true, "work_time"},

@@ -6,15 +6,23 @@ drop outside), fleet-sim with two robots, R1 saying in its Hello that it is four
 (nearer); the route the service shows for it (GET /api/v1/orders/{id}) holds poses with a
 heading and a motion mode inside the bay, a turn among them (the robot turns round there; on
 the lanes it would just drive back), fleet-sim drives them, and the order completes with the
-robots never closer than eps1. (That a differential robot keeps its lanes is the core test's,
+robots never closer than eps1. Then an order asking to reach K facing the bay's mouth (heading
+pi, a stop with a heading): it goes to R1, the route's pick waypoint has that heading, the
+order (REST) shows it, and it completes; a heading at the drop (on the lanes) is
+INVALID_ARGUMENT, and a dispatcher running the time-window planner answers FAILED_PRECONDITION
+(only the rules planner refines plans through free space). (That a differential robot keeps
+its lanes is the core test's,
 FreeSpaceRound; two robots picking at the closed end of one bay lock each other up, see the
 closing note of 2026-12-06.)
 
     free_space_robot.py --stubs DIR --dispatchd BIN --fleet-sim BIN --wmsctl BIN --scenarios DIR
 """
+import math
 import os
 import sys
 import uuid
+
+import grpc
 
 sys.dont_write_bytecode = True  # no __pycache__ in the source tree
 sys.path.insert(0, sys.argv[sys.argv.index("--stubs") + 1])
@@ -28,12 +36,25 @@ TURNS = {"MOTION_MODE_SPIN_LEFT", "MOTION_MODE_SPIN_RIGHT", "MOTION_MODE_REVERSE
          "MOTION_MODE_ARC_REVERSE_LEFT", "MOTION_MODE_ARC_REVERSE_RIGHT"}
 
 
-def submit(server, tag):
-    r = orders_pb2.SubmitOrderRequest(
-        client_order_id=f"bay-{tag}-{uuid.uuid4().hex[:8]}",
-        picks=[orders_pb2.StopSpec(position=common_pb2.Vec2(x=PICK[0], y=PICK[1]))],
-        drop=orders_pb2.StopSpec(position=common_pb2.Vec2(x=DROP[0], y=DROP[1])))
+def submit(server, tag, pick_heading=None, drop_heading=None):
+    pick = orders_pb2.StopSpec(position=common_pb2.Vec2(x=PICK[0], y=PICK[1]))
+    drop = orders_pb2.StopSpec(position=common_pb2.Vec2(x=DROP[0], y=DROP[1]))
+    if pick_heading is not None:
+        pick.heading = pick_heading
+    if drop_heading is not None:
+        drop.heading = drop_heading
+    r = orders_pb2.SubmitOrderRequest(client_order_id=f"bay-{tag}-{uuid.uuid4().hex[:8]}", picks=[pick], drop=drop)
     return server.orders.SubmitOrder(r, timeout=10).order.id
+
+
+def refused(server, code, text, **headings):
+    """SubmitOrder with these headings fails with `code`, its message holding `text`."""
+    try:
+        submit(server, "refused", **headings)
+    except grpc.RpcError as err:
+        check(err.code() == code and text in err.details(), f"refused with {err.code()}: {err.details()}")
+        return
+    check(False, f"an order with {headings} was accepted")
 
 
 def route_of(server, order_id):
@@ -69,7 +90,25 @@ def main():
         done = h.watch(server, lambda o: first in o and o[first].state == COMPLETED,
                        timeout=60, what="the order completed", order_ids=[first])
         h.log("states: " + ", ".join(f"{k}={state_name(v.state)}" for k, v in sorted(done.items())))
+
+        # A stop with a heading: K reached facing the bay's mouth (the lanes arrive facing east).
+        refused(server, grpc.StatusCode.INVALID_ARGUMENT, "inside a free-space region", drop_heading=0.0)
+        posed_order = submit(server, "2", pick_heading=math.pi)
+        shown = server.rest(f"/api/v1/orders/{posed_order}")
+        heading = shown.get("order", shown)["picks"][0].get("heading")
+        check(heading is not None and abs(abs(heading) - math.pi) < 1e-9, f"the order shows pick heading {heading}")
+        robot, waypoints = h.wait_for(lambda: route_of(server, posed_order), 20, "the posed order's route")
+        check(robot == "R1", f"the order with a heading went to {robot}, not the four-wheel-steer R1")
+        at_pick = [w for w in waypoints if w.get("action") == "WAYPOINT_ACTION_PICK"]
+        check(len(at_pick) == 1 and abs(abs(at_pick[0].get("heading", 0.0)) - math.pi) < 1e-6,
+              f"the pick waypoint: {at_pick}")
+        h.watch(server, lambda o: posed_order in o and o[posed_order].state == COMPLETED,
+                timeout=60, what="the order with a heading completed", order_ids=[posed_order])
         h.check_min_distance(server)
+
+        # The time-window planner does not refine plans through free space: it says so.
+        planned = h.start_server(["--map", MAP, "--planner", "time-windows"], db=os.path.join(h.work, "tw.db"))
+        refused(planned, grpc.StatusCode.FAILED_PRECONDITION, "needs the rules planner", pick_heading=math.pi)
 
 
 if __name__ == "__main__":

@@ -373,6 +373,9 @@ TEST_F(OrderFlowTest, BadOrdersGetInvalidArgumentWithAClearMessage) {
   pb::SubmitOrderRequest bad_work = OrderRequest("bad-7", {"K3-2-3N"}, "D-B2");
   bad_work.set_work_time(-1.0);
   cases.push_back({bad_work, "work"});
+  pb::SubmitOrderRequest lane_heading = OrderRequest("bad-8", {"K3-2-3N"}, "D-B2");
+  lane_heading.mutable_picks(0)->set_heading(1.0);  // the Chu2024 floor has no free space
+  cases.push_back({lane_heading, "a heading can only be given at a point inside a free-space region"});
   for (const auto& c : cases) {
     pb::SubmitOrderResponse response;
     const grpc::Status status = Submit(c.request, &response);

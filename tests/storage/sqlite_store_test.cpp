@@ -249,7 +249,36 @@ TEST_F(SqliteStoreTest, RejectsMalformedOrders) {
   engine::Order nan = MakeOrder("o", "c");
   nan.release_time = std::nan("");
   EXPECT_EQ(store->InsertOrder(nan, "").error().code, ErrorCode::kInvalidArgument);
+  engine::Order nan_heading = MakeOrder("o", "c");
+  nan_heading.stop_headings[0] = std::nan("");
+  EXPECT_EQ(store->InsertOrder(nan_heading, "").error().code, ErrorCode::kInvalidArgument);
   EXPECT_TRUE(store->ListOrders({}).value().orders.empty());
+}
+
+// Issue 17 §3: the headings an order's stops ask for are stored with it and survive a
+// restart; they are part of the order's content (a repeat of the client id with other
+// headings is another order), and an order without any keeps the hash it always had.
+TEST_F(SqliteStoreTest, StopHeadingsSurviveAReopenAndArePartOfTheContent) {
+  engine::Order posed = MakeOrder("o1", "c1", {4, 5}, 12);
+  posed.stop_headings = {{0, -1.5707963267948966}, {2, 3.141592653589793}};
+  engine::Order plain = posed;
+  plain.stop_headings.clear();
+  EXPECT_NE(OrderContentHash(posed), OrderContentHash(plain));
+  {
+    auto store = OpenOrDie(db_path());
+    ASSERT_NE(store, nullptr);
+    ASSERT_TRUE(store->InsertOrder(posed, "").ok());
+    ASSERT_TRUE(store->InsertOrder(MakeOrder("o2", "c2"), "").ok());
+  }
+  auto store = OpenOrDie(db_path());
+  ASSERT_NE(store, nullptr);
+  auto o1 = store->GetOrder("o1");
+  ASSERT_TRUE(o1.ok()) << o1.error().message;
+  EXPECT_EQ(o1->order.stop_headings, posed.stop_headings);  // bit-exact
+  EXPECT_EQ(o1->content_hash, OrderContentHash(posed));
+  auto o2 = store->GetOrder("o2");
+  ASSERT_TRUE(o2.ok()) << o2.error().message;
+  EXPECT_TRUE(o2->order.stop_headings.empty());
 }
 
 TEST_F(SqliteStoreTest, StateTransitionsFollowTheLifecycleAndAreJournaledInOrder) {

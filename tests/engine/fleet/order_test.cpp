@@ -5,9 +5,14 @@
 #include <cmath>
 #include <set>
 #include <limits>
+#include <map>
 #include <memory>
+#include <numbers>
+#include <optional>
+#include <string>
 
 #include "engine/map/chu2024_floor.h"
+#include "engine/map/map_builder.h"
 
 namespace dispatch::engine {
 namespace {
@@ -186,6 +191,55 @@ TEST_F(ResolveOrderTest, RejectsEmptyPicksAndBadWorkTime) {
       *map_, Request({Eigen::Vector2d(std::nan(""), 1.0)}, Eigen::Vector2d(6.5, 2.75)));
   ASSERT_FALSE(nan_xy.ok());
   EXPECT_NE(nan_xy.error().message.find("not finite"), std::string::npos);
+}
+
+
+// Issue 17 §3: a stop may ask for a heading, only where a robot can choose its pose (a point in
+// a free-space region) and only in a single-robot order; it is stored wrapped into (-pi, pi].
+TEST(ResolveOrderHeadingTest, AHeadingIsKeptAtAFreeSpacePointAndRefusedElsewhere) {
+  MapBuilder b("bay");
+  b.SetFloor({0, 0}, {10, 4});
+  b.AddRectZone("z", {0, 0}, {10, 4});
+  b.AddPoint("w", {1.5, 0.8}, PointKind::kLane);
+  b.AddPoint("K", {6.5, 0.8}, PointKind::kPick);
+  b.AddPoint("L", {1.5, 2.0}, PointKind::kPick);
+  b.AddPoint("D", {1.5, 2.8}, PointKind::kDrop);
+  b.AddPath("w", "K", std::nullopt, 0.0, true);
+  b.AddPath("w", "L", std::nullopt, 0.0, true);
+  b.AddPath("L", "D", std::nullopt, 0.0, true);
+  b.AddFreeSpace("bay", {{2, 0.1}, {8, 0.1}, {8, 1.5}, {2, 1.5}});
+  auto built = b.Build();
+  ASSERT_TRUE(built.ok()) << built.error().message;
+  const WarehouseMap& map = *built;
+  auto request = [](std::map<std::size_t, double> headings) {
+    OrderRequest r;
+    r.id = "o1";
+    r.picks = {std::string("K"), std::string("L")};
+    r.drop = std::string("D");
+    r.stop_headings = std::move(headings);
+    return r;
+  };
+  const double pi = std::numbers::pi;
+  const Result<Order> kept = ResolveOrder(map, request({{0, 3 * pi}}));
+  ASSERT_TRUE(kept.ok()) << kept.error().message;
+  ASSERT_EQ(kept->stop_headings.size(), 1u);
+  EXPECT_NEAR(kept->stop_headings.at(0), pi, 1e-9);  // 3 pi wrapped
+  EXPECT_TRUE(ResolveOrder(map, request({})).ok());
+
+  auto refused = [&](OrderRequest r, const std::string& why) {
+    const Result<Order> o = ResolveOrder(map, r);
+    ASSERT_FALSE(o.ok()) << why;
+    EXPECT_EQ(o.error().code, ErrorCode::kInvalidArgument);
+    EXPECT_NE(o.error().message.find(why), std::string::npos) << o.error().message;
+  };
+  refused(request({{1, 0.0}}), "pick 2: a heading can only be given at a point inside a free-space region; 'L'");
+  refused(request({{2, 0.0}}), "drop: a heading can only be given");
+  refused(request({{3, 0.0}}), "a heading for stop 4 of 3");
+  refused(request({{0, std::nan("")}}), "pick 1: heading must be finite");
+  refused(request({{0, std::numeric_limits<double>::infinity()}}), "heading must be finite");
+  OrderRequest team = request({{0, 0.0}});
+  team.formation = true;
+  refused(team, "a formation order's stops cannot ask for a heading");
 }
 
 }  // namespace
