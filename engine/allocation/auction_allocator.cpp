@@ -319,11 +319,17 @@ std::vector<Bid> AuctionAllocator::ComputeBids(const FleetState& state, const Pl
       bids.push_back(UnreachableBid(state.robot_id(i), s.end_time));
       continue;
     }
+    // A four-wheel-steer robot's plan through free space is not its lanes' (issue 17 §3).
+    const double refined = state.RefinedExtra(i, task);
+    if (!std::isfinite(refined)) {  // the heading asked for cannot be planned for it
+      bids.push_back(UnreachableBid(state.robot_id(i), s.end_time));
+      continue;
+    }
     Bid b;
     b.robot = state.robot_id(i);
     b.ready_time = s.end_time;
     // Chu2024 eq. (3): T_d = S_d / v and T_w = n_c * t_w over the queue and the order.
-    SetTimes(c, s.travel_time + leg + task_travel, s.work_time + task_work, b);
+    SetTimes(c, s.travel_time + leg + task_travel + refined, s.work_time + task_work, b);
     bids.push_back(std::move(b));
   }
   TrafficPredictor::DensityAccumulator density(predictor, TrafficPredictor::PlanHandle{});

@@ -154,18 +154,38 @@ Status FleetState::AssignSingle(std::size_t robot, const std::string& order_id,
     return Error{segment.error().code,
                  "order " + order_id + " for robot " + e.info.id + ": " + segment.error().message};
   }
-  if (free_space_ && e.info.kind == RobotKind::kFourWheelSteer) {
-    Result<Plan> refined = free_space_->Refine(*segment, config_.speed, StopWaypoints(*segment, task.stop_headings));
-    if (refined.ok()) {
-      segment = std::move(refined);
-    } else if (!task.stop_headings.empty()) {  // its lanes cannot give the heading
-      return Error{refined.error().code, "order " + order_id + " for robot " + e.info.id +
-                                             ": the heading asked for cannot be planned: " + refined.error().message};
-    }  // else: its lanes
+  double travel = routes_->Cost(s.end_point, task.picks.front()) + TaskTravelTime(task);
+  Result<double> extra = Refined(e, task, segment.value());
+  if (!extra.ok()) {
+    return Error{extra.error().code, "order " + order_id + " for robot " + e.info.id + ": " + extra.error().message};
   }
-  const double travel = routes_->Cost(s.end_point, task.picks.front()) + TaskTravelTime(task);
+  travel += *extra;
   AppendTask(e, order_id, task, segment->waypoints, travel);
   return Ok{};
+}
+
+Result<double> FleetState::Refined(const RobotEntry& e, const PlanTask& task, Plan& segment) const {
+  if (!free_space_ || e.info.kind != RobotKind::kFourWheelSteer) return 0.0;
+  Result<Plan> refined = free_space_->Refine(segment, config_.speed, StopWaypoints(segment, task.stop_headings));
+  if (!refined.ok()) {
+    if (task.stop_headings.empty()) return 0.0;  // its lanes
+    // Its lanes cannot give the heading.
+    return Error{refined.error().code, "the heading asked for cannot be planned: " + refined.error().message};
+  }
+  // The same stops and work: the difference at the end is driving and turning.
+  const double extra = refined->waypoints.back().eta - segment.waypoints.back().eta;
+  segment = std::move(refined).value();
+  return extra;
+}
+
+double FleetState::RefinedExtra(std::size_t robot, const PlanTask& task) const {
+  const RobotEntry& e = robots_.at(robot);
+  if (!free_space_ || e.info.kind != RobotKind::kFourWheelSteer || !CanServe(robot, task)) return 0.0;
+  const QueueSummary& s = e.summary;
+  Result<Plan> segment = BuildPlan(*map_, *routes_, s.end_point, s.end_time, config_.speed, {task}, config_.turn_time);
+  if (!segment.ok()) return 0.0;  // the bid finds it unreachable on its own
+  Result<double> extra = Refined(e, task, segment.value());
+  return extra.ok() ? *extra : std::numeric_limits<double>::infinity();
 }
 
 void FleetState::AppendTask(RobotEntry& e, const std::string& order_id, const PlanTask& task,

@@ -147,10 +147,21 @@ class FleetState {
   // graph's headings at its stops); null: on the lanes, as every robot. A segment the hybrid
   // A* cannot refine (an anchor pose that does not fit the region, no path, the search limits)
   // keeps its lanes, unless its task asks for a heading: then AssignSingle fails saying why.
-  // The bids still price the lanes' times (the refined legs are usually a few seconds longer).
+  // The auction's bids price the refined legs (RefinedExtra); the batch strategies' costs and
+  // the greedy rule's distance are the lanes'.
   void UseFreeSpace(std::shared_ptr<const FreeSpaceMotion> motion) { free_space_ = std::move(motion); }
+  // Seconds robot's plan for `task` (from its queue's end) takes beyond the lanes' when
+  // AssignSingle refines it through free space (turns, crabs, spins; may be < 0): what the
+  // auction adds to its T_d and AssignSingle to its queue's. 0 when it would not be refined;
+  // +infinity when the task asks for a heading the hybrid A* cannot plan it into.
+  double RefinedExtra(std::size_t robot, const PlanTask& task) const;
 
  private:
+  struct RobotEntry;
+  // `segment` (the lanes' plan of `task` for e) refined through free space when e is a
+  // four-wheel-steer robot and free-space motion is in use; returns the seconds it gained at
+  // its end (0: not refined). Errors: a heading the refinement cannot plan.
+  Result<double> Refined(const RobotEntry& e, const PlanTask& task, Plan& segment) const;
   struct RobotEntry {
     FleetRobot info;
     std::vector<QueuedTask> queue;

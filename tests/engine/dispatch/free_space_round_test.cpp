@@ -173,6 +173,35 @@ TEST(FreeSpaceRound, AStopHeadingNoRobotCanTakeLeavesTheOrderAcceptedSayingWhy) 
   EXPECT_NE(r.notes[0].find("asks for a heading"), std::string::npos) << r.notes[0];
 }
 
+// The auction prices the legs a four-wheel-steer robot will drive: by the lanes R1 (4WIS, at
+// P1) is 2 m nearer K than R2 (differential, at P2), but turning round in the dead-end bay
+// costs it more than that (a spin of pi at 1 rad/s, where the lanes just drive back), so R2
+// wins; R1's bid is its refined plan's time, which is more than its lanes' time.
+TEST(FreeSpaceRound, TheBidsPriceTheRefinedLegs) {
+  const auto map = Bay(false);
+  const auto routes = Routes(map);
+  RoundRunner runner(map, routes, AllocationConfig{}, std::move(MakeAllocator("auction")).value());
+  RoundInput input;
+  RoundRobot r1, r2;
+  r1.id = "R1";
+  r1.start = *map->FindPoint("P1");
+  r1.kind = RobotKind::kFourWheelSteer;
+  r2.id = "R2";
+  r2.start = *map->FindPoint("P2");
+  input.robots = {r1, r2};
+  input.pending = {PickAtK(*map, "o1", 0.0)};
+  const RoundResult result = runner.Run(input);
+  ASSERT_EQ(result.awards.size(), 1u);
+  EXPECT_EQ(result.awards[0].award.winners, std::vector<std::string>{"R2"}) << result.awards[0].award.reason;
+  const Bid& steer = result.awards[0].award.bids.at(0);
+  const Bid& lanes = result.awards[0].award.bids.at(1);
+  const double k = *map->FindPoint("K"), d = *map->FindPoint("D");
+  const double lanes_r1 = routes->Cost(r1.start, static_cast<PointId>(k)) +
+                          routes->Cost(static_cast<PointId>(k), static_cast<PointId>(d));
+  EXPECT_GT(steer.t_d, lanes_r1 + 2.0) << "R1's bid prices its turn in the bay";
+  EXPECT_LT(lanes_r1, lanes.t_d) << "by the lanes alone R1 is nearer";
+}
+
 // Orders at K every 5 s through the core, checked for safety at every step.
 Result<StreamResult> Serve(std::shared_ptr<const WarehouseMap> map, const std::vector<FleetRobot>& robots, int count) {
   std::vector<Order> orders;
