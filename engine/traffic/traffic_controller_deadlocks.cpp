@@ -19,7 +19,7 @@ std::size_t traffic_detail::RouteQueryHash::operator()(const traffic_detail::Rou
   std::size_t h = 0;  // the bound is not part of the key
   for (long long v : {static_cast<long long>(q.from), static_cast<long long>(q.to),
                       static_cast<long long>(q.ban_point), static_cast<long long>(q.ban_corridor),
-                      static_cast<long long>(q.ban_guard)}) {
+                      static_cast<long long>(q.ban_guard), static_cast<long long>(q.keep_off)}) {
     h = h * 1000003u ^ std::hash<long long>{}(v);
   }
   return h;
@@ -31,8 +31,8 @@ std::size_t traffic_detail::RouteQueryHash::operator()(const traffic_detail::Rou
 // the straight distance and no robot is faster than `speed`); searches stop once every
 // open route costs more than `bound` seconds (no route returned then).
 Detour TrafficController::Impl::Route(PointId from, PointId to, PointId ban_point, int ban_corridor,
-                                      int ban_guard, double bound) {
-  const traffic_detail::RouteQuery q{from, to, ban_point, ban_corridor, ban_guard, bound};
+                                      int ban_guard, double bound, int keep_off) {
+  const traffic_detail::RouteQuery q{from, to, ban_point, ban_corridor, ban_guard, bound, keep_off};
   if (to == ban_point || from == to) return Search(q);
   // A* pops in increasing cost (the heuristic is consistent), so a search under any bound
   // runs as the unbounded one until it stops: it finds the cheapest route when that costs at
@@ -57,7 +57,8 @@ Detour TrafficController::Impl::Route(PointId from, PointId to, PointId ban_poin
 // arcs), which goes straight for the goal where Search's straight-line heuristic sweeps.
 // Only the cost: which of several cheapest routes Search returns is its own order's choice.
 double TrafficController::Impl::CheapestCost(const traffic_detail::RouteQuery& q) {
-  const auto [from, to, ban_point, ban_corridor, ban_guard, bound] = q;
+  const auto [from, to, ban_point, ban_corridor, ban_guard, bound, keep_off] = q;
+  (void)keep_off;  // read by Allowed(q)
   const double inf = std::numeric_limits<double>::infinity();
   const double limit = bound + 1e-6 * (1.0 + std::abs(bound));  // float tables' rounding
   if (++stamp == 0) {
@@ -101,7 +102,8 @@ double TrafficController::Impl::CheapestCost(const traffic_detail::RouteQuery& q
 
 // Search: Route without the memo.
 Detour TrafficController::Impl::Search(const traffic_detail::RouteQuery& q) {
-  const auto [from, to, ban_point, ban_corridor, ban_guard, bound] = q;
+  const auto [from, to, ban_point, ban_corridor, ban_guard, bound, keep_off] = q;
+  (void)keep_off;  // read by Allowed(q)
   Detour out;
   if (to == ban_point || from == to) {
     if (from == to) out = {{from}, 0.0};
@@ -203,6 +205,22 @@ PointId TrafficController::Impl::StickyBan(std::size_t r) {
   return kNoPoint;
 }
 
+// See traffic_controller_impl.h.
+int TrafficController::Impl::StickyCorridor(std::size_t r) {
+  RobotState& x = robots[r];
+  const int c = x.avoiding_corridor;
+  if (c < 0) return -1;
+  auto inside = [&](PointId p) { return p != kNoPoint && lanes.interior_of[static_cast<std::size_t>(p)] == c; };
+  const auto& holders = cstate[static_cast<std::size_t>(c)].holders;
+  if (!inside(x.at) && (x.route.empty() || !inside(x.route.back())) &&
+      std::find(holders.begin(), holders.end(), x.avoiding_corridor_holder) != holders.end()) {
+    return c;
+  }
+  x.avoiding_corridor = -1;
+  x.avoiding_corridor_holder = -1;
+  return -1;
+}
+
 // Re-plans robot r's route to its goal avoiding what it waits for; true when applied.
 bool TrafficController::Impl::TryDetour(std::size_t r, PointId ban_point, int ban_corridor,
                                         int ban_guard, bool need_free_first_hop) {
@@ -213,13 +231,20 @@ bool TrafficController::Impl::TryDetour(std::size_t r, PointId ban_point, int ba
   // Detours more than blocked_after longer than the current route are not worth taking
   // (and bounding keeps a failing search from sweeping the whole floor).
   const double bound = RouteCost(x) + config.blocked_after;
-  Detour d = Route(x.at, x.route.back(), ban_point, ban_corridor, ban_guard, bound);
+  const int keep_off = StickyCorridor(r);
+  Detour d = Route(x.at, x.route.back(), ban_point, ban_corridor, ban_guard, bound,
+                   keep_off != ban_corridor ? keep_off : -1);
   if (d.points.size() < 2 || !StartAllowed(r, d.points)) return false;
   if (need_free_first_hop && PointBlocker(d.points[1], r) >= 0) return false;
+  const int corridor_holder = ban_corridor >= 0 ? x.waits_on : -1;
   if (!Assign(r, std::move(d.points)).ok()) return false;
   if (holder >= 0) {
     x.avoiding = ban_point;
     x.avoiding_holder = holder;
+  }
+  if (corridor_holder >= 0) {
+    x.avoiding_corridor = ban_corridor;
+    x.avoiding_corridor_holder = corridor_holder;
   }
   Replanned(x);
   ClearWait(x);
@@ -255,7 +280,7 @@ bool TrafficController::Impl::TryBackOff(std::size_t r, PointId avoid, PointId b
     std::vector<PointId> route{x.at};
     if (goal != kNoPoint) {
       const double bound = RouteCost(x) + config.blocked_after;
-      Detour d = Route(n, goal, ban_point, -1, -1, bound);
+      Detour d = Route(n, goal, ban_point, -1, -1, bound, StickyCorridor(r));
       if (d.points.empty()) d = Route(n, goal, kNoPoint, -1, -1, bound);
       if (d.points.empty()) continue;
       // Inside the corridor the other must enter and back through where it stood: it would

@@ -101,7 +101,8 @@ TrafficDecision TrafficController::Impl::HeadOn(std::size_t r, int c, int oncomi
     const double bound = config.head_on == HeadOnPolicy::kChooseFaster
                              ? old_cost + rec.wait_estimate
                              : kInf;
-    Detour d = Route(x.at, x.route.back(), StickyBan(r), c, -1, bound);
+    const int keep_off = StickyCorridor(r);
+    Detour d = Route(x.at, x.route.back(), StickyBan(r), c, -1, bound, keep_off != c ? keep_off : -1);
     if (!d.points.empty() && !StartAllowed(r, d.points)) d = Detour{};
     rec.replan_extra = d.points.empty() ? kInf : d.cost - old_cost;
     const bool replan =

@@ -60,6 +60,10 @@ struct RobotState {
   // detours keep going round it while that robot holds it (StickyBan).
   PointId avoiding = kNoPoint;
   int avoiding_holder = -1;
+  // The same for the corridor its last detour went round, and the robot it waited on there
+  // (StickyCorridor).
+  int avoiding_corridor = -1;
+  int avoiding_corridor_holder = -1;
   std::string why;
   // Giving way (Wang2019 §3.3 case ②, GiveWay): to this robot (-1: none), until then at most.
   int give_way_to = -1;
@@ -102,9 +106,10 @@ struct RouteQuery {
   PointId from, to, ban_point;
   int ban_corridor, ban_guard;
   double bound;  // not part of the memo's key (RouteAnswer)
+  int keep_off = -1;  // a second corridor banned (the one its last detour went round, StickyCorridor)
   bool operator==(const RouteQuery& o) const {
     return from == o.from && to == o.to && ban_point == o.ban_point && ban_corridor == o.ban_corridor &&
-           ban_guard == o.ban_guard;
+           ban_guard == o.ban_guard && keep_off == o.keep_off;
   }
 };
 // What a search under `bound` found: the cheapest route (then the answer to every bound at
@@ -232,6 +237,13 @@ struct TrafficController::Impl {
   // head-on on the way, and the head-on's detour, shorter than the one it drove, led back to
   // the held point: round and back every 8 s until it was blocked.
   PointId StickyBan(std::size_t r);
+  // The corridor r's last detour from a corridor wait went round (-1: none), while the robot
+  // it waited on still holds it and r is not in it nor bound for a point in it: detours,
+  // head-on detours and back-offs keep off it too (found on a dense grid with the time-window
+  // planner: a robot backed off from one corridor held the other way straight into the
+  // corridor its detour had just gone round, and back, for 120 s, while a robot waiting for it
+  // to clear was blocked).
+  int StickyCorridor(std::size_t r);
   // With r's envelope taken as `envelope` (an agent about to be placed with another one).
   int PointBlocker(PointId q, std::size_t r, double envelope) const;
   int CorridorBlocker(int c, int d, std::size_t r) const;
@@ -276,13 +288,14 @@ struct TrafficController::Impl {
 
   // Detours, back-off, sidings and deadlocks (traffic_controller_deadlocks.cpp).
   Detour Route(PointId from, PointId to, PointId ban_point, int ban_corridor, int ban_guard,
-               double bound = kInf);
+               double bound = kInf, int keep_off = -1);
   Detour Search(const traffic_detail::RouteQuery& q);  // Route without the memo
   double CheapestCost(const traffic_detail::RouteQuery& q);  // Search's route cost, by bound_routes
   // Whether a search under q's bans may take arc a (its point, corridor and intersection).
   bool Allowed(const SearchArc& a, const traffic_detail::RouteQuery& q) const {
     if (a.to == q.ban_point) return false;
     if (q.ban_corridor >= 0 && a.corridor == q.ban_corridor) return false;
+    if (q.keep_off >= 0 && a.corridor == q.keep_off) return false;
     return !(q.ban_guard >= 0 && guard_of[static_cast<std::size_t>(a.to)] == q.ban_guard && a.to != q.to);
   }
   bool StartAllowed(std::size_t r, const std::vector<PointId>& points) const;
