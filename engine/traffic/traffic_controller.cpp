@@ -67,6 +67,10 @@ Result<TrafficController> TrafficController::Create(std::shared_ptr<const Wareho
       if (IsServicePoint(m.point(pts[k]).kind)) impl->cstate[c].exclusive = true;
     }
   }
+  impl->region_of.assign(n, -1);
+  for (std::size_t f = 0; f < m.free_spaces().size(); ++f) {
+    for (PointId p : m.free_spaces()[f].points) impl->region_of[static_cast<std::size_t>(p)] = static_cast<int>(f);
+  }
   impl->dist.assign(n, kInf);
   impl->via.assign(n, -1);
   impl->seen.assign(n, 0);

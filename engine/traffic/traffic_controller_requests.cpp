@@ -40,6 +40,19 @@ int TrafficController::Impl::PointBlocker(PointId q, std::size_t r, double envel
 }
 
 // The robot holding corridor c the other way (-1: free for direction d).
+int TrafficController::Impl::RegionBlocker(PointId q, std::size_t r) const {
+  const int f = region_of[static_cast<std::size_t>(q)];
+  const RobotState& x = robots[r];
+  if (f < 0 || (x.at != kNoPoint && region_of[static_cast<std::size_t>(x.at)] == f)) return -1;
+  auto in = [&](PointId p) { return p != kNoPoint && region_of[static_cast<std::size_t>(p)] == f; };
+  for (std::size_t h = 0; h < robots.size(); ++h) {
+    const RobotState& o = robots[h];
+    if (h == r || o.removed || Mates(x, o)) continue;
+    if (in(o.at) || in(o.next)) return static_cast<int>(h);
+  }
+  return -1;
+}
+
 int TrafficController::Impl::CorridorBlocker(int c, int d, std::size_t r) const {
   const CorridorState& s = cstate[static_cast<std::size_t>(c)];
   if (s.dir == d && !s.exclusive) return -1;
@@ -275,6 +288,13 @@ TrafficDecision TrafficController::Impl::Check(std::size_t r, PointId q, double 
     x.wait_point = q;
     return WaitFor(r, WaitKind::kPoint, blocker, t, WhyKey{2, q, blocker},
                    [&] { return "point " + Name(q) + " held by " + robots[static_cast<std::size_t>(blocker)].id; });
+  }
+  if (const int holder_in = RegionBlocker(q, r); holder_in >= 0) {
+    x.wait_point = q;
+    return WaitFor(r, WaitKind::kPoint, holder_in, t, WhyKey{6, region_of[static_cast<std::size_t>(q)], holder_in}, [&] {
+      return "free-space region '" + M().free_spaces()[static_cast<std::size_t>(region_of[static_cast<std::size_t>(q)])].name +
+             "' held by " + robots[static_cast<std::size_t>(holder_in)].id;
+    });
   }
   for (std::size_t k = x.pos; k < x.arcs.size() && k < x.pos + 2; ++k) {
     const int c = CorridorOf(x.arcs[k]);

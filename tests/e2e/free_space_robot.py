@@ -9,9 +9,8 @@ planned into it: the order (REST) shows the heading; the route the service shows
 them, the pick's waypoint facing pi; fleet-sim drives them. Then a plain order into the bay
 goes to R2: R1 is nearer by the lanes, but the bids price its route through the bay (it turns
 round there, where the lanes just drive back). Both orders complete with the robots never
-closer than eps1. (Only one robot is in the bay at a time here: the gate sees a refined robot
-at the graph points its poses are named after, so another robot in the same region is not
-kept clear of its true path; a region kept to one robot is still missing.) A heading at the drop (on the lanes) is INVALID_ARGUMENT, and a
+closer than eps1 (a free-space region holds one robot at a time: the traffic controller keeps
+the other out while one is in it). A heading at the drop (on the lanes) is INVALID_ARGUMENT, and a
 dispatcher running the time-window planner answers FAILED_PRECONDITION (only the rules planner
 refines plans through free space). (That a differential robot keeps
 its lanes is the core test's,

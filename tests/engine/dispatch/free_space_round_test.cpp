@@ -228,6 +228,22 @@ TEST(FreeSpaceRound, AFourWheelSteerRobotTurnsRoundInTheDeadEndOrderAfterOrder) 
   ExpectAllDoneSafely(Serve(map, {{"R1", *map->FindPoint("P1"), 0.0, RobotKind::kFourWheelSteer}}, 3));
 }
 
+// A free-space region holds one robot at a time (TrafficController::RegionBlocker): in the
+// dead-end bay the two kinds take turns, order after order, and the safety check over the
+// robots' true positions finds nothing. Without it the second robot drove in while the first
+// turned round at K (and two robots in one dead end lock each other up).
+TEST(FreeSpaceRound, BothKindsTakeTurnsInADeadEndBay) {
+  const auto map = Bay(false);
+  auto run = Serve(map,
+                   {{"R1", *map->FindPoint("P1"), 0.0, RobotKind::kFourWheelSteer},
+                    {"R2", *map->FindPoint("P2"), 0.0, RobotKind::kDifferential}},
+                   4);
+  ExpectAllDoneSafely(run);
+  std::set<std::string> served;
+  for (const auto& o : run->orders) served.insert(o.robot);
+  EXPECT_EQ(served, (std::set<std::string>{"R1", "R2"})) << "both kinds served the bay";
+}
+
 TEST(FreeSpaceRound, BothKindsServeTheBayOnTheCoreSafely) {
   const auto map = Bay(true);
   auto run = Serve(map,
