@@ -232,29 +232,24 @@ TEST(FreeSpaceRound, AFourWheelSteerRobotTurnsRoundInTheDeadEndOrderAfterOrder) 
 // dead-end bay the two kinds take turns, order after order, and the safety check over the
 // robots' true positions finds nothing. Without it the second robot drove in while the first
 // turned round at K (and two robots in one dead end lock each other up).
-TEST(FreeSpaceRound, BothKindsTakeTurnsInADeadEndBay) {
-  const auto map = Bay(false);
+// R1 (four-wheel steer, at P1) and R2 (differential, at P2) serve `count` orders at K on the
+// core: every one completes safely, and both kinds serve the bay.
+void ExpectBothKindsServe(bool loop, int count) {
+  const auto map = Bay(loop);
   auto run = Serve(map,
                    {{"R1", *map->FindPoint("P1"), 0.0, RobotKind::kFourWheelSteer},
                     {"R2", *map->FindPoint("P2"), 0.0, RobotKind::kDifferential}},
-                   4);
+                   count);
   ExpectAllDoneSafely(run);
+  if (!run.ok()) return;
   std::set<std::string> served;
   for (const auto& o : run->orders) served.insert(o.robot);
   EXPECT_EQ(served, (std::set<std::string>{"R1", "R2"})) << "both kinds served the bay";
 }
 
-TEST(FreeSpaceRound, BothKindsServeTheBayOnTheCoreSafely) {
-  const auto map = Bay(true);
-  auto run = Serve(map,
-                   {{"R1", *map->FindPoint("P1"), 0.0, RobotKind::kFourWheelSteer},
-                    {"R2", *map->FindPoint("P2"), 0.0, RobotKind::kDifferential}},
-                   6);
-  ExpectAllDoneSafely(run);
-  std::set<std::string> served;
-  for (const auto& o : run->orders) served.insert(o.robot);
-  EXPECT_EQ(served, (std::set<std::string>{"R1", "R2"})) << "both kinds served the bay";
-}
+TEST(FreeSpaceRound, BothKindsTakeTurnsInADeadEndBay) { ExpectBothKindsServe(false, 4); }
+
+TEST(FreeSpaceRound, BothKindsServeTheBayOnTheCoreSafely) { ExpectBothKindsServe(true, 6); }
 
 }  // namespace
 }  // namespace dispatch::engine
