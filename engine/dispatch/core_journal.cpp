@@ -3,6 +3,7 @@
 #include <array>
 #include <cstdio>
 #include <cstring>
+#include <limits>
 #include <utility>
 
 #include "engine/common/fnv1a.h"
@@ -46,7 +47,9 @@ void Add(std::string& out, const std::string& part) {
   out += part;
 }
 
-// The waypoints as numbers: a plan's identity without printing it whole.
+// The waypoints as numbers: a plan's identity without printing it whole. A posed waypoint's
+// heading and motion mode count too (four-wheel-steer plans); a waypoint without them adds the
+// bytes it always did, so journals of lane plans replay to the same lines.
 std::string WaypointsDigest(const std::vector<Waypoint>& waypoints) {
   std::string bytes;
   for (const Waypoint& w : waypoints) {
@@ -54,6 +57,12 @@ std::string WaypointsDigest(const std::vector<Waypoint>& waypoints) {
     const int ints[] = {w.seq, w.point, static_cast<int>(w.action)};
     bytes.append(reinterpret_cast<const char*>(values), sizeof(values));
     bytes.append(reinterpret_cast<const char*>(ints), sizeof(ints));
+    if (w.heading || w.mode) {
+      const double heading = w.heading.value_or(std::numeric_limits<double>::quiet_NaN());
+      const int mode = w.mode ? static_cast<int>(*w.mode) : -1;
+      bytes.append(reinterpret_cast<const char*>(&heading), sizeof(heading));
+      bytes.append(reinterpret_cast<const char*>(&mode), sizeof(mode));
+    }
   }
   return Hex64(Fnv1a64(bytes)).substr(0, 8);
 }
