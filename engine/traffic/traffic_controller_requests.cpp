@@ -39,7 +39,6 @@ int TrafficController::Impl::PointBlocker(PointId q, std::size_t r, double envel
   return -1;
 }
 
-// The robot holding corridor c the other way (-1: free for direction d).
 int TrafficController::Impl::RegionBlocker(PointId q, std::size_t r) const {
   const int f = region_of[static_cast<std::size_t>(q)];
   const RobotState& x = robots[r];
@@ -53,6 +52,7 @@ int TrafficController::Impl::RegionBlocker(PointId q, std::size_t r) const {
   return -1;
 }
 
+// The robot holding corridor c the other way (-1: free for direction d).
 int TrafficController::Impl::CorridorBlocker(int c, int d, std::size_t r) const {
   const CorridorState& s = cstate[static_cast<std::size_t>(c)];
   if (s.dir == d && !s.exclusive) return -1;
@@ -291,9 +291,10 @@ TrafficDecision TrafficController::Impl::Check(std::size_t r, PointId q, double 
   }
   if (const int holder_in = RegionBlocker(q, r); holder_in >= 0) {
     x.wait_point = q;
-    return WaitFor(r, WaitKind::kPoint, holder_in, t, WhyKey{6, region_of[static_cast<std::size_t>(q)], holder_in}, [&] {
-      return "free-space region '" + M().free_spaces()[static_cast<std::size_t>(region_of[static_cast<std::size_t>(q)])].name +
-             "' held by " + robots[static_cast<std::size_t>(holder_in)].id;
+    const int f = region_of[static_cast<std::size_t>(q)];
+    return WaitFor(r, WaitKind::kPoint, holder_in, t, WhyKey{6, f, holder_in}, [&] {
+      return "free-space region '" + M().free_spaces()[static_cast<std::size_t>(f)].name + "' held by " +
+             robots[static_cast<std::size_t>(holder_in)].id;
     });
   }
   for (std::size_t k = x.pos; k < x.arcs.size() && k < x.pos + 2; ++k) {

@@ -63,19 +63,18 @@ bool GateImpl::TeammateBeside(const GateBot& b, const std::string& order) const 
   // stranger 0.400 m from it).
   if (!OnFloor(b)) return false;
   const PointId next = ctl.Next(static_cast<std::size_t>(b.ctl));
-  if (next == kNoPoint) return false;
-  const Eigen::Vector2d& p = map->point(next).position;
-  for (const auto& [id, o] : bots) {
-    if (&o != &b && o.has_xy && OfTeam(o, order) && (o.xy - p).norm() < envelope) return true;
-  }
-  return false;
+  return next != kNoPoint && TeamDistanceFrom(map->point(next).position, b, order) < envelope;
 }
 
 double GateImpl::TeammateDistance(const GateBot& b, const std::string& order) const {
+  if (!b.has_xy) return std::numeric_limits<double>::infinity();
+  return TeamDistanceFrom(b.xy, b, order);
+}
+
+double GateImpl::TeamDistanceFrom(const Eigen::Vector2d& p, const GateBot& b, const std::string& order) const {
   double best = std::numeric_limits<double>::infinity();
-  if (!b.has_xy) return best;
   for (const auto& [id, o] : bots) {
-    if (&o != &b && o.has_xy && OfTeam(o, order)) best = std::min(best, (o.xy - b.xy).norm());
+    if (&o != &b && o.has_xy && OfTeam(o, order)) best = std::min(best, (o.xy - p).norm());
   }
   return best;
 }

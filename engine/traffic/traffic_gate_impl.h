@@ -288,6 +288,8 @@ struct GateImpl {
   bool TeammateBeside(const GateBot& b, const std::string& order) const;
   // The distance from b to the nearest other robot of team `order` (infinity: none known).
   double TeammateDistance(const GateBot& b, const std::string& order) const;
+  // The distance from p to the nearest robot of team `order` other than b (infinity: none).
+  double TeamDistanceFrom(const Eigen::Vector2d& p, const GateBot& b, const std::string& order) const;
   bool StepLeaving(GateTeam& team, double t, std::vector<GateEffect>& out);  // traffic_gate_leaving.cpp
 };
 

@@ -80,8 +80,7 @@ def main():
         # inside the bay, a turn among them, and the pick's waypoint faces pi.
         refused(server, grpc.StatusCode.INVALID_ARGUMENT, "inside a free-space region", drop_heading=0.0)
         posed_order = submit(server, "1", pick_heading=math.pi)
-        shown = server.rest(f"/api/v1/orders/{posed_order}")
-        heading = shown.get("order", shown)["picks"][0].get("heading")
+        heading = server.rest(f"/api/v1/orders/{posed_order}")["order"]["picks"][0].get("heading")  # OrderDetail
         check(heading is not None and abs(abs(heading) - math.pi) < 1e-9, f"the order shows pick heading {heading}")
         h.watch(server, lambda o: posed_order in o and o[posed_order].state in (ASSIGNED, IN_PROGRESS),
                 timeout=20, what="the order with a heading assigned", order_ids=[posed_order])
