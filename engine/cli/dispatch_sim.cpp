@@ -43,6 +43,7 @@
 
 #include "engine/allocation/auction_allocator.h"
 #include "engine/cli/journal_replay.h"
+#include "engine/cli/lorr_command.h"
 #include "engine/cli/mapf_command.h"
 #include "engine/cli/motion_command.h"
 #include "engine/cli/routing_command.h"
@@ -216,6 +217,8 @@ int Main(int argc, char** argv) {
   r->add_option("--max-time", replay.max_time, "What-if simulated seconds before giving up")->capture_default_str();
   MapfArgs mapf;
   auto* m = AddMapfCommand(app, mapf);
+  LorrArgs lorr, lorr_check;
+  const LorrCommands lorr_commands = AddLorrCommands(app, lorr, lorr_check);
   MotionArgs motion;
   auto* mo = AddMotionCommand(app, motion);
   RoutingArgs routing;
@@ -223,6 +226,8 @@ int Main(int argc, char** argv) {
   CLI11_PARSE(app, argc, argv);
   if (*rt) return RunRouting(routing);
   if (*m) return RunMapf(mapf);
+  if (*lorr_commands.run) return RunLorr(lorr);
+  if (*lorr_commands.check) return RunLorrCheck(lorr_check);
   if (*mo) return RunMotion(motion);
   if (*r) return RunReplay(replay);
   if (*p) return RunPlan(plan);

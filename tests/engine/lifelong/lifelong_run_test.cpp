@@ -1,0 +1,137 @@
+#include "engine/lifelong/lifelong_run.h"
+
+#include <gtest/gtest.h>
+
+#include <nlohmann/json.hpp>
+
+#include "engine/lifelong/lorr_check.h"
+#include "engine/lifelong/lorr_output.h"
+#include "lorr_files.h"
+
+namespace dispatch::engine {
+namespace {
+
+using testing_lorr::LorrExample;
+using testing_lorr::WriteProblem;
+
+LorrProblem Load(const std::string& json) {
+  auto problem = LoadLorrProblem(json);
+  EXPECT_TRUE(problem.ok()) << problem.error().message;
+  return std::move(problem).value();
+}
+
+LifelongRecord RunFor(const LorrProblem& problem, int steps, const std::string& strategy = "greedy") {
+  LifelongOptions options;
+  options.steps = steps;
+  options.strategy = strategy;
+  auto record = RunLifelong(problem, options);
+  EXPECT_TRUE(record.ok()) << record.error().message;
+  return std::move(record).value();
+}
+
+LorrCheckReport Check(const LorrProblem& problem, const std::string& output) {
+  auto report = CheckLorrOutput(problem, output);
+  EXPECT_TRUE(report.ok()) << report.error().message;
+  return report.ok() ? report.value() : LorrCheckReport{};
+}
+
+// A robot whose task ends in a dead end where an idle robot stands: pushes alone cannot get it
+// in (the idle robot can only leave through the first robot's cell); the swap rule backs the
+// first robot away and lets the idle one out.
+//   row 0: .....
+//   row 1: @@.@@      cell 7 is a dead end below cell 2; robot 0 (at cell 0) is nearer the
+//                     pickup at cell 1 than robot 1 (at cell 7), so it takes the task "1,7"
+TEST(LifelongRunTest, ARobotGetsIntoADeadEndAnotherRobotStandsIn) {
+  const LorrProblem problem = Load(WriteProblem("deadend", {".....", "@@.@@"}, {"0", "7"}, {"1,7"}, 2, 0.5));
+  const LifelongRecord record = RunFor(problem, 30);
+  ASSERT_FALSE(record.events.empty());
+  EXPECT_EQ(record.events[0].robot, 0);
+  EXPECT_GE(record.tasks_finished, 1);
+  EXPECT_EQ(record.planner_errors, 0);
+  EXPECT_TRUE(Check(problem, LorrOutputJson(record, problem.grid)).ok());
+}
+
+TEST(LifelongRunTest, TasksAreRevealedInFileOrderAndWrapRound) {
+  const LorrProblem problem = Load(WriteProblem("wrap", {"......"}, {"0"}, {"1,2", "3,4"}, 1, 2.0));
+  const LifelongRecord record = RunFor(problem, 40);
+  ASSERT_GE(record.tasks.size(), 4u);
+  EXPECT_EQ(record.tasks[0].errands, (std::vector<int>{1, 2}));
+  EXPECT_EQ(record.tasks[2].id, 2);
+  EXPECT_EQ(record.tasks[2].errands, (std::vector<int>{1, 2}));  // task 2 is the file's task 0
+  EXPECT_GE(record.tasks_finished, 3);
+  // Two tasks out at once (2.0 x 1 robot): the third is revealed when the first is finished.
+  EXPECT_EQ(record.tasks[1].release_step, 0);
+  EXPECT_GT(record.tasks[2].release_step, 0);
+  EXPECT_TRUE(Check(problem, LorrOutputJson(record, problem.grid)).ok());
+}
+
+TEST(LifelongRunTest, ThePublicRandomInstanceRunsLegallyAndTheOutputHasTheCompetitionsKeys) {
+  const LorrProblem problem = Load(LorrExample("random.domain/random_32_32_20_100.json"));
+  const LifelongRecord record = RunFor(problem, 100);
+  EXPECT_EQ(record.planner_errors, 0);
+  EXPECT_GT(record.tasks_finished, 20);
+  const std::string output = LorrOutputJson(record, problem.grid);
+  const auto json = nlohmann::json::parse(output);
+  for (const char* key : {"actionModel", "version", "teamSize", "numTaskFinished", "makespan", "numPlannerErrors",
+                          "numScheduleErrors", "numEntryTimeouts", "start", "actualPaths", "plannerPaths",
+                          "plannerTimes", "errors", "actualSchedule", "plannerSchedule", "scheduleErrors", "events",
+                          "tasks"}) {
+    EXPECT_TRUE(json.contains(key)) << key;
+  }
+  EXPECT_EQ(json["actionModel"], "MAPF_T");
+  EXPECT_EQ(json["start"][0], nlohmann::json::parse("[11, 8, \"E\"]"));  // cell 360
+  EXPECT_EQ(json["actualPaths"][0].get<std::string>().size(), 2u * 100 - 1);
+  const LorrCheckReport report = Check(problem, output);
+  EXPECT_TRUE(report.ok()) << (report.problems.empty() ? "" : report.problems[0]);
+  EXPECT_EQ(report.tasks_finished, record.tasks_finished);
+  EXPECT_EQ(report.steps, 100);
+}
+
+// The checker finds what a run that broke the rules would write.
+TEST(LifelongRunTest, TheCheckerFindsBrokenOutputs) {
+  const LorrProblem problem = Load(WriteProblem("tamper", {".....", "@@.@@"}, {"0", "4"}, {"2,7", "1,3"}, 2, 1.0));
+  const LifelongRecord record = RunFor(problem, 30);
+  ASSERT_GE(record.tasks_finished, 1);
+  const auto good = nlohmann::json::parse(LorrOutputJson(record, problem.grid));
+  ASSERT_TRUE(Check(problem, good.dump()).ok());
+
+  auto claims_more = good;
+  claims_more["numTaskFinished"] = record.tasks_finished + 1;
+  EXPECT_FALSE(Check(problem, claims_more.dump()).ok());
+
+  auto lost_event = good;
+  lost_event["events"].erase(lost_event["events"].begin());
+  EXPECT_FALSE(Check(problem, lost_event.dump()).ok());
+
+  auto into_wall = good;  // robot 0 starts facing east at cell 0: turn south and drive into '@'
+  std::string path = into_wall["actualPaths"][0];
+  path[0] = 'R';
+  path[2] = 'F';
+  into_wall["actualPaths"][0] = path;
+  EXPECT_FALSE(Check(problem, into_wall.dump()).ok());
+
+  auto other_errands = good;
+  other_errands["tasks"][0][2] = nlohmann::json::parse("[0, 2, 0, 3]");
+  EXPECT_FALSE(Check(problem, other_errands.dump()).ok());
+
+  auto moved_start = good;
+  moved_start["start"][0] = nlohmann::json::parse("[0, 1, \"E\"]");
+  EXPECT_FALSE(Check(problem, moved_start.dump()).ok());
+
+  EXPECT_FALSE(CheckLorrOutput(problem, "[1, 2]").ok());
+}
+
+TEST(LifelongRunTest, BadOptionsAreRefused) {
+  const LorrProblem problem = Load(WriteProblem("options", {"...."}, {"0"}, {"1,2"}, 1));
+  LifelongOptions options;
+  options.strategy = "nearest";
+  auto unknown = RunLifelong(problem, options);
+  ASSERT_FALSE(unknown.ok());
+  EXPECT_NE(unknown.error().message.find("unknown strategy 'nearest'"), std::string::npos);
+  options = {};
+  options.steps = -1;
+  EXPECT_FALSE(RunLifelong(problem, options).ok());
+}
+
+}  // namespace
+}  // namespace dispatch::engine
