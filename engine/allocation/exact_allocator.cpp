@@ -45,6 +45,10 @@ void ExactAllocator::AllocateBatch(const std::vector<const Order*>& orders, Flee
   BatchSingles taken = TakeSingles(orders, state, auction_, sink);
   const std::vector<const Order*>& singles = taken.orders;
   const std::vector<PlanTask>& tasks = taken.tasks;
+  if (state.config().max_queue == 1) {
+    AllocateOneToOne(singles, tasks, state, sink);
+    return;
+  }
   const std::function<bool()> stop = DeadlineCheck(options_.budget);
   std::size_t next = 0;
   while (next < singles.size()) {
@@ -87,35 +91,65 @@ void ExactAllocator::AllocateBatch(const std::vector<const Order*>& orders, Flee
       for (std::size_t k : chunk) sink(*singles[k], auction_.Allocate(*singles[k], state));
       continue;
     }
-    char buf[160];
+    char what[96];
+    std::snprintf(what, sizeof(what), "exact over %zu orders and %zu robots", chunk.size(), robots.size());
     for (std::size_t c = 0; c < chunk.size(); ++c) {
-      const Order& order = *singles[chunk[c]];
-      const PlanTask& task = tasks[chunk[c]];
-      const std::size_t robot = best->robot_of_order[c];
-      const QueueSummary before = state.summary(robot);
-      if (Status s = state.AssignSingle(robot, order.id, task); !s.ok()) {
-        sink(order, s.error());
-        continue;
-      }
-      AwardExplanation ex;
-      ex.order_id = order.id;
-      ex.strategy = std::string(name());
-      // The winner's terms as the auction would state them (its queue up to this order).
-      const QueueSummary& after = state.summary(robot);
-      Bid bid;
-      bid.robot = state.robot_id(robot);
-      bid.ready_time = before.end_time;
-      bid.t_d = after.travel_time;
-      bid.t_w = after.work_time;
-      bid.t_t = bid.t_d + bid.t_w;
-      bid.bid = BidValue(state.config().alpha, state.config().beta, bid.t_t, bid.t_d, 0.0);
-      ex.bids.push_back(bid);
-      ex.winners.push_back(bid.robot);
-      std::snprintf(buf, sizeof(buf), "exact over %zu orders and %zu robots: %s (B=%.2f; %s %.2f)",
-                    chunk.size(), robots.size(), bid.robot.c_str(), bid.bid,
-                    options_.objective == BatchObjective::kBidSum ? "bid sum" : "queue totals", best->cost);
-      ex.reason = buf;
-      sink(order, std::move(ex));
+      Commit(*singles[chunk[c]], tasks[chunk[c]], best->robot_of_order[c], what, best->cost, state, sink);
+    }
+  }
+}
+
+void ExactAllocator::Commit(const Order& order, const PlanTask& task, std::size_t robot, const char* what,
+                            double batch_cost, FleetState& state, const AwardSink& sink) const {
+  const QueueSummary before = state.summary(robot);
+  if (Status s = state.AssignSingle(robot, order.id, task); !s.ok()) {
+    sink(order, s.error());
+    return;
+  }
+  AwardExplanation ex;
+  ex.order_id = order.id;
+  ex.strategy = std::string(name());
+  // The winner's terms as the auction would state them (its queue up to this order).
+  const QueueSummary& after = state.summary(robot);
+  Bid bid;
+  bid.robot = state.robot_id(robot);
+  bid.ready_time = before.end_time;
+  bid.t_d = after.travel_time;
+  bid.t_w = after.work_time;
+  bid.t_t = bid.t_d + bid.t_w;
+  bid.bid = BidValue(state.config().alpha, state.config().beta, bid.t_t, bid.t_d, 0.0);
+  ex.bids.push_back(bid);
+  ex.winners.push_back(bid.robot);
+  char buf[200];
+  std::snprintf(buf, sizeof(buf), "%s: %s (B=%.2f; %s %.2f)", what, bid.robot.c_str(), bid.bid,
+                options_.objective == BatchObjective::kBidSum ? "bid sum" : "queue totals", batch_cost);
+  ex.reason = buf;
+  sink(order, std::move(ex));
+}
+
+void ExactAllocator::AllocateOneToOne(const std::vector<const Order*>& singles, const std::vector<PlanTask>& tasks,
+                                      FleetState& state, const AwardSink& sink) {
+  std::vector<std::size_t> robots;
+  for (std::size_t r = 0; r < state.robot_count(); ++r) {
+    if (state.HasRoom(r)) robots.push_back(r);
+  }
+  std::vector<Order> batch;
+  for (const Order* order : singles) batch.push_back(*order);
+  Result<BatchAssignment> best = OneToOneAssignment(state, batch, robots);
+  if (robots.empty() || !best.ok()) {  // the auction says why
+    for (const Order* order : singles) sink(*order, auction_.Allocate(*order, state));
+    return;
+  }
+  char what[96];
+  std::snprintf(what, sizeof(what), "one-to-one over %zu orders and %zu robots", singles.size(), robots.size());
+  for (std::size_t k = 0; k < singles.size(); ++k) {
+    const std::size_t robot = best->robot_of_order[k];
+    if (robot != kNoRobot) {
+      Commit(*singles[k], tasks[k], robot, what, best->cost, state, sink);
+    } else {
+      sink(*singles[k], Error{ErrorCode::kFailedPrecondition,
+                              "order " + singles[k]->id + ": " + what +
+                                  ", every robot with room took a cheaper order or cannot reach this one"});
     }
   }
 }

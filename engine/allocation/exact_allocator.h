@@ -19,6 +19,11 @@
 // - Formation orders, orders no robot with room reaches, a chunk with no finite map (full
 //   queues, one-way lanes) and, once `budget` is spent, the rest of the batch go to the
 //   auction, which says why.
+// - With AllocationConfig::max_queue = 1 every robot with room takes one order at most, and the
+//   round is one assignment problem whatever its size: OneToOneAssignment over the whole batch
+//   and every robot with room (the Hungarian method). When the orders outnumber those robots,
+//   the cheapest to serve are served (a robot near a pick takes it; the LoRR benchmark's
+//   setting), and the others wait for the next round, saying so.
 // The traffic term of the auction's bids is not part of BatchCost. Deterministic unless the
 // budget runs out. Not thread-safe, like every Allocator.
 #pragma once
@@ -51,6 +56,13 @@ class ExactAllocator : public Allocator {
                      const AwardSink& sink) override;
 
  private:
+  // Every robot holds at most one order (max_queue = 1): the round is one-to-one.
+  void AllocateOneToOne(const std::vector<const Order*>& singles, const std::vector<PlanTask>& tasks,
+                        FleetState& state, const AwardSink& sink);
+  // Appends `order` to `robot`'s queue and tells `sink` why (`what`, the batch's cost).
+  void Commit(const Order& order, const PlanTask& task, std::size_t robot, const char* what, double batch_cost,
+              FleetState& state, const AwardSink& sink) const;
+
   ExactOptions options_;
   AuctionAllocator auction_;
 };

@@ -152,30 +152,31 @@ Result<BatchAssignment> BruteForceAssignment(const FleetState& state,
   return best;
 }
 
-Result<BatchAssignment> HungarianAssignment(const FleetState& state,
-                                            const std::vector<Order>& orders) {
-  Result<std::vector<BatchTask>> tasks = Prepare(state, orders);
-  if (!tasks.ok()) return tasks.error();
-  const std::size_t n = orders.size();
-  const std::size_t m = state.robot_count();
-  if (n > m) {
-    return Error{ErrorCode::kFailedPrecondition,
-                 "hungarian: " + std::to_string(n) + " orders but only " + std::to_string(m) +
-                     " robots (one order per robot)"};
-  }
+namespace {
+
+// Marginal cost of appending each order to each robot's queue (rows: orders; columns: the
+// robots), unreachable = kBig.
+constexpr double kBig = 1e15;
+
+std::vector<std::vector<double>> MarginalCosts(const FleetState& state, const std::vector<BatchTask>& tasks,
+                                               const std::vector<std::size_t>& robots) {
   const AllocationConfig& c = state.config();
-  // Marginal cost of appending order k to robot r's queue; unreachable = a large finite cost.
-  constexpr double kBig = 1e15;
-  std::vector<std::vector<double>> a(n + 1, std::vector<double>(m + 1, 0.0));
-  for (std::size_t k = 0; k < n; ++k) {
-    for (std::size_t r = 0; r < m; ++r) {
-      const BatchTask& t = (*tasks)[k];
-      const double travel = state.routes().Cost(state.summary(r).end_point, t.first) + t.travel;
-      const double cost = c.alpha * (travel + t.work) + c.beta * travel;
-      a[k + 1][r + 1] = std::isfinite(cost) ? cost : kBig;
+  std::vector<std::vector<double>> cost(tasks.size(), std::vector<double>(robots.size(), kBig));
+  for (std::size_t k = 0; k < tasks.size(); ++k) {
+    for (std::size_t j = 0; j < robots.size(); ++j) {
+      const BatchTask& t = tasks[k];
+      const double travel = state.routes().Cost(state.summary(robots[j]).end_point, t.first) + t.travel;
+      const double value = c.alpha * (travel + t.work) + c.beta * travel;
+      if (std::isfinite(value)) cost[k][j] = value;
     }
   }
-  // Rows = orders (n), columns = robots (m >= n); potentials u, v; p[j] = row of column j.
+  return cost;
+}
+
+// The Hungarian method (potentials, O(n^2 m)) on an n x m cost matrix with n <= m: the column
+// of each row, distinct, at the least total.
+std::vector<std::size_t> SolveRows(const std::vector<std::vector<double>>& cost, std::size_t n, std::size_t m) {
+  // 1-based: a[i][j] for rows 1..n and columns 1..m; p[j] = the row of column j.
   std::vector<double> u(n + 1, 0.0), v(m + 1, 0.0);
   std::vector<std::size_t> p(m + 1, 0), way(m + 1, 0);
   for (std::size_t i = 1; i <= n; ++i) {
@@ -190,7 +191,7 @@ Result<BatchAssignment> HungarianAssignment(const FleetState& state,
       std::size_t j1 = 0;
       for (std::size_t j = 1; j <= m; ++j) {
         if (used[j]) continue;
-        const double cur = a[i0][j] - u[i0] - v[j];
+        const double cur = cost[i0 - 1][j - 1] - u[i0] - v[j];
         if (cur < minv[j]) {
           minv[j] = cur;
           way[j] = j0;
@@ -216,15 +217,71 @@ Result<BatchAssignment> HungarianAssignment(const FleetState& state,
       j0 = j1;
     } while (j0 != 0);
   }
-  BatchAssignment result;
-  result.robot_of_order.assign(n, 0);
+  std::vector<std::size_t> column_of_row(n, 0);
   for (std::size_t j = 1; j <= m; ++j) {
-    if (p[j] != 0) result.robot_of_order[p[j] - 1] = j - 1;
+    if (p[j] != 0) column_of_row[p[j] - 1] = j - 1;
   }
+  return column_of_row;
+}
+
+}  // namespace
+
+Result<BatchAssignment> HungarianAssignment(const FleetState& state,
+                                            const std::vector<Order>& orders) {
+  Result<std::vector<BatchTask>> tasks = Prepare(state, orders);
+  if (!tasks.ok()) return tasks.error();
+  const std::size_t n = orders.size();
+  const std::size_t m = state.robot_count();
+  if (n > m) {
+    return Error{ErrorCode::kFailedPrecondition,
+                 "hungarian: " + std::to_string(n) + " orders but only " + std::to_string(m) +
+                     " robots (one order per robot)"};
+  }
+  std::vector<std::size_t> all(m);
+  for (std::size_t r = 0; r < m; ++r) all[r] = r;
+  BatchAssignment result;
+  result.robot_of_order = SolveRows(MarginalCosts(state, *tasks, all), n, m);
   result.cost = Total(state, *tasks, result.robot_of_order, nullptr, BatchObjective::kQueueTotals);
   if (!std::isfinite(result.cost)) {
     return Unreachable("hungarian: no one-order-per-robot assignment of the " +
                        std::to_string(n) + " orders has a finite cost");
+  }
+  return result;
+}
+
+Result<BatchAssignment> OneToOneAssignment(const FleetState& state, const std::vector<Order>& orders,
+                                           const std::vector<std::size_t>& robots) {
+  Result<std::vector<BatchTask>> tasks = Prepare(state, orders);
+  if (!tasks.ok()) return tasks.error();
+  for (std::size_t r : robots) {
+    if (r >= state.robot_count()) return InvalidArgument("one-to-one: unknown robot index " + std::to_string(r));
+  }
+  const std::vector<std::vector<double>> cost = MarginalCosts(state, *tasks, robots);
+  const std::size_t n = orders.size();
+  const std::size_t m = robots.size();
+  BatchAssignment result;
+  result.robot_of_order.assign(n, kNoRobot);
+  if (n == 0 || m == 0) return result;
+  if (n <= m) {
+    const std::vector<std::size_t> column = SolveRows(cost, n, m);
+    for (std::size_t k = 0; k < n; ++k) result.robot_of_order[k] = column[k];
+  } else {  // more orders than robots: rows are the robots
+    std::vector<std::vector<double>> transposed(m, std::vector<double>(n));
+    for (std::size_t k = 0; k < n; ++k) {
+      for (std::size_t j = 0; j < m; ++j) transposed[j][k] = cost[k][j];
+    }
+    const std::vector<std::size_t> order_of_robot = SolveRows(transposed, m, n);
+    for (std::size_t j = 0; j < m; ++j) result.robot_of_order[order_of_robot[j]] = j;
+  }
+  for (std::size_t k = 0; k < n; ++k) {
+    std::size_t& j = result.robot_of_order[k];
+    if (j == kNoRobot) continue;
+    if (cost[k][j] >= kBig) {  // matched only because something had to be: no route
+      j = kNoRobot;
+      continue;
+    }
+    result.cost += cost[k][j];
+    j = robots[j];
   }
   return result;
 }

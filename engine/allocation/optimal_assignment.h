@@ -69,4 +69,16 @@ Result<BatchAssignment> BruteForceAssignment(const FleetState& state,
 Result<BatchAssignment> HungarianAssignment(const FleetState& state,
                                             const std::vector<Order>& orders);
 
+// robot_of_order's entry for an order a one-to-one assignment leaves out.
+inline constexpr std::size_t kNoRobot = static_cast<std::size_t>(-1);
+
+// The one-order-per-robot case of any shape, over `robots` (indices): as many orders as there
+// are robots (or robots as orders) each go to a distinct robot, at the least total of the
+// marginal costs (HungarianAssignment's: eq. (1) of the order appended to the robot's queue),
+// by the Hungarian method on the smaller side (O(min^2 max)). The orders left out, and an
+// order matched to a robot that cannot reach it, get kNoRobot. cost = the matched orders'
+// marginal costs summed. Errors as BatchCost, or an unknown robot index.
+Result<BatchAssignment> OneToOneAssignment(const FleetState& state, const std::vector<Order>& orders,
+                                           const std::vector<std::size_t>& robots);
+
 }  // namespace dispatch::engine

@@ -2,7 +2,7 @@
 // §2) through the product's allocation and planning (engine/lifelong), and the independent
 // checker of its output.
 //   dispatch-sim lorr --problem FILE.json --steps N [--output out.json] [--plan-ms 100]
-//       [--strategy greedy|auction|exact|psoga] [--seed S]
+//       [--strategy exact|auction|greedy|psoga] [--seed S]
 //   dispatch-sim lorr-check --problem FILE.json --output out.json
 // `lorr` prints tasks finished, makespan, errors and planning time per step (mean, max) and
 // writes the competition's output JSON; exit 0, or 2 when the run had planner errors.
@@ -23,7 +23,7 @@ struct LorrArgs {
   int steps = 500;
   std::string output;
   double plan_ms = 0.0;
-  std::string strategy = "greedy";
+  std::string strategy = "exact";
   std::uint64_t seed = 0;
 };
 

@@ -3,10 +3,12 @@
 //
 // Each step t (the competition's order, v2.1.2):
 //  1. Schedule: the revealed tasks no robot holds go to the robots without a task through the
-//     product's allocation strategy (MakeAllocator: greedy, auction, exact, psoga), as orders
-//     (picks = all errands but the last, drop = the last, no work time) on the grid's map with a
-//     FleetState of the free robots, one task each at most (max_queue = 1). A robot keeps its
-//     task until it is finished (the competition forbids taking an opened task away).
+//     product's allocation strategy (MakeAllocator: exact by default, auction, greedy, psoga), as
+//     orders (picks = all errands but the last, drop = the last, no work time) on the grid's map
+//     with a FleetState of the free robots, one task each at most (max_queue = 1: for `exact`
+//     the round is one assignment problem, the cheapest tasks to serve go to the free robots).
+//     A robot keeps its task until it is finished (the competition forbids taking an opened
+//     task away).
 //  2. Plan: TurnPibt gives every robot an action towards its task's next errand.
 //  3. Move: the joint step is checked (CheckJointStep); an illegal one is logged as a planner
 //     error and every robot waits instead.
@@ -36,7 +38,7 @@ namespace dispatch::engine {
 struct LifelongOptions {
   int steps = 100;
   double plan_ms = 0.0;           // the per-step time limit, ms; 0 = none
-  std::string strategy = "greedy";  // MakeAllocator's names
+  std::string strategy = "exact";  // MakeAllocator's names
   std::uint64_t seed = 0;
   // Polled between steps: true stops the run early (its record holds the steps done).
   std::function<bool()> cancelled;

@@ -33,6 +33,7 @@ bool TurnPibt::Push(int robot, int banned_cell) {
     int target_first;  // 0 for the cell the robot is turning towards
     int turns;         // 0 for the own cell and the cell ahead
     std::uint64_t tie;
+    double score = 0.0;
   };
   std::array<Candidate, 5> candidates{};
   std::size_t count = 0;
@@ -43,8 +44,16 @@ bool TurnPibt::Push(int robot, int banned_cell) {
     candidates[count++] = {cell, Distance(cell, goal), cell == target_[r] ? 0 : 1, TurnsBetween(pose.direction, d),
                            random_()};
   }
+  // Steps to the goal through each candidate: a neighbour costs its turns and its distance
+  // (one step of the distance is the move itself); staying costs the step it wastes, weighted
+  // so that a robot facing away still turns round rather than wait.
+  for (std::size_t k = 0; k < count; ++k) {
+    Candidate& c = candidates[k];
+    c.score = c.distance + c.turns + (c.cell == pose.cell && goal >= 0 ? kStayCost : 0.0);
+  }
   auto before = [](const Candidate& a, const Candidate& b) {
     if (a.target_first != b.target_first) return a.target_first < b.target_first;
+    if (a.score != b.score) return a.score < b.score;
     if (a.distance != b.distance) return a.distance < b.distance;
     if (a.turns != b.turns) return a.turns < b.turns;
     return a.tie < b.tie;
@@ -61,8 +70,9 @@ bool TurnPibt::Push(int robot, int banned_cell) {
   if (count > 1 && candidates[0].cell != pose.cell) {
     const int best = candidates[0].cell;
     const int other = occupant_[static_cast<std::size_t>(best)];
+    const int other_goal = other == -1 ? -1 : (*goals_)[static_cast<std::size_t>(other)];
     if (other != -1 && next_[static_cast<std::size_t>(other)] == -1 && DeadEndBonus(best) > 0.0 &&
-        (*goals_)[static_cast<std::size_t>(other)] != best) {
+        other_goal != best) {
       follower = other;
       std::reverse(candidates.begin(), candidates.begin() + static_cast<std::ptrdiff_t>(count));
     }

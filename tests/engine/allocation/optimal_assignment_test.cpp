@@ -194,3 +194,83 @@ TEST(OptimalAssignmentTest, ARobotSubsetQueueRoomAndAStopBoundTheSearch) {
 
 }  // namespace
 }  // namespace dispatch::engine
+
+namespace dispatch::engine {
+namespace {
+
+// OneToOneAssignment against every injective map of the smaller side into the larger, each
+// costed by BatchCost on the orders it serves (empty queues cost nothing), on both shapes.
+TEST(OptimalAssignmentTest, OneToOneServesTheCheapestOrdersWhateverTheShape) {
+  auto map = Grid(5, 5, 1.0, 5, {{0, 4}, {4, 4}, {2, 2}, {4, 0}}, {{0, 0}, {2, 4}});
+  auto routes = Routes(map);
+  const std::vector<PointId> picks = {Pt(*map, "0,4"), Pt(*map, "4,4"), Pt(*map, "2,2"), Pt(*map, "4,0")};
+  const std::vector<PointId> drops = {Pt(*map, "0,0"), Pt(*map, "2,4")};
+  int more_orders = 0;
+  for (int seed = 0; seed < 40; ++seed) {
+    std::mt19937 rng(seed + 1000);
+    const std::size_t m = 1 + rng() % 3;
+    const std::size_t n = 1 + rng() % 5;
+    std::vector<FleetRobot> robots;
+    for (std::size_t i = 0; i < m; ++i) {
+      robots.push_back({"R" + std::to_string(i), static_cast<PointId>(rng() % map->point_count()), 0.0});
+    }
+    std::vector<Order> orders;
+    for (std::size_t k = 0; k < n; ++k) {
+      orders.push_back(MakeOrder("o" + std::to_string(k), {picks[rng() % picks.size()]}, drops[rng() % drops.size()],
+                                 false, static_cast<double>(k)));
+    }
+    FleetState s = MakeFleet(map, routes, robots);
+    std::vector<std::size_t> all(m);
+    for (std::size_t r = 0; r < m; ++r) all[r] = r;
+    Result<BatchAssignment> got = OneToOneAssignment(s, orders, all);
+    ASSERT_TRUE(got.ok()) << got.error().message;
+    // Every injective map serving min(n, m) orders: robot_of_order with distinct robots.
+    double best = INFINITY;
+    std::vector<std::size_t> assign(n, kNoRobot);
+    auto cost_of = [&](const std::vector<std::size_t>& a) {
+      std::vector<Order> served;
+      std::vector<std::size_t> by;
+      for (std::size_t k = 0; k < n; ++k) {
+        if (a[k] == kNoRobot) continue;
+        served.push_back(orders[k]);
+        by.push_back(a[k]);
+      }
+      Result<double> c = BatchCost(s, served, by);
+      return c.ok() ? *c : INFINITY;
+    };
+    auto visit = [&](auto&& self, std::size_t k, std::vector<bool>& used, std::size_t count) -> void {
+      if (k == n) {
+        if (count == std::min(n, m)) best = std::min(best, cost_of(assign));
+        return;
+      }
+      assign[k] = kNoRobot;
+      self(self, k + 1, used, count);
+      for (std::size_t r = 0; r < m; ++r) {
+        if (used[r]) continue;
+        used[r] = true;
+        assign[k] = r;
+        self(self, k + 1, used, count + 1);
+        used[r] = false;
+        assign[k] = kNoRobot;
+      }
+    };
+    std::vector<bool> used(m, false);
+    visit(visit, 0, used, 0);
+    std::size_t served = 0;
+    std::vector<bool> taken(m, false);
+    for (std::size_t r : got->robot_of_order) {
+      if (r == kNoRobot) continue;
+      ++served;
+      EXPECT_FALSE(taken[r]) << "seed " << seed;
+      taken[r] = true;
+    }
+    EXPECT_EQ(served, std::min(n, m)) << "seed " << seed;
+    EXPECT_NEAR(cost_of(got->robot_of_order), best, 1e-6) << "seed " << seed;
+    EXPECT_NEAR(got->cost, best, 1e-6) << "seed " << seed;
+    if (n > m) ++more_orders;
+  }
+  EXPECT_GT(more_orders, 10);
+}
+
+}  // namespace
+}  // namespace dispatch::engine

@@ -20,7 +20,7 @@ LorrProblem Load(const std::string& json) {
   return std::move(problem).value();
 }
 
-LifelongRecord RunFor(const LorrProblem& problem, int steps, const std::string& strategy = "greedy") {
+LifelongRecord RunFor(const LorrProblem& problem, int steps, const std::string& strategy = "exact") {
   LifelongOptions options;
   options.steps = steps;
   options.strategy = strategy;
