@@ -46,8 +46,14 @@ void ExactAllocator::AllocateBatch(const std::vector<const Order*>& orders, Flee
   const std::vector<const Order*>& singles = taken.orders;
   const std::vector<PlanTask>& tasks = taken.tasks;
   if (state.config().max_queue == 1) {
-    AllocateOneToOne(singles, tasks, state, sink);
-    return;
+    std::size_t with_room = 0;
+    for (std::size_t r = 0; r < state.robot_count(); ++r) with_room += state.HasRoom(r) ? 1 : 0;
+    const double small = static_cast<double>(std::min(with_room, singles.size()));
+    const double large = static_cast<double>(std::max(with_room, singles.size()));
+    if (small * small * large <= static_cast<double>(options_.max_one_to_one_work)) {
+      AllocateOneToOne(singles, tasks, state, sink);
+      return;
+    }
   }
   const std::function<bool()> stop = DeadlineCheck(options_.budget);
   std::size_t next = 0;

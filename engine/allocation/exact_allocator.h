@@ -20,10 +20,10 @@
 //   queues, one-way lanes) and, once `budget` is spent, the rest of the batch go to the
 //   auction, which says why.
 // - With AllocationConfig::max_queue = 1 every robot with room takes one order at most, and the
-//   round is one assignment problem whatever its size: OneToOneAssignment over the whole batch
-//   and every robot with room (the Hungarian method). When the orders outnumber those robots,
-//   the cheapest to serve are served (a robot near a pick takes it; the LoRR benchmark's
-//   setting), and the others wait for the next round, saying so.
+//   round is one assignment problem: OneToOneAssignment over the whole batch and every robot
+//   with room (the Hungarian method), up to `max_one_to_one_work` (beyond, the chunks). When
+//   the orders outnumber those robots, the cheapest to serve are served (a robot near a pick
+//   takes it; the LoRR benchmark's setting), and the others wait for the next round, saying so.
 // The traffic term of the auction's bids is not part of BatchCost. Deterministic unless the
 // budget runs out. Not thread-safe, like every Allocator.
 #pragma once
@@ -44,6 +44,9 @@ struct ExactOptions {
   std::size_t candidates = 4;                          // robots per order (>= 1)
   std::size_t max_maps = 50'000;                       // maps per chunk (>= candidates)
   std::chrono::milliseconds budget{1000};              // per batch
+  // The one-to-one round's bound: min(orders, robots)^2 x max(orders, robots) (the Hungarian
+  // method's steps; 2e8 is about half a second here). Larger rounds go in chunks.
+  double max_one_to_one_work = 2e8;
 };
 
 class ExactAllocator : public Allocator {

@@ -26,6 +26,8 @@ LorrCommands AddLorrCommands(CLI::App& app, LorrArgs& run, LorrArgs& check) {
       ->capture_default_str()->check(CLI::NonNegativeNumber);
   l->add_option("--strategy", run.strategy, "Allocation strategy")->capture_default_str()->check(CLI::IsMember(AllocatorNames()));
   l->add_option("--seed", run.seed, "Seed of the planner's tie-breaks")->capture_default_str();
+  l->add_option("--route-cache-mb", run.route_cache_mb, "The lazy route table's cache on large floors, MiB")
+      ->capture_default_str()->check(CLI::PositiveNumber);
   commands.run = l;
   auto* c = app.add_subcommand("lorr-check", "Replay a LoRR output JSON against its problem and check every rule");
   c->add_option("--problem", check.problem, "The problem JSON")->required();
@@ -47,6 +49,7 @@ int RunLorr(const LorrArgs& a) {
   options.plan_ms = a.plan_ms;
   options.strategy = a.strategy;
   options.seed = a.seed;
+  options.route_cache_bytes = a.route_cache_mb << 20;
   const auto run_begin = std::chrono::steady_clock::now();
   Result<LifelongRecord> record = RunLifelong(*problem, options);
   if (!record) {

@@ -2,7 +2,7 @@
 // §2) through the product's allocation and planning (engine/lifelong), and the independent
 // checker of its output.
 //   dispatch-sim lorr --problem FILE.json --steps N [--output out.json] [--plan-ms 100]
-//       [--strategy exact|auction|greedy|psoga] [--seed S]
+//       [--strategy exact|auction|greedy|psoga] [--seed S] [--route-cache-mb 4096]
 //   dispatch-sim lorr-check --problem FILE.json --output out.json
 // `lorr` prints tasks finished, makespan, errors and planning time per step (mean, max) and
 // writes the competition's output JSON; exit 0, or 2 when the run had planner errors.
@@ -25,6 +25,7 @@ struct LorrArgs {
   double plan_ms = 0.0;
   std::string strategy = "exact";
   std::uint64_t seed = 0;
+  std::size_t route_cache_mb = 4096;
 };
 
 struct LorrCommands {

@@ -200,7 +200,9 @@ Result<LifelongRecord> RunLifelong(const LorrProblem& problem, const LifelongOpt
   if (problem.starts.empty()) return InvalidArgument("the problem has no robots");
   Result<std::unique_ptr<Allocator>> allocator = MakeAllocator(options.strategy);
   if (!allocator) return allocator.error();
-  Result<std::unique_ptr<RouteTable>> routes = MakeRouteTable(problem.grid.map(), RouteTableOptions{});
+  RouteTableOptions route_options;
+  route_options.lazy_cache_bytes = options.route_cache_bytes;
+  Result<std::unique_ptr<RouteTable>> routes = MakeRouteTable(problem.grid.map(), route_options);
   if (!routes) return routes.error();
   Run run(problem, options, std::move(allocator).value(), std::shared_ptr<const RouteTable>(std::move(routes).value()));
   return run.Go();

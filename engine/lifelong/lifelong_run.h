@@ -40,6 +40,10 @@ struct LifelongOptions {
   double plan_ms = 0.0;           // the per-step time limit, ms; 0 = none
   std::string strategy = "exact";  // MakeAllocator's names
   std::uint64_t seed = 0;
+  // The route table's cache on floors above RouteTableOptions::lazy_threshold_points (the
+  // lazy table: 12 bytes per cell per destination; every robot's goal and every waiting
+  // task's pickup is a destination, so the LoRR warehouse floors need a few GiB).
+  std::size_t route_cache_bytes = std::size_t{4} << 30;
   // Polled between steps: true stops the run early (its record holds the steps done).
   std::function<bool()> cancelled;
 };
