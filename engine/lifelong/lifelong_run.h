@@ -20,7 +20,9 @@
 // When a step's scheduling and planning take longer than `plan_ms` (0: no limit), the
 // competition's robots would have waited: the run counts an entry timeout and every robot waits
 // ('T') for each whole `plan_ms` over, before the late actions are applied. Deterministic for a
-// seed when plan_ms = 0.
+// seed when plan_ms = 0, except where a strategy's own time budget runs out (the exact
+// strategy's chunks on a round too large for one assignment: the first step of the large
+// floors).
 #pragma once
 
 #include <cstdint>
