@@ -46,10 +46,12 @@ bool TurnPibt::Push(int robot, int banned_cell) {
   }
   // Steps to the goal through each candidate: a neighbour costs its turns and its distance
   // (one step of the distance is the move itself); staying costs the step it wastes, weighted
-  // so that a robot facing away still turns round rather than wait.
+  // so that a robot facing away still turns round rather than wait; a neighbour another robot
+  // stands in costs the push.
   for (std::size_t k = 0; k < count; ++k) {
     Candidate& c = candidates[k];
     c.score = c.distance + c.turns + (c.cell == pose.cell && goal >= 0 ? kStayCost : 0.0);
+    if (c.cell != pose.cell && occupant_[static_cast<std::size_t>(c.cell)] != -1) c.score += kOccupiedCost;
   }
   auto before = [](const Candidate& a, const Candidate& b) {
     if (a.target_first != b.target_first) return a.target_first < b.target_first;

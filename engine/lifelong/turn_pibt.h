@@ -7,8 +7,8 @@
 // kit's planner does; robots without a goal come last):
 //  1. PIBT: a robot takes the free candidate cell (its own and its free neighbours) with the
 //     fewest steps to its goal through it: the route table's cost from the cell (routes.Cost:
-//     the product's route oracle) plus the quarter turns to face it; for its own cell, its
-//     distance plus kStayCost; ties to the nearer cell, then fewer turns, then seeded random. The cell it turns
+//     the product's route oracle) plus the quarter turns to face it, plus kOccupiedCost when
+//     another robot stands in it; for its own cell, its distance plus kStayCost; ties to the nearer cell, then fewer turns, then seeded random. The cell it turns
 //     towards comes first while it turns (below). A robot standing in the chosen cell
 //     is pushed (priority inheritance) and must leave it, never into the pusher's cell; a
 //     pushed robot that cannot leave makes its pusher try its next candidate. A swap that pushes
@@ -56,6 +56,12 @@ class TurnPibt {
   // What staying costs a robot with a goal, in steps, when candidates are ranked (measured on
   // random_32_32_20_100: 1.5 and 2 rank alike; 1 lets robots facing away wait instead of turn).
   static constexpr double kStayCost = 1.5;
+  // What a neighbour another robot stands in costs beyond its steps: a free cell goes first
+  // among equals, and a robot does not push another to move away from its own goal (that
+  // ties with staying, and the tie goes to the nearer cell). Measured on random_32_32_20_100,
+  // seeds 0-7: mean 845.6 tasks without, 851.6 with 0.1-0.4, 857.4 with 0.5; from 0.75 robots
+  // facing away from an occupied cell wait instead of pushing, and runs lock up (314-759).
+  static constexpr double kOccupiedCost = 0.5;
 
   const LorrGrid& grid_;
   std::shared_ptr<const RouteTable> routes_;
