@@ -13,6 +13,9 @@ namespace {
 using Json = nlohmann::json;
 constexpr std::size_t kMaxProblems = 20;
 
+// CheckLorrOutput's work; nlohmann's type errors (a string where a cell belongs) escape it.
+Result<LorrCheckReport> Replay(const LorrProblem& problem, std::string_view output_json);
+
 class Findings {
  public:
   explicit Findings(LorrCheckReport& report) : report_(report) {}
@@ -61,6 +64,16 @@ Result<std::vector<std::pair<int, int>>> ParseSchedule(const std::string& text, 
 }  // namespace
 
 Result<LorrCheckReport> CheckLorrOutput(const LorrProblem& problem, std::string_view output_json) {
+  try {
+    return Replay(problem, output_json);
+  } catch (const Json::exception& e) {  // a value of the wrong type where a number belongs
+    return InvalidArgument(std::string("the output has a value of the wrong type: ") + e.what());
+  }
+}
+
+namespace {
+
+Result<LorrCheckReport> Replay(const LorrProblem& problem, std::string_view output_json) {
   const Json out = Json::parse(output_json, nullptr, /*allow_exceptions=*/false);
   if (out.is_discarded() || !out.is_object()) return InvalidArgument("the output is not a JSON object");
   for (const char* key : {"teamSize", "numTaskFinished"}) {
@@ -213,5 +226,7 @@ Result<LorrCheckReport> CheckLorrOutput(const LorrProblem& problem, std::string_
   findings.Close();
   return report;
 }
+
+}  // namespace
 
 }  // namespace dispatch::engine

@@ -119,6 +119,11 @@ TEST(LifelongRunTest, TheCheckerFindsBrokenOutputs) {
   EXPECT_FALSE(Check(problem, moved_start.dump()).ok());
 
   EXPECT_FALSE(CheckLorrOutput(problem, "[1, 2]").ok());
+  auto wrong_type = good;  // a word where a row belongs: refused, not thrown
+  wrong_type["tasks"][0][2][0] = "row";
+  auto refused = CheckLorrOutput(problem, wrong_type.dump());
+  ASSERT_FALSE(refused.ok());
+  EXPECT_NE(refused.error().message.find("wrong type"), std::string::npos) << refused.error().message;
 }
 
 TEST(LifelongRunTest, BadOptionsAreRefused) {
