@@ -46,12 +46,14 @@ void ExactAllocator::AllocateBatch(const std::vector<const Order*>& orders, Flee
   const std::vector<const Order*>& singles = taken.orders;
   const std::vector<PlanTask>& tasks = taken.tasks;
   if (state.config().max_queue == 1) {
-    std::size_t with_room = 0;
-    for (std::size_t r = 0; r < state.robot_count(); ++r) with_room += state.HasRoom(r) ? 1 : 0;
-    const double small = static_cast<double>(std::min(with_room, singles.size()));
-    const double large = static_cast<double>(std::max(with_room, singles.size()));
-    if (small * small * large <= static_cast<double>(options_.max_one_to_one_work)) {
-      AllocateOneToOne(singles, tasks, state, sink);
+    std::vector<std::size_t> robots;
+    for (std::size_t r = 0; r < state.robot_count(); ++r) {
+      if (state.HasRoom(r)) robots.push_back(r);
+    }
+    const double small = static_cast<double>(std::min(robots.size(), singles.size()));
+    const double large = static_cast<double>(std::max(robots.size(), singles.size()));
+    if (small * small * large <= options_.max_one_to_one_work) {
+      AllocateOneToOne(singles, tasks, robots, state, sink);
       return;
     }
   }
@@ -134,11 +136,8 @@ void ExactAllocator::Commit(const Order& order, const PlanTask& task, std::size_
 }
 
 void ExactAllocator::AllocateOneToOne(const std::vector<const Order*>& singles, const std::vector<PlanTask>& tasks,
-                                      FleetState& state, const AwardSink& sink) {
-  std::vector<std::size_t> robots;
-  for (std::size_t r = 0; r < state.robot_count(); ++r) {
-    if (state.HasRoom(r)) robots.push_back(r);
-  }
+                                      const std::vector<std::size_t>& robots, FleetState& state,
+                                      const AwardSink& sink) {
   std::vector<Order> batch;
   for (const Order* order : singles) batch.push_back(*order);
   Result<BatchAssignment> best = OneToOneAssignment(state, batch, robots);

@@ -59,9 +59,10 @@ class ExactAllocator : public Allocator {
                      const AwardSink& sink) override;
 
  private:
-  // Every robot holds at most one order (max_queue = 1): the round is one-to-one.
+  // Every robot holds at most one order (max_queue = 1): the round is one-to-one over
+  // `robots`, those with room.
   void AllocateOneToOne(const std::vector<const Order*>& singles, const std::vector<PlanTask>& tasks,
-                        FleetState& state, const AwardSink& sink);
+                        const std::vector<std::size_t>& robots, FleetState& state, const AwardSink& sink);
   // Appends `order` to `robot`'s queue and tells `sink` why (`what`, the batch's cost).
   void Commit(const Order& order, const PlanTask& task, std::size_t robot, const char* what, double batch_cost,
               FleetState& state, const AwardSink& sink) const;

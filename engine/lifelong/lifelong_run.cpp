@@ -122,7 +122,6 @@ class Run {
     }
     std::vector<const Order*> batch;
     for (const Order& order : orders) batch.push_back(&order);
-    std::vector<int> taken;
     allocator_->AllocateBatch(batch, state.value(), [&](const Order& order, Result<AwardExplanation> award) {
       if (!award || award->winners.empty()) return;
       const std::optional<std::size_t> entry = state->FindRobot(award->winners.front());
@@ -131,13 +130,10 @@ class Run {
       const int id = std::stoi(order.id);
       task_of_[static_cast<std::size_t>(robot)] = id;
       open_.at(id).robot = robot;
-      taken.push_back(id);
       record_.planner_schedule[static_cast<std::size_t>(robot)].emplace_back(step + 1, id);
       record_.actual_schedule[static_cast<std::size_t>(robot)].emplace_back(step + 1, id);
     });
-    if (!taken.empty()) {
-      std::erase_if(waiting_, [&](int id) { return open_.at(id).robot != -1; });
-    }
+    std::erase_if(waiting_, [&](int id) { return open_.at(id).robot != -1; });
     return Ok{};
   }
 

@@ -126,11 +126,13 @@ std::vector<GridAction> TurnPibt::Step(const std::vector<GridPose>& poses, const
   }
   std::vector<int> order(n);
   std::iota(order.begin(), order.end(), 0);
+  std::vector<double> rank(n);  // the priority the order sorts by, computed once per robot
+  for (std::size_t r = 0; r < n; ++r) rank[r] = priority_[r] + DeadEndBonus(poses[r].cell);
   std::stable_sort(order.begin(), order.end(), [&](int a, int b) {
     const auto x = static_cast<std::size_t>(a);
     const auto y = static_cast<std::size_t>(b);
     if ((goals[x] >= 0) != (goals[y] >= 0)) return goals[x] >= 0;
-    return priority_[x] + DeadEndBonus(poses[x].cell) > priority_[y] + DeadEndBonus(poses[y].cell);
+    return rank[x] > rank[y];
   });
   next_.assign(n, -1);
   for (std::size_t r = 0; r < n; ++r) occupant_[static_cast<std::size_t>(poses[r].cell)] = static_cast<int>(r);
