@@ -14,10 +14,6 @@ namespace {
 using nlohmann::json;
 using engine::CoreInput;
 
-Error Corrupt(const char* what, const std::string& detail) {
-  return engine::IoError(std::string("stored ") + what + " is corrupt: " + detail);
-}
-
 // Runs `fn` (which may throw json errors) and maps them to `error`.
 template <class T, class F>
 Result<T> Guard(const char* what, bool decoding, F&& fn) {

@@ -10,13 +10,14 @@
 #include "engine/common/fnv1a.h"
 
 namespace dispatch::storage {
-namespace {
-
-using nlohmann::json;
 
 Error Corrupt(const char* what, const std::string& detail) {
   return engine::IoError(std::string("stored ") + what + " is corrupt: " + detail);
 }
+
+namespace {
+
+using nlohmann::json;
 
 // Order::stop_headings as [[stop index, radians], ...] in index order.
 json HeadingsJson(const std::map<std::size_t, double>& headings) {

@@ -15,6 +15,9 @@
 
 namespace dispatch::storage {
 
+// kIoError "stored <what> is corrupt: <detail>", the decoders' one error.
+Error Corrupt(const char* what, const std::string& detail);
+
 // Order body: picks, drop, work_time, release_time.
 Result<std::string> EncodeOrderBody(const engine::Order& order);
 // Fills picks, drop, work_time, release_time of `order` from `body`.

@@ -9,11 +9,10 @@
 #include <utility>
 
 #include "engine/allocation/route_sampler.h"
+#include "engine/common/numbers.h"
 
 namespace dispatch::engine {
 namespace {
-
-constexpr double kInf = std::numeric_limits<double>::infinity();
 
 Bid UnreachableBid(const std::string& robot, double ready_time) {
   Bid b;

@@ -5,11 +5,10 @@
 #include <limits>
 
 #include "engine/allocation/allocator.h"
+#include "engine/common/numbers.h"
 
 namespace dispatch::engine {
 namespace {
-
-constexpr double kInf = std::numeric_limits<double>::infinity();
 
 struct BatchTask {
   PointId first = kNoPoint;

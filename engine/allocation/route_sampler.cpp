@@ -3,10 +3,9 @@
 #include <algorithm>
 #include <limits>
 
+#include "engine/common/numbers.h"
+
 namespace dispatch::engine {
-namespace {
-constexpr double kInf = std::numeric_limits<double>::infinity();
-}  // namespace
 
 RouteSampler::RouteSampler(const WarehouseMap& map, const RouteTable& routes, double speed,
                            double step) {

@@ -8,10 +8,10 @@
 #include <random>
 #include <utility>
 
+#include "engine/common/numbers.h"
+
 namespace dispatch::engine {
 namespace {
-
-constexpr double kInf = std::numeric_limits<double>::infinity();
 
 // Heading change between two headings, in [0, pi].
 double Turn(double a, double b) {
@@ -36,9 +36,9 @@ struct Particle {
   double previous_best_fit = kInf;  // pbest's fitness before this iteration (evolution speed)
 };
 
-class Search {
+class SwarmSearch {
  public:
-  Search(const SwarmProblem& p, const SwarmOptions& o, std::vector<double> dist)
+  SwarmSearch(const SwarmProblem& p, const SwarmOptions& o, std::vector<double> dist)
       : p_(p), o_(o), dist_(std::move(dist)), m_(SwarmBlocks(p.tasks.size(), p.robots.size()).back()), rng_(o.seed) {}
 
   SwarmPlan Run();
@@ -76,7 +76,7 @@ class Search {
   double gbest_fit_ = kInf;
 };
 
-void Search::Repair(std::vector<std::size_t>& pos) {
+void SwarmSearch::Repair(std::vector<std::size_t>& pos) {
   // Each task given twice keeps one copy at random; the others take the unassigned tasks, in
   // random order (seed 003 step 3, last paragraph).
   std::vector<std::vector<std::size_t>> where(m_);
@@ -96,7 +96,7 @@ void Search::Repair(std::vector<std::size_t>& pos) {
   for (std::size_t k = 0; k < empty.size(); ++k) pos[empty[k]] = missing[k];
 }
 
-void Search::Update(Particle& x, const std::vector<std::size_t>& gbest, double w, double c1, double c2) {
+void SwarmSearch::Update(Particle& x, const std::vector<std::size_t>& gbest, double w, double c1, double c2) {
   // Eq. (2), the velocity clamped to a tenth of the index range (at least 1: the usual v_max
   // of PSO, here measured best of 0.05, 0.1 and 0.25 on the 5 x 30 batches), then eq. (3): up
   // with probability x - floor(x), within the task indices.
@@ -115,7 +115,7 @@ void Search::Update(Particle& x, const std::vector<std::size_t>& gbest, double w
   Repair(x.pos);
 }
 
-std::vector<std::size_t> Search::Child(const std::vector<std::size_t>& a, const std::vector<std::size_t>& b) {
+std::vector<std::size_t> SwarmSearch::Child(const std::vector<std::size_t>& a, const std::vector<std::size_t>& b) {
   // Step 4: a random segment of b in place of a's, repaired; mutated with the set probability.
   std::vector<std::size_t> child = a;
   std::size_t i = Below(m_), j = Below(m_);
@@ -132,7 +132,7 @@ std::vector<std::size_t> Search::Child(const std::vector<std::size_t>& a, const 
   return child;
 }
 
-void Search::Breed(std::vector<Particle>& swarm) {
+void SwarmSearch::Breed(std::vector<Particle>& swarm) {
   const std::size_t n = swarm.size();
   std::vector<std::size_t> order(n);
   std::iota(order.begin(), order.end(), 0);
@@ -154,7 +154,7 @@ void Search::Breed(std::vector<Particle>& swarm) {
   swarm.resize(n);
 }
 
-SwarmPlan Search::Run() {
+SwarmPlan SwarmSearch::Run() {
   const std::size_t n = o_.particles;
   std::vector<Particle> swarm(n);
   // s51-s52: random permutations, their fitness, pbest and gbest.
@@ -299,7 +299,7 @@ Result<SwarmPlan> PlanSwarm(const SwarmProblem& problem, const SwarmOptions& opt
       dist[r * m + j] = d;
     }
   }
-  return Search(problem, options, std::move(dist)).Run();
+  return SwarmSearch(problem, options, std::move(dist)).Run();
 }
 
 }  // namespace dispatch::engine

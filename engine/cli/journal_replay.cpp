@@ -20,7 +20,7 @@ namespace {
 
 constexpr int kPage = 20000;  // entries read at a time
 
-int Fail(const std::string& message) {
+int FailReplay(const std::string& message) {
   std::cerr << "dispatch-sim replay: " << message << "\n";
   return 1;
 }
@@ -120,7 +120,7 @@ Result<Loaded> Load(storage::JournalStore& journal, std::int64_t wanted) {
 
 int List(storage::JournalStore& journal) {
   auto runs = journal.Runs();
-  if (!runs.ok()) return Fail(runs.error().message);
+  if (!runs.ok()) return FailReplay(runs.error().message);
   std::printf("run  entries  bytes     truncated  setup\n");
   for (const auto& r : *runs) {
     auto setup = storage::DecodeRunSetup(r.setup);
@@ -160,13 +160,13 @@ Status WriteSimulationJournal(const std::string& db, const std::string& map_sour
 
 int RunReplay(const ReplayArgs& a) {
   auto opened = storage::JournalStore::Open(a.db, /*read_only=*/true);
-  if (!opened.ok()) return Fail(opened.error().message);
+  if (!opened.ok()) return FailReplay(opened.error().message);
   storage::JournalStore& journal = **opened;
   if (a.list) return List(journal);
   auto loaded = Load(journal, a.run);
-  if (!loaded.ok()) return Fail(loaded.error().message);
+  if (!loaded.ok()) return FailReplay(loaded.error().message);
   auto replay = CoreReplay::Create(loaded->replay);
-  if (!replay.ok()) return Fail(replay.error().message);
+  if (!replay.ok()) return FailReplay(replay.error().message);
   CoreReplay& core = **replay;
 
   // The recorded run, entry by entry.
@@ -176,10 +176,10 @@ int RunReplay(const ReplayArgs& a) {
   std::uint64_t expected = 1, matched = 0;
   for (;;) {
     auto page = journal.Read(loaded->run.run, expected - 1, kPage);
-    if (!page.ok()) return Fail(page.error().message);
+    if (!page.ok()) return FailReplay(page.error().message);
     for (const JournalEntry& e : *page) {
       if (e.seq != expected) {
-        return Fail("the journal of run " + std::to_string(loaded->run.run) + " has a gap: entry " +
+        return FailReplay("the journal of run " + std::to_string(loaded->run.run) + " has a gap: entry " +
                     std::to_string(expected) + " is missing");
       }
       ++expected;
@@ -189,7 +189,7 @@ int RunReplay(const ReplayArgs& a) {
         if (!t0) t0 = e.input.time;
       }
       auto out = core.Feed(e);
-      if (!out.ok()) return Fail(out.error().message);
+      if (!out.ok()) return FailReplay(out.error().message);
       if (*out != e.output) {
         std::printf("replay of run %lld diverged at entry %llu (%s at t=%.3f s%s%s):\n  recorded: %s\n  replayed: %s\n",
                     static_cast<long long>(loaded->run.run), static_cast<unsigned long long>(e.seq),
@@ -235,13 +235,13 @@ int RunReplay(const ReplayArgs& a) {
 
   // What if: the recorded orders on the simulator's motion model, with the recorded settings
   // and with the changed ones.
-  if (robots.empty()) return Fail("--what-if: the run has no robots");
+  if (robots.empty()) return FailReplay("--what-if: the run has no robots");
   std::vector<FleetRobot> fleet;
   for (const auto& [id, r] : robots) fleet.push_back(r);
   std::sort(fleet.begin(), fleet.end(), [](const FleetRobot& x, const FleetRobot& y) { return NaturalLess(x.id, y.id); });
   const std::size_t n = a.robots == 0 ? fleet.size() : a.robots;
   if (n > fleet.size()) {
-    return Fail("--robots " + std::to_string(n) + ": the run had " + std::to_string(fleet.size()) +
+    return FailReplay("--robots " + std::to_string(n) + ": the run had " + std::to_string(fleet.size()) +
                 " robots; a what-if can use fewer");
   }
   for (Order& o : orders) {
@@ -250,7 +250,7 @@ int RunReplay(const ReplayArgs& a) {
     if (o.release_time) o.release_time = std::max(0.0, *o.release_time - start);
   }
   const std::string strategy = a.strategy.empty() ? loaded->setup.strategy : a.strategy;
-  if (auto known = MakeAllocator(strategy); !known.ok()) return Fail(known.error().message);
+  if (auto known = MakeAllocator(strategy); !known.ok()) return FailReplay(known.error().message);
   auto simulate = [&](const std::string& name, double zeta, std::size_t count) -> Result<StreamResult> {
     StreamConfig c;
     c.time_step = a.dt;
@@ -267,10 +267,10 @@ int RunReplay(const ReplayArgs& a) {
                           orders, c);
   };
   auto same = simulate(loaded->setup.strategy, loaded->setup.allocation.zeta, fleet.size());
-  if (!same.ok()) return Fail("simulating the recorded settings: " + same.error().message);
+  if (!same.ok()) return FailReplay("simulating the recorded settings: " + same.error().message);
   const double zeta = a.zeta.value_or(loaded->setup.allocation.zeta);
   auto changed = simulate(strategy, zeta, n);
-  if (!changed.ok()) return Fail("simulating the what-if: " + changed.error().message);
+  if (!changed.ok()) return FailReplay("simulating the what-if: " + changed.error().message);
   std::printf("\nwhat-if on the simulator's motion model (the recorded orders at their recorded times):\n");
   PrintColumns({recorded, FromSimulation("simulated", loaded->setup.strategy, loaded->setup.allocation.zeta,
                                          fleet.size(), *same),

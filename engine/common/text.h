@@ -12,4 +12,8 @@ namespace dispatch::engine {
 // UTF-8 characters) and "... (N bytes)".
 std::string Clipped(std::string_view text, std::size_t max_bytes = 64);
 
+// `v` with six significant digits and no trailing zeros ("%g", as a stream prints it): 2.5,
+// 100, 1e-05. How messages and generated ids write coordinates.
+std::string Number(double v);
+
 }  // namespace dispatch::engine

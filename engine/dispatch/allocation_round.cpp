@@ -89,7 +89,7 @@ RoundResult RoundRunner::Run(const RoundInput& input) {
     }
   }
   RoundSegments segments;  // where each robot's new work begins (the time-window planner)
-  segments.first_new.assign(input.robots.size(), static_cast<std::size_t>(-1));
+  segments.first_new.assign(input.robots.size(), RoundSegments::kNothingNew);
   segments.in_formation.assign(input.robots.size(), false);
   std::vector<bool> queued(input.robots.size());  // has orders (before or from this round)
   for (std::size_t i = 0; i < input.robots.size(); ++i) queued[i] = input.robots[i].has_queue();

@@ -9,8 +9,6 @@
 namespace dispatch::engine {
 namespace {
 
-constexpr std::size_t kNone = static_cast<std::size_t>(-1);
-
 // Every arc driven by every plan, with the time it is entered.
 std::vector<LaneUse> UsesOf(const WarehouseMap& map, const FleetState& fleet) {
   std::vector<LaneUse> uses;
@@ -51,9 +49,9 @@ void RouteAwardsByHeat(const WarehouseMap& map, const AllocationConfig& config, 
   std::vector<PointId> at(fleet.robot_count(), kNoPoint);
   std::vector<double> free_at(fleet.robot_count(), now);
   for (std::size_t i = 0; i < fleet.robot_count(); ++i) {
-    const std::size_t first = i < segments.first_new.size() ? segments.first_new[i] : kNone;
+    const std::size_t first = i < segments.first_new.size() ? segments.first_new[i] : RoundSegments::kNothingNew;
     const auto& w = fleet.plan(i).waypoints;
-    if (first == kNone || w.empty()) continue;
+    if (first == RoundSegments::kNothingNew || w.empty()) continue;
     const Waypoint& before = w[first > 0 ? first - 1 : 0];
     at[i] = before.point;
     free_at[i] = first > 0 ? before.departure() : before.eta;

@@ -10,8 +10,6 @@
 namespace dispatch::engine {
 namespace {
 
-constexpr std::size_t kNone = static_cast<std::size_t>(-1);
-
 // The visits of `w` as a route the table accepts: waypoints at one point in a row are one
 // visit, no arrival faster than its arc allows, the last visit for ever. Empty when two
 // points in a row are not joined by an arc (the plan is then not reserved).
@@ -83,8 +81,8 @@ struct RoundWindows {
       : rules(RulesOf(config)), table(map, rules), replan(fleet.robot_count(), false), kept(fleet.robot_count()) {
     for (std::size_t i = 0; i < fleet.robot_count(); ++i) {
       const auto& w = fleet.plan(i).waypoints;
-      const std::size_t first = i < segments.first_new.size() ? segments.first_new[i] : kNone;
-      replan[i] = first != kNone && !segments.in_formation[i];
+      const std::size_t first = i < segments.first_new.size() ? segments.first_new[i] : RoundSegments::kNothingNew;
+      replan[i] = first != RoundSegments::kNothingNew && !segments.in_formation[i];
       // A robot without a queue keeps its start waypoint; its new segment repeats it.
       const std::size_t upto = replan[i] ? std::max<std::size_t>(first, 1) : w.size();
       kept[i].assign(w.begin(), w.begin() + static_cast<std::ptrdiff_t>(std::min(upto, w.size())));

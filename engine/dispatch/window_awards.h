@@ -28,8 +28,9 @@
 namespace dispatch::engine {
 
 // Per robot of `fleet` (its index): where this round's new waypoints begin in its plan
-// (npos: it won nothing), and whether it won a formation in the round.
+// (kNothingNew: it won nothing), and whether it won a formation in the round.
 struct RoundSegments {
+  static constexpr std::size_t kNothingNew = static_cast<std::size_t>(-1);
   std::vector<std::size_t> first_new;
   std::vector<bool> in_formation;
 };

@@ -3,20 +3,14 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
-#include <sstream>
 
+#include "engine/common/text.h"
 #include "engine/fleet/formation.h"
 
 namespace dispatch::engine {
 namespace {
 
-std::string Num(double v) {
-  std::ostringstream out;
-  out << v;
-  return out.str();
-}
-
-std::string Xy(const Eigen::Vector2d& p) { return "(" + Num(p.x()) + ", " + Num(p.y()) + ")"; }
+std::string Xy(const Eigen::Vector2d& p) { return "(" + Number(p.x()) + ", " + Number(p.y()) + ")"; }
 
 Result<PointId> SnapCoordinate(const WarehouseMap& map, const Eigen::Vector2d& xy, PointKind kind,
                                const SnapOptions& options) {
@@ -47,14 +41,14 @@ Result<PointId> SnapCoordinate(const WarehouseMap& map, const Eigen::Vector2d& x
   if (best_d > options.tolerance) {
     return InvalidArgument("coordinate " + Xy(xy) + " is not at a " + kind_name +
                            " point: nearest is '" + map.point(best).name + "' " +
-                           Xy(map.point(best).position) + " at " + Num(best_d) +
-                           " m, tolerance " + Num(options.tolerance) + " m");
+                           Xy(map.point(best).position) + " at " + Number(best_d) +
+                           " m, tolerance " + Number(options.tolerance) + " m");
   }
   if (second != kNoPoint && second_d <= options.tolerance) {
     return InvalidArgument("coordinate " + Xy(xy) + " is ambiguous: " + kind_name + " points '" +
-                           map.point(best).name + "' (" + Num(best_d) + " m) and '" +
-                           map.point(second).name + "' (" + Num(second_d) +
-                           " m) are both within tolerance " + Num(options.tolerance) + " m");
+                           map.point(best).name + "' (" + Number(best_d) + " m) and '" +
+                           map.point(second).name + "' (" + Number(second_d) +
+                           " m) are both within tolerance " + Number(options.tolerance) + " m");
   }
   return best;
 }
@@ -131,16 +125,16 @@ Result<Order> ResolveOrder(const WarehouseMap& map, const OrderRequest& request,
   const std::string what = "order '" + request.id + "': ";
   if (request.picks.empty()) return InvalidArgument(what + "no pick points");
   if (!std::isfinite(request.work_time) || request.work_time <= 0.0) {
-    return InvalidArgument(what + "work time t_w must be > 0 s, got " + Num(request.work_time));
+    return InvalidArgument(what + "work time t_w must be > 0 s, got " + Number(request.work_time));
   }
   if (request.work_time > kMaxWorkTime) {
-    return InvalidArgument(what + "work time t_w must be at most " + Num(kMaxWorkTime) + " s (a day), got " +
-                           Num(request.work_time));
+    return InvalidArgument(what + "work time t_w must be at most " + Number(kMaxWorkTime) + " s (a day), got " +
+                           Number(request.work_time));
   }
   if (request.release_time &&
       (!std::isfinite(*request.release_time) || std::abs(*request.release_time) > kMaxReleaseTime)) {
-    return InvalidArgument(what + "release time must be finite and within +-" + Num(kMaxReleaseTime) +
-                           " s of the dispatcher's epoch, got " + Num(*request.release_time));
+    return InvalidArgument(what + "release time must be finite and within +-" + Number(kMaxReleaseTime) +
+                           " s of the dispatcher's epoch, got " + Number(*request.release_time));
   }
   Order order;
   order.id = request.id;
@@ -169,7 +163,7 @@ Result<Order> ResolveOrder(const WarehouseMap& map, const OrderRequest& request,
       return InvalidArgument(what + "a heading for stop " + std::to_string(k + 1) + " of " +
                              std::to_string(order.picks.size() + 1));
     }
-    if (!std::isfinite(heading)) return InvalidArgument(what + stop + ": heading must be finite, got " + Num(heading));
+    if (!std::isfinite(heading)) return InvalidArgument(what + stop + ": heading must be finite, got " + Number(heading));
     if (request.formation) return InvalidArgument(what + stop + ": a formation order's stops cannot ask for a heading");
     const PointId p = k < order.picks.size() ? order.picks[k] : order.drop;
     const auto& regions = map.free_spaces();

@@ -17,7 +17,7 @@ constexpr std::size_t kMaxZoneLabels = 200;
 constexpr double kAutoSidePx = 1200.0;
 
 // Shortest fixed-point text with at most 2 decimals ("12", "3.5", "-0.25").
-std::string Num(double v) {
+std::string Coordinate(double v) {
   char buf[32];
   std::snprintf(buf, sizeof buf, "%.2f", v);
   std::string s = buf;
@@ -72,7 +72,7 @@ void RenderZones(std::ostringstream& out, const WarehouseMap& map, const Frame& 
     const Zone& z = map.zones()[i];
     out << "<polygon class=\"zone\" fill=\"" << ZoneFill(i) << "\" points=\"";
     for (std::size_t k = 0; k < z.polygon.size(); ++k) {
-      out << (k ? " " : "") << Num(f.X(z.polygon[k].x())) << ',' << Num(f.Y(z.polygon[k].y()));
+      out << (k ? " " : "") << Coordinate(f.X(z.polygon[k].x())) << ',' << Coordinate(f.Y(z.polygon[k].y()));
     }
     out << "\"><title>" << XmlEscape(z.name) << "</title></polygon>\n";
   }
@@ -86,7 +86,7 @@ void RenderFreeSpaces(std::ostringstream& out, const WarehouseMap& map, const Fr
   for (const FreeSpace& s : map.free_spaces()) {
     out << "<polygon class=\"free-space\" points=\"";
     for (std::size_t k = 0; k < s.polygon.size(); ++k) {
-      out << (k ? " " : "") << Num(f.X(s.polygon[k].x())) << ',' << Num(f.Y(s.polygon[k].y()));
+      out << (k ? " " : "") << Coordinate(f.X(s.polygon[k].x())) << ',' << Coordinate(f.Y(s.polygon[k].y()));
     }
     out << "\"><title>free space " << XmlEscape(s.name) << "</title></polygon>\n";
   }
@@ -102,9 +102,9 @@ void RenderZoneLabels(std::ostringstream& out, const WarehouseMap& map, const Fr
     Eigen::Vector2d c = Eigen::Vector2d::Zero();
     for (const auto& v : z.polygon) c += v;
     c /= static_cast<double>(z.polygon.size());
-    out << "<text class=\"zone-label\" x=\"" << Num(f.X(c.x())) << "\" y=\"" << Num(f.Y(c.y()))
-        << "\">" << XmlEscape(z.name) << "<tspan x=\"" << Num(f.X(c.x())) << "\" dy=\"1.1em\">S="
-        << Num(z.area) << " m\u00b2</tspan></text>\n";
+    out << "<text class=\"zone-label\" x=\"" << Coordinate(f.X(c.x())) << "\" y=\"" << Coordinate(f.Y(c.y()))
+        << "\">" << XmlEscape(z.name) << "<tspan x=\"" << Coordinate(f.X(c.x())) << "\" dy=\"1.1em\">S="
+        << Coordinate(z.area) << " m\u00b2</tspan></text>\n";
   }
   out << "</g>\n";
 }
@@ -114,24 +114,24 @@ void RenderDetailed(std::ostringstream& out, const WarehouseMap& map, const Fram
   const double r = std::clamp(0.15 * f.scale, 2.0, 6.0);  // point radius, px
   out << "<g class=\"shelves\">\n";
   for (const Shelf& s : map.shelves()) {
-    out << "<rect class=\"shelf\" x=\"" << Num(f.X(s.min.x())) << "\" y=\"" << Num(f.Y(s.max.y()))
-        << "\" width=\"" << Num((s.max.x() - s.min.x()) * f.scale) << "\" height=\""
-        << Num((s.max.y() - s.min.y()) * f.scale) << "\"><title>" << XmlEscape(s.name)
+    out << "<rect class=\"shelf\" x=\"" << Coordinate(f.X(s.min.x())) << "\" y=\"" << Coordinate(f.Y(s.max.y()))
+        << "\" width=\"" << Coordinate((s.max.x() - s.min.x()) * f.scale) << "\" height=\""
+        << Coordinate((s.max.y() - s.min.y()) * f.scale) << "\"><title>" << XmlEscape(s.name)
         << "</title></rect>\n";
   }
   out << "</g>\n<g class=\"intersections\">\n";
   for (const Intersection& x : map.intersections()) {
     for (PointId id : x.inner) {
       const Point& p = map.point(id);
-      out << "<circle class=\"inter-inner\" cx=\"" << Num(f.X(p.position.x())) << "\" cy=\""
-          << Num(f.Y(p.position.y())) << "\" r=\"" << Num(3 * r) << "\"><title>"
+      out << "<circle class=\"inter-inner\" cx=\"" << Coordinate(f.X(p.position.x())) << "\" cy=\""
+          << Coordinate(f.Y(p.position.y())) << "\" r=\"" << Coordinate(3 * r) << "\"><title>"
           << XmlEscape(x.name) << " inner</title></circle>\n";
     }
     for (PointId id : x.approach) {
       const Point& p = map.point(id);
-      out << "<rect class=\"approach\" x=\"" << Num(f.X(p.position.x()) - 2 * r) << "\" y=\""
-          << Num(f.Y(p.position.y()) - 2 * r) << "\" width=\"" << Num(4 * r) << "\" height=\""
-          << Num(4 * r) << "\"><title>" << XmlEscape(x.name) << " approach</title></rect>\n";
+      out << "<rect class=\"approach\" x=\"" << Coordinate(f.X(p.position.x()) - 2 * r) << "\" y=\""
+          << Coordinate(f.Y(p.position.y()) - 2 * r) << "\" width=\"" << Coordinate(4 * r) << "\" height=\""
+          << Coordinate(4 * r) << "\"><title>" << XmlEscape(x.name) << " approach</title></rect>\n";
     }
   }
   out << "</g>\n<g class=\"paths\">\n";
@@ -145,27 +145,27 @@ void RenderDetailed(std::ostringstream& out, const WarehouseMap& map, const Fram
       a += d / len * r;
       b -= d / len * r;
     }
-    out << "<line class=\"" << (path.bidirectional ? "lane2" : "oneway") << "\" x1=\"" << Num(a.x())
-        << "\" y1=\"" << Num(a.y()) << "\" x2=\"" << Num(b.x()) << "\" y2=\"" << Num(b.y())
+    out << "<line class=\"" << (path.bidirectional ? "lane2" : "oneway") << "\" x1=\"" << Coordinate(a.x())
+        << "\" y1=\"" << Coordinate(a.y()) << "\" x2=\"" << Coordinate(b.x()) << "\" y2=\"" << Coordinate(b.y())
         << '"' << (path.bidirectional ? "" : " marker-end=\"url(#arrow)\"") << "/>\n";
   }
   out << "</g>\n<g class=\"points\">\n";
   for (const Point& p : map.points()) {
-    out << "<circle class=\"pt " << StyleOf(p.kind).css << "\" cx=\"" << Num(f.X(p.position.x()))
-        << "\" cy=\"" << Num(f.Y(p.position.y())) << "\" r=\""
-        << Num(IsServicePoint(p.kind) ? r : 0.6 * r) << "\"><title>" << XmlEscape(p.name)
+    out << "<circle class=\"pt " << StyleOf(p.kind).css << "\" cx=\"" << Coordinate(f.X(p.position.x()))
+        << "\" cy=\"" << Coordinate(f.Y(p.position.y())) << "\" r=\""
+        << Coordinate(IsServicePoint(p.kind) ? r : 0.6 * r) << "\"><title>" << XmlEscape(p.name)
         << "</title></circle>\n";
   }
   for (const ParkingStation& s : map.stations()) {
     const Point& p = map.point(s.point);
-    out << "<text class=\"station-label\" x=\"" << Num(f.X(p.position.x()) + 1.5 * r) << "\" y=\""
-        << Num(f.Y(p.position.y()) + 3 * r) << "\">" << XmlEscape(s.name) << " \u00d7" << s.capacity
+    out << "<text class=\"station-label\" x=\"" << Coordinate(f.X(p.position.x()) + 1.5 * r) << "\" y=\""
+        << Coordinate(f.Y(p.position.y()) + 3 * r) << "\">" << XmlEscape(s.name) << " \u00d7" << s.capacity
         << "</text>\n";
   }
   if (options.show_point_labels) {
     for (const Point& p : map.points()) {
-      out << "<text class=\"pt-label\" x=\"" << Num(f.X(p.position.x()) + 1.5 * r) << "\" y=\""
-          << Num(f.Y(p.position.y()) - 1.5 * r) << "\">" << XmlEscape(p.name) << "</text>\n";
+      out << "<text class=\"pt-label\" x=\"" << Coordinate(f.X(p.position.x()) + 1.5 * r) << "\" y=\""
+          << Coordinate(f.Y(p.position.y()) - 1.5 * r) << "\">" << XmlEscape(p.name) << "</text>\n";
     }
   }
   out << "</g>\n";
@@ -173,13 +173,13 @@ void RenderDetailed(std::ostringstream& out, const WarehouseMap& map, const Fram
 
 // Compact style: one <path> per class, world coordinates in a flipped group.
 void RenderCompact(std::ostringstream& out, const WarehouseMap& map, const Frame& f) {
-  out << "<g class=\"world\" transform=\"matrix(" << Num(f.scale) << " 0 0 " << Num(-f.scale)
-      << ' ' << Num(f.X(0.0)) << ' ' << Num(f.Y(0.0)) << ")\">\n";
+  out << "<g class=\"world\" transform=\"matrix(" << Coordinate(f.scale) << " 0 0 " << Coordinate(-f.scale)
+      << ' ' << Coordinate(f.X(0.0)) << ' ' << Coordinate(f.Y(0.0)) << ")\">\n";
   if (!map.shelves().empty()) {
     out << "<path class=\"shelf\" d=\"";
     for (const Shelf& s : map.shelves()) {
-      out << 'M' << Num(s.min.x()) << ' ' << Num(s.min.y()) << 'h' << Num(s.max.x() - s.min.x())
-          << 'v' << Num(s.max.y() - s.min.y()) << 'h' << Num(s.min.x() - s.max.x()) << 'z';
+      out << 'M' << Coordinate(s.min.x()) << ' ' << Coordinate(s.min.y()) << 'h' << Coordinate(s.max.x() - s.min.x())
+          << 'v' << Coordinate(s.max.y() - s.min.y()) << 'h' << Coordinate(s.min.x() - s.max.x()) << 'z';
     }
     out << "\"/>\n";
   }
@@ -189,13 +189,13 @@ void RenderCompact(std::ostringstream& out, const WarehouseMap& map, const Frame
       if (path.bidirectional != (bidirectional == 1)) continue;
       const Eigen::Vector2d& a = map.point(path.from).position;
       const Eigen::Vector2d& b = map.point(path.to).position;
-      d += 'M' + Num(a.x()) + ' ' + Num(a.y());
+      d += 'M' + Coordinate(a.x()) + ' ' + Coordinate(a.y());
       if (a.y() == b.y()) {
-        d += 'H' + Num(b.x());
+        d += 'H' + Coordinate(b.x());
       } else if (a.x() == b.x()) {
-        d += 'V' + Num(b.y());
+        d += 'V' + Coordinate(b.y());
       } else {
-        d += 'L' + Num(b.x()) + ' ' + Num(b.y());
+        d += 'L' + Coordinate(b.x()) + ' ' + Coordinate(b.y());
       }
     }
     if (!d.empty()) {
@@ -208,16 +208,16 @@ void RenderCompact(std::ostringstream& out, const WarehouseMap& map, const Frame
     std::string d;
     for (const Point& p : map.points()) {
       if (p.kind != kind) continue;
-      d += 'M' + Num(p.position.x() - kCell / 2) + ' ' + Num(p.position.y() - kCell / 2) + "h" +
-           Num(kCell) + "v" + Num(kCell) + "h-" + Num(kCell) + 'z';
+      d += 'M' + Coordinate(p.position.x() - kCell / 2) + ' ' + Coordinate(p.position.y() - kCell / 2) + "h" +
+           Coordinate(kCell) + "v" + Coordinate(kCell) + "h-" + Coordinate(kCell) + 'z';
     }
     if (!d.empty()) out << "<path class=\"pt " << StyleOf(kind).css << "\" d=\"" << d << "\"/>\n";
   }
   for (const Intersection& x : map.intersections()) {
     for (PointId id : x.inner) {
       const Point& p = map.point(id);
-      out << "<circle class=\"inter-inner\" cx=\"" << Num(p.position.x()) << "\" cy=\""
-          << Num(p.position.y()) << "\" r=\"0.6\"/>\n";
+      out << "<circle class=\"inter-inner\" cx=\"" << Coordinate(p.position.x()) << "\" cy=\""
+          << Coordinate(p.position.y()) << "\" r=\"0.6\"/>\n";
     }
   }
   out << "</g>\n";
@@ -257,7 +257,7 @@ void RenderLegend(std::ostringstream& out, const WarehouseMap& map, double top, 
   for (std::size_t i = 0; i < entries.size(); ++i) {
     const double x = 20.0 + static_cast<double>(static_cast<int>(i) % per_row) * kEntryWidth;
     const double y = top + 14.0 + static_cast<double>(static_cast<int>(i) / per_row) * kRowHeight;
-    out << "<g transform=\"translate(" << Num(x) << ' ' << Num(y) << ")\">" << entries[i].swatch
+    out << "<g transform=\"translate(" << Coordinate(x) << ' ' << Coordinate(y) << ")\">" << entries[i].swatch
         << "<text x=\"22\" y=\"4\">" << XmlEscape(entries[i].text) << "</text></g>\n";
   }
   out << "</g>\n";
@@ -285,8 +285,8 @@ std::string RenderMapSvg(const WarehouseMap& map, const SvgOptions& options) {
   const double height = legend_top + (options.show_legend ? LegendHeight(LegendEntries(map), width) : 0.0);
 
   std::ostringstream out;
-  out << "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"" << Num(width) << "\" height=\""
-      << Num(height) << "\" viewBox=\"0 0 " << Num(width) << ' ' << Num(height) << "\">\n";
+  out << "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"" << Coordinate(width) << "\" height=\""
+      << Coordinate(height) << "\" viewBox=\"0 0 " << Coordinate(width) << ' ' << Coordinate(height) << "\">\n";
   out << "<title>" << XmlEscape(map.name()) << "</title>\n";
   out << "<defs>\n<marker id=\"arrow\" viewBox=\"0 0 10 10\" refX=\"10\" refY=\"5\" "
          "markerWidth=\"5\" markerHeight=\"5\" orient=\"auto\"><path d=\"M0 0L10 5L0 10z\" "
@@ -309,9 +309,9 @@ std::string RenderMapSvg(const WarehouseMap& map, const SvgOptions& options) {
     out << ".pt." << StyleOf(kind).css << "{fill:" << StyleOf(kind).fill << "}\n";
   }
   out << "</style>\n";
-  out << "<rect class=\"floor\" x=\"" << Num(f.X(f.min.x())) << "\" y=\"" << Num(f.Y(f.max.y()))
-      << "\" width=\"" << Num(extent.x() * f.scale) << "\" height=\""
-      << Num(extent.y() * f.scale) << "\"/>\n";
+  out << "<rect class=\"floor\" x=\"" << Coordinate(f.X(f.min.x())) << "\" y=\"" << Coordinate(f.Y(f.max.y()))
+      << "\" width=\"" << Coordinate(extent.x() * f.scale) << "\" height=\""
+      << Coordinate(extent.y() * f.scale) << "\"/>\n";
   RenderZones(out, map, f);
   RenderFreeSpaces(out, map, f);
   if (compact) {

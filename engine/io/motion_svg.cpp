@@ -10,7 +10,7 @@
 namespace dispatch::engine {
 namespace {
 
-std::string Num(double v) {
+std::string Tenths(double v) {
   char buf[32];
   std::snprintf(buf, sizeof buf, "%.1f", v);
   return buf;
@@ -31,9 +31,9 @@ std::string RenderMotionSvg(const OccupancyGrid& grid, const std::vector<MotionS
   auto py = [&](double y) { return o.margin_px + (floor_h - (y - grid.origin().y())) * s; };
 
   std::string svg;
-  svg += "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"" + Num(width) + "\" height=\"" + Num(height) +
-         "\" viewBox=\"0 0 " + Num(width) + " " + Num(height) + "\">\n";
-  svg += "<rect x=\"0\" y=\"0\" width=\"" + Num(width) + "\" height=\"" + Num(height) + "\" fill=\"white\"/>\n";
+  svg += "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"" + Tenths(width) + "\" height=\"" + Tenths(height) +
+         "\" viewBox=\"0 0 " + Tenths(width) + " " + Tenths(height) + "\">\n";
+  svg += "<rect x=\"0\" y=\"0\" width=\"" + Tenths(width) + "\" height=\"" + Tenths(height) + "\" fill=\"white\"/>\n";
   svg += "<g class=\"grid\">\n";
   for (int iy = 0; iy < grid.height(); ++iy) {
     for (int ix = 0; ix < grid.width();) {
@@ -45,8 +45,8 @@ std::string RenderMotionSvg(const OccupancyGrid& grid, const std::vector<MotionS
       while (end < grid.width() && grid.Occupied(end, iy)) ++end;
       const double x0 = grid.origin().x() + ix * res;
       const double y1 = grid.origin().y() + (iy + 1) * res;
-      svg += "<rect class=\"grid-cell\" x=\"" + Num(px(x0)) + "\" y=\"" + Num(py(y1)) + "\" width=\"" +
-             Num((end - ix) * res * s) + "\" height=\"" + Num(res * s) + "\" fill=\"#444\"/>\n";
+      svg += "<rect class=\"grid-cell\" x=\"" + Tenths(px(x0)) + "\" y=\"" + Tenths(py(y1)) + "\" width=\"" +
+             Tenths((end - ix) * res * s) + "\" height=\"" + Tenths(res * s) + "\" fill=\"#444\"/>\n";
       ix = end;
     }
   }
@@ -65,7 +65,7 @@ std::string RenderMotionSvg(const OccupancyGrid& grid, const std::vector<MotionS
       since = 0.0;
       std::string points;
       for (const auto& [x, y] : FootprintCorners(poses[i], p.footprint, 0.0)) {
-        points += Num(px(x)) + "," + Num(py(y)) + " ";
+        points += Tenths(px(x)) + "," + Tenths(py(y)) + " ";
       }
       points.pop_back();
       svg += "<polygon class=\"footprint\" points=\"" + points + "\" fill=\"" + p.colour +
@@ -73,7 +73,7 @@ std::string RenderMotionSvg(const OccupancyGrid& grid, const std::vector<MotionS
     }
     if (!poses.empty()) {
       std::string points;
-      for (const MotionPose& q : poses) points += Num(px(q.x)) + "," + Num(py(q.y)) + " ";
+      for (const MotionPose& q : poses) points += Tenths(px(q.x)) + "," + Tenths(py(q.y)) + " ";
       points.pop_back();
       svg += "<polyline class=\"path\" points=\"" + points + "\" fill=\"none\" stroke=\"" + p.colour +
              "\" stroke-width=\"2\"/>\n";
@@ -83,13 +83,13 @@ std::string RenderMotionSvg(const OccupancyGrid& grid, const std::vector<MotionS
   double ly = floor_h * s + 2.0 * o.margin_px + 12.0;
   svg += "<g class=\"legend\" font-family=\"sans-serif\" font-size=\"13\">\n";
   if (!o.title.empty()) {
-    svg += "<text x=\"" + Num(o.margin_px) + "\" y=\"" + Num(ly) + "\">" + XmlEscape(o.title) + "</text>\n";
+    svg += "<text x=\"" + Tenths(o.margin_px) + "\" y=\"" + Tenths(ly) + "\">" + XmlEscape(o.title) + "</text>\n";
     ly += 18.0;
   }
   for (const MotionSvgPath& p : paths) {
-    svg += "<rect x=\"" + Num(o.margin_px) + "\" y=\"" + Num(ly - 10.0) + "\" width=\"20\" height=\"10\" fill=\"" +
+    svg += "<rect x=\"" + Tenths(o.margin_px) + "\" y=\"" + Tenths(ly - 10.0) + "\" width=\"20\" height=\"10\" fill=\"" +
            p.colour + "\"/>\n";
-    svg += "<text x=\"" + Num(o.margin_px + 28.0) + "\" y=\"" + Num(ly) + "\">" + XmlEscape(p.label) + "</text>\n";
+    svg += "<text x=\"" + Tenths(o.margin_px + 28.0) + "\" y=\"" + Tenths(ly) + "\">" + XmlEscape(p.label) + "</text>\n";
     ly += 18.0;
   }
   svg += "</g>\n</svg>\n";

@@ -2,9 +2,9 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
 #include <map>
 
+#include "engine/common/text.h"
 #include "engine/map/map_builder.h"
 
 namespace dispatch::engine {
@@ -46,12 +46,6 @@ std::vector<std::pair<double, double>> HorizontalPairs() {
   for (int j = 0; j < kShelfRows - 1; ++j) pairs.push_back({5.0 + 4.0 * j, 6.5 + 4.0 * j});
   pairs.push_back({21.75, 23.25});  // top ring
   return pairs;
-}
-
-std::string Num(double v) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%g", v);
-  return buf;
 }
 
 // Nodes placed on one line, keyed by their coordinate along it.
@@ -249,10 +243,10 @@ Result<WarehouseMap> BuildChu2024Floor(const Chu2024FloorOptions& options) {
       }
     }
     if (lane_point.empty() || best > 2.0) {
-      return InvalidArgument("pick dock (" + Num(dock.x()) + ", " + Num(dock.y()) +
+      return InvalidArgument("pick dock (" + Number(dock.x()) + ", " + Number(dock.y()) +
                              ") has no lane point within 2 m");
     }
-    const std::string name = "K-dock-" + Num(dock.x()) + "-" + Num(dock.y());
+    const std::string name = "K-dock-" + Number(dock.x()) + "-" + Number(dock.y());
     b.AddPoint(name, dock, PointKind::kPick);
     b.AddPath(lane_point, name, std::nullopt, 0.0, /*bidirectional=*/true);
   }

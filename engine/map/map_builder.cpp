@@ -8,6 +8,8 @@
 #include <sstream>
 #include <unordered_set>
 
+#include "engine/common/text.h"
+
 namespace dispatch::engine {
 
 namespace {
@@ -27,12 +29,6 @@ double PolygonArea(const std::vector<Eigen::Vector2d>& poly) {
 }
 
 bool Finite(const Eigen::Vector2d& p) { return std::isfinite(p.x()) && std::isfinite(p.y()); }
-
-std::string Num(double v) {
-  std::ostringstream out;
-  out << v;
-  return out.str();
-}
 
 double Cross(const Eigen::Vector2d& o, const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
   return (a.x() - o.x()) * (b.y() - o.y()) - (a.y() - o.y()) * (b.x() - o.x());
@@ -257,11 +253,11 @@ Result<WarehouseMap> MapBuilder::Build(const MapBuildOptions& options) const {
     const double length = spec.length.value_or(straight);
     if (!std::isfinite(length) || !(length > 0)) {
       return InvalidArgument(where + ": length must be a positive number of metres, got " +
-                             Num(length));
+                             Number(length));
     }
     if (length < straight - 1e-6) {
-      return InvalidArgument(where + ": length " + Num(length) +
-                             " is shorter than the straight distance " + Num(straight));
+      return InvalidArgument(where + ": length " + Number(length) +
+                             " is shorter than the straight distance " + Number(straight));
     }
     if (!std::isfinite(spec.max_speed) || spec.max_speed < 0) {
       return InvalidArgument(where + ": max_speed must be >= 0 (0 = no limit)");

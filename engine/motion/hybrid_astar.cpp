@@ -24,7 +24,7 @@ struct Move {
   double amount = 0.0;  // metres, or radians for spins
 };
 
-struct Node {
+struct PoseNode {
   MotionPose pose;
   double g = 0.0;
   int parent = -1;
@@ -32,9 +32,9 @@ struct Node {
   bool closed = false;
 };
 
-class Search {
+class PoseSearch {
  public:
-  Search(const FootprintChecker& checker, const MotionPose& start, const MotionPose& goal,
+  PoseSearch(const FootprintChecker& checker, const MotionPose& start, const MotionPose& goal,
          const HybridAStarOptions& options)
       : checker_(checker), start_(start), goal_(goal), o_(options),
         bin_width_(kTwoPi / options.heading_bins),
@@ -172,12 +172,12 @@ class Search {
   double bin_width_;
   double spin_spacing_;
   std::vector<Move> moves_;
-  std::vector<Node> nodes_;
+  std::vector<PoseNode> nodes_;
   std::vector<int> steps_to_goal_;  // per cell, -1: not reached (empty: plain Manhattan)
 };
 
-bool Search::Analytic(int i, MotionPath& tail, std::string& kind) const {
-  const Node& n = nodes_[i];
+bool PoseSearch::Analytic(int i, MotionPath& tail, std::string& kind) const {
+  const PoseNode& n = nodes_[i];
   const std::optional<MotionMode> previous = i == 0 ? std::nullopt : std::optional(n.move.mode);
   std::optional<double> best;
   MotionPath candidate;
@@ -215,7 +215,7 @@ bool Search::Analytic(int i, MotionPath& tail, std::string& kind) const {
   return best.has_value();
 }
 
-MotionPath Search::Reconstruct(int last) const {
+MotionPath PoseSearch::Reconstruct(int last) const {
   std::vector<int> chain;
   for (int i = last; i >= 0; i = nodes_[i].parent) chain.push_back(i);
   std::reverse(chain.begin(), chain.end());
@@ -229,7 +229,7 @@ MotionPath Search::Reconstruct(int last) const {
   return path;
 }
 
-Result<MotionPath> Search::Run() {
+Result<MotionPath> PoseSearch::Run() {
   if (o_.manhattan_through_free_cells) SweepFromGoal();
   using Entry = std::tuple<double, int>;  // f, node index (creation order breaks ties)
   std::priority_queue<Entry, std::vector<Entry>, std::greater<>> open;
@@ -321,7 +321,7 @@ Result<MotionPath> PlanHybridAStar(const FootprintChecker& checker, const Motion
   MotionPose g = goal;
   s.theta = WrapHeading(s.theta);
   g.theta = WrapHeading(g.theta);
-  return Search(checker, s, g, options).Run();
+  return PoseSearch(checker, s, g, options).Run();
 }
 
 }  // namespace dispatch::engine

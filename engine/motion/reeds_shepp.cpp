@@ -16,7 +16,7 @@ namespace dispatch::engine {
 namespace {
 
 constexpr double kPi = std::numbers::pi;
-constexpr double kEps = 1e-10;
+constexpr double kRsEps = 1e-10;
 
 struct Word {
   int n = 0;
@@ -32,9 +32,9 @@ void Polar(double x, double y, double& r, double& theta) {
 // (8.1) L+S+L+
 bool LpSpLp(double x, double y, double phi, double& t, double& u, double& v) {
   Polar(x - std::sin(phi), y - 1.0 + std::cos(phi), u, t);
-  if (t < -kEps) return false;
+  if (t < -kRsEps) return false;
   v = WrapHeading(phi - t);
-  return v >= -kEps;
+  return v >= -kRsEps;
 }
 
 // (8.2) L+S+R+
@@ -48,7 +48,7 @@ bool LpSpRp(double x, double y, double phi, double& t, double& u, double& v) {
   const double theta = std::atan2(2.0, u);
   t = WrapHeading(t1 + theta);
   v = WrapHeading(t - phi);
-  return t >= -kEps && v >= -kEps;
+  return t >= -kRsEps && v >= -kRsEps;
 }
 
 // (8.3) L+R-L+
@@ -60,7 +60,7 @@ bool LpRmL(double x, double y, double phi, double& t, double& u, double& v) {
   u = -2.0 * std::asin(0.25 * u1);
   t = WrapHeading(theta + 0.5 * u + kPi);
   v = WrapHeading(phi - t + u);
-  return t >= -kEps && u <= kEps;
+  return t >= -kRsEps && u <= kRsEps;
 }
 
 // Shared by (8.7) and (8.8).
@@ -82,7 +82,7 @@ bool LpRupLumRm(double x, double y, double phi, double& t, double& u, double& v)
   if (rho > 1.0) return false;
   u = std::acos(rho);
   TauOmega(u, -u, xi, eta, phi, t, v);
-  return t >= -kEps && v <= kEps;
+  return t >= -kRsEps && v <= kRsEps;
 }
 
 // (8.8) L+R-L-R+: lengths t, u, u, v
@@ -94,7 +94,7 @@ bool LpRumLumRp(double x, double y, double phi, double& t, double& u, double& v)
   u = -std::acos(rho);
   if (u < -kPi / 2.0) return false;
   TauOmega(u, u, xi, eta, phi, t, v);
-  return t >= -kEps && v >= -kEps;
+  return t >= -kRsEps && v >= -kRsEps;
 }
 
 // (8.9) L+R-(pi/2)S-L-: lengths t, -pi/2, u, v
@@ -107,7 +107,7 @@ bool LpRmSmLm(double x, double y, double phi, double& t, double& u, double& v) {
   u = 2.0 - r;
   t = WrapHeading(theta + std::atan2(r, -2.0));
   v = WrapHeading(phi - kPi / 2.0 - t);
-  return t >= -kEps && u <= kEps && v <= kEps;
+  return t >= -kRsEps && u <= kRsEps && v <= kRsEps;
 }
 
 // (8.10) L+R-(pi/2)S-R-: lengths t, -pi/2, u, v
@@ -119,7 +119,7 @@ bool LpRmSmRm(double x, double y, double phi, double& t, double& u, double& v) {
   t = theta;
   u = 2.0 - rho;
   v = WrapHeading(t + kPi / 2.0 - phi);
-  return t >= -kEps && u <= kEps && v <= kEps;
+  return t >= -kRsEps && u <= kRsEps && v <= kRsEps;
 }
 
 // (8.11) L+R-(pi/2)S-L-(pi/2)R+: lengths t, -pi/2, u, -pi/2, v
@@ -131,10 +131,10 @@ bool LpRmSLmRp(double x, double y, double phi, double& t, double& u, double& v) 
   Polar(xi, eta, rho, theta);
   if (rho < 2.0) return false;
   u = 4.0 - std::sqrt(rho * rho - 4.0);
-  if (u > kEps) return false;
+  if (u > kRsEps) return false;
   t = WrapHeading(std::atan2((4.0 - u) * xi - 2.0 * eta, -2.0 * xi + (u - 4.0) * eta));
   v = WrapHeading(t - phi);
-  return t >= -kEps && v >= -kEps;
+  return t >= -kRsEps && v >= -kRsEps;
 }
 
 Word Make(std::initializer_list<char> types, std::initializer_list<double> lens) {

@@ -10,7 +10,7 @@
 namespace dispatch::engine {
 namespace {
 
-struct Node {
+struct CtNode {
   int parent = -1;
   int agent = -1;  // the agent constrained here (-1: the root)
   PathConstraint constraint;
@@ -28,10 +28,10 @@ std::vector<TimedPath> Unshare(const std::vector<std::shared_ptr<const TimedPath
 
 // The constraints on agent x in `leaf` (not yet in the tree; its parent is): its own, and for
 // every agent that settled at its goal by a step, to keep away from that goal from then on.
-std::vector<PathConstraint> ConstraintsOf(const std::vector<Node>& tree, const Node& leaf, int x,
+std::vector<PathConstraint> ConstraintsOf(const std::vector<CtNode>& tree, const CtNode& leaf, int x,
                                           const std::vector<MapfAgent>& agents) {
   std::vector<PathConstraint> out;
-  auto take = [&](const Node& n) {
+  auto take = [&](const CtNode& n) {
     if (n.agent == x) {
       out.push_back(n.constraint);
     } else if (n.agent >= 0 && n.constraint.kind == PathConstraint::Kind::kFinishBy) {
@@ -55,15 +55,15 @@ Result<MapfSolution> SolveCbs(const MapfGraph& graph, const std::vector<MapfAgen
   search_limits.stop = limits.stop;
 
   MapfSolution out;
-  std::vector<Node> tree;
-  Node root;
+  std::vector<CtNode> tree;
+  CtNode root;
   for (std::size_t i = 0; i < agents.size(); ++i) {
     auto found = PlanAgent(graph, steps[i], agents[i].start, agents[i].goal, {}, search_limits);
     ++out.searches;
     if (!found.ok()) return Error{found.error().code, "agent " + std::to_string(i) + ": " + found.error().message};
     root.paths.push_back(std::make_shared<const TimedPath>(std::move(found.value().path)));
   }
-  auto evaluate = [&](Node& n) {
+  auto evaluate = [&](CtNode& n) {
     const std::vector<TimedPath> paths = Unshare(n.paths);
     n.cost = SumOfCosts(paths);
     n.conflicts = CountConflicts(paths, graph.size());
@@ -101,7 +101,7 @@ Result<MapfSolution> SolveCbs(const MapfGraph& graph, const std::vector<MapfAgen
       }
     }
     for (int side = 0; side < 2; ++side) {
-      Node child;
+      CtNode child;
       child.parent = id;
       std::vector<int> replan;
       if (settled >= 0) {

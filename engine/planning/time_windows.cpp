@@ -5,12 +5,11 @@
 #include <numbers>
 #include <string>
 
+#include "engine/common/numbers.h"
 #include "engine/routing/cost_graph.h"
 
 namespace dispatch::engine {
 namespace {
-
-constexpr double kEps = 1e-9;
 
 bool Overlap(double a_from, double a_to, double b_from, double b_to) {
   return a_from < b_to - kEps && b_from < a_to - kEps;

@@ -9,13 +9,14 @@
 #include <unordered_map>
 #include <utility>
 
+#include "engine/common/numbers.h"
+
 namespace dispatch::engine {
 namespace {
 
-constexpr double kEps = 1e-9;
 using Interval = std::pair<double, double>;
 
-struct Node {
+struct WindowNode {
   PointId p = kNoPoint;
   int interval = 0;     // index into the point's free intervals
   ArcId came = -1;      // the arc it arrived by (-1: none, or no turning time)
@@ -65,9 +66,9 @@ class StopSearch {
   // From `from` (standing at its point since `since`, ready at from.arrive) to `goal`, to
   // stand there `work` s (for ever when `forever`). Appends the visits up to the goal to
   // `route` (the goal's depart = arrival + work, or kForever) and returns the goal's node.
-  Result<Node> Run(Node from, double since, PointId goal, double work, bool forever, TimedRoute& route,
+  Result<WindowNode> Run(WindowNode from, double since, PointId goal, double work, bool forever, TimedRoute& route,
                    std::size_t& expanded) {
-    std::vector<Node> nodes{from};
+    std::vector<WindowNode> nodes{from};
     std::unordered_map<Key, double, KeyHash> best;
     using Entry = std::tuple<double, double, int>;  // f, -arrival (later first: nearer), node
     std::priority_queue<Entry, std::vector<Entry>, std::greater<>> open;
@@ -88,14 +89,14 @@ class StopSearch {
       return Unreachable("time windows: point " + map_.point(goal).name + " is never free long enough");
     }
     auto f_of = [&](double arrive, double h_p) { return std::max(arrive + h_p, goal_from); };
-    auto key_of = [&](const Node& n) { return Key{n.p, n.interval, rules_.turn_s_per_90 > 0.0 ? n.came : -1}; };
+    auto key_of = [&](const WindowNode& n) { return Key{n.p, n.interval, rules_.turn_s_per_90 > 0.0 ? n.came : -1}; };
     best[key_of(from)] = from.arrive;
     open.push({f_of(from.arrive, h(from.p)), -from.arrive, 0});
     std::size_t local = 0;
     while (!open.empty()) {
       const int index = std::get<2>(open.top());
       open.pop();
-      const Node n = nodes[static_cast<std::size_t>(index)];
+      const WindowNode n = nodes[static_cast<std::size_t>(index)];
       if (best[key_of(n)] < n.arrive - kEps) continue;  // a better arrival was found since
       const Interval span = Free(n.p)[static_cast<std::size_t>(n.interval)];
       if (n.p == goal && (forever ? std::isinf(span.second) : n.arrive + work + clear_ <= span.second + kEps)) {
@@ -124,7 +125,7 @@ class StopSearch {
           if (free_q[m].first > latest + drive + kEps) break;
           const double leave = LeaveTime(a, std::max(earliest, free_q[m].first - drive), drive);
           if (leave > latest + kEps || leave + drive >= free_q[m].second - kEps) continue;
-          Node next{q, static_cast<int>(m), a, leave + drive, index, leave};
+          WindowNode next{q, static_cast<int>(m), a, leave + drive, index, leave};
           auto [it, fresh] = best.try_emplace(key_of(next), next.arrive);
           if (!fresh) {
             if (it->second <= next.arrive + kEps) continue;
@@ -161,13 +162,13 @@ class StopSearch {
   }
 
   // The visits from the stop's start to node `last` (the start's visit began at `since`).
-  static void Emit(const std::vector<Node>& nodes, int last, double since, double work, bool forever,
+  static void Emit(const std::vector<WindowNode>& nodes, int last, double since, double work, bool forever,
                    TimedRoute& route) {
     std::vector<int> chain;
     for (int k = last; k >= 0; k = nodes[static_cast<std::size_t>(k)].parent) chain.push_back(k);
     std::reverse(chain.begin(), chain.end());
     for (std::size_t i = 0; i < chain.size(); ++i) {
-      const Node& n = nodes[static_cast<std::size_t>(chain[i])];
+      const WindowNode& n = nodes[static_cast<std::size_t>(chain[i])];
       TimedVisit v{n.p, i == 0 ? since : n.arrive, 0.0};
       if (i + 1 < chain.size()) {
         v.depart = nodes[static_cast<std::size_t>(chain[i + 1])].left_parent;
@@ -209,7 +210,7 @@ Result<WindowPlan> PlanInWindows(const ReservationTable& table, const RouteTable
                        std::to_string(request.start_time));
   }
   WindowPlan out;
-  Node at{request.start, first, -1, request.start_time, -1, 0.0};
+  WindowNode at{request.start, first, -1, request.start_time, -1, 0.0};
   double since = request.start_time;
   std::vector<WindowStop> stops = request.stops;
   const bool stand = stops.empty();

@@ -8,10 +8,11 @@
 #include <thread>
 #include <utility>
 
+#include "engine/common/numbers.h"
+
 namespace dispatch::engine {
 namespace {
 
-constexpr double kInf = std::numeric_limits<double>::infinity();
 using HeapItem = std::pair<double, VertexId>;
 using MinHeap = std::priority_queue<HeapItem, std::vector<HeapItem>, std::greater<>>;
 
@@ -54,7 +55,7 @@ ShortestPathTree SearchLevels(const CostGraph& graph, std::span<const VertexId> 
 }
 
 // Shared loop: `reverse` searches in-arcs and relaxes the arc's tail.
-ShortestPathTree Search(const CostGraph& graph, std::span<const VertexId> roots, bool reverse) {
+ShortestPathTree GrowTree(const CostGraph& graph, std::span<const VertexId> roots, bool reverse) {
   if (graph.uniform_cost() > 0.0) return SearchLevels(graph, roots, reverse, graph.uniform_cost());
   const std::size_t n = graph.vertex_count();
   ShortestPathTree t;
@@ -88,11 +89,11 @@ ShortestPathTree Search(const CostGraph& graph, std::span<const VertexId> roots,
 
 ShortestPathTree Dijkstra(const CostGraph& graph, VertexId source) {
   const VertexId roots[] = {source};
-  return Search(graph, roots, false);
+  return GrowTree(graph, roots, false);
 }
 
 ShortestPathTree ReverseDijkstra(const CostGraph& graph, std::span<const VertexId> targets) {
-  return Search(graph, targets, true);
+  return GrowTree(graph, targets, true);
 }
 
 Result<AllPairsTable> AllPairsDijkstra(const CostGraph& graph, int threads,

@@ -11,7 +11,7 @@
 namespace dispatch::engine {
 namespace {
 
-constexpr float kInf = std::numeric_limits<float>::infinity();
+constexpr float kNoPath = std::numeric_limits<float>::infinity();
 constexpr std::size_t kTile = 64;
 
 Error Cancelled() { return {ErrorCode::kFailedPrecondition, "all-pairs build cancelled"}; }
@@ -21,7 +21,7 @@ Error Cancelled() { return {ErrorCode::kFailedPrecondition, "all-pairs build can
 // the head of each arc.
 void InitMatrices(const CostGraph& graph, std::size_t stride, std::vector<float>& dist,
                   std::vector<VertexId>* next) {
-  dist.assign(stride * stride, kInf);
+  dist.assign(stride * stride, kNoPath);
   if (next) next->assign(stride * stride, kNoVertex);
   for (std::size_t i = 0; i < stride; ++i) {
     dist[i * stride + i] = 0.0f;
@@ -48,7 +48,7 @@ void RelaxTile(float* c, const float* a, const float* b, std::size_t stride, boo
     for (std::size_t i = 0; i < kTile; ++i) {
       if (skip_diag && i == k) continue;
       const float aik = a[i * stride + k];
-      if (aik == kInf) continue;
+      if (aik == kNoPath) continue;
       float* ci = c + i * stride;
 #pragma GCC ivdep
       for (std::size_t j = 0; j < kTile; ++j) ci[j] = std::min(ci[j], aik + bk[j]);
@@ -61,7 +61,7 @@ void RelaxTile(float* c, const float* a, const float* b, std::size_t stride, boo
 // O(out-degree * n) per row; the compare/select loop vectorises like RelaxTile.
 void DeriveSuccessorRow(const CostGraph& graph, const float* dist, std::size_t stride,
                         std::size_t n, std::size_t i, float* best, VertexId* next) {
-  std::fill_n(best, n, kInf);
+  std::fill_n(best, n, kNoPath);
   std::fill_n(next, n, kNoVertex);
   for (std::int32_t id : graph.out_arcs(static_cast<VertexId>(i))) {
     const CostArc& arc = graph.arc(id);

@@ -90,7 +90,7 @@ Result<StreamResult> RunTwo(std::shared_ptr<const WarehouseMap> map, std::shared
 
 double TimeOf(const StreamOrderOutcome& o) { return o.completion_time - o.release_time; }
 
-Result<HeadOnRun> RunOnce(std::shared_ptr<const WarehouseMap> map, std::shared_ptr<const RouteTable> routes,
+Result<HeadOnRun> RunHeadOn(std::shared_ptr<const WarehouseMap> map, std::shared_ptr<const RouteTable> routes,
                           double h1_work, HeadOnPolicy policy) {
   StreamConfig config;
   config.traffic.head_on = policy;
@@ -163,7 +163,7 @@ Result<HeadOnComparison> RunHeadOnComparison(double h1_work) {
   for (auto [policy, slot] : {std::pair{HeadOnPolicy::kAlwaysWait, &out.wait},
                               std::pair{HeadOnPolicy::kAlwaysReplan, &out.replan},
                               std::pair{HeadOnPolicy::kChooseFaster, &out.chosen}}) {
-    auto run = RunOnce(map, routes, h1_work, policy);
+    auto run = RunHeadOn(map, routes, h1_work, policy);
     if (!run.ok()) return run.error();
     *slot = *run;
   }

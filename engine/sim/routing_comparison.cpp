@@ -13,7 +13,7 @@
 namespace dispatch::engine {
 namespace {
 
-Result<RoutingRun> RunOnce(std::shared_ptr<const WarehouseMap> map, const std::vector<FleetRobot>& robots,
+Result<RoutingRun> RunRouting(std::shared_ptr<const WarehouseMap> map, const std::vector<FleetRobot>& robots,
                            const std::vector<Order>& orders, const RoutingComparisonOptions& o, bool improved) {
   RouteTableOptions table;
   table.turn_penalty_s = improved ? o.turn_time : 0.0;
@@ -64,7 +64,7 @@ Result<RoutingComparison> RunRoutingComparison(const RoutingComparisonOptions& o
   out.tasks = o.tasks;
   out.seed = o.seed;
   for (auto [improved, slot] : {std::pair{false, &out.traditional}, std::pair{true, &out.improved}}) {
-    auto run = RunOnce(map, *robots, *orders, o, improved);
+    auto run = RunRouting(map, *robots, *orders, o, improved);
     if (!run.ok()) return run.error();
     *slot = *run;
   }

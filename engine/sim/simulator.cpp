@@ -7,14 +7,13 @@
 #include <map>
 #include <optional>
 
+#include "engine/common/numbers.h"
 #include "engine/traffic/intersection_grants.h"
 
 namespace dispatch::engine {
 namespace {
 
-constexpr double kEps = 1e-9;
-
-struct Zone {
+struct GuardRun {
   std::size_t guard = 0;
   Movement movement;
   double start_s = 0, end_s = 0;
@@ -50,7 +49,7 @@ struct RobotRt {
   std::vector<int> task_of;          // queue task per waypoint (-1: none)
   std::vector<int> slot_block;       // block whose slot this waypoint is, or -1
   std::vector<int> block_at;         // block whose formation part holds this waypoint, or -1
-  std::vector<Zone> zones;
+  std::vector<GuardRun> zones;
   std::vector<ZoneState> zstate;
   Cursor c;
   int split = -1;       // block this robot just left, until it is eps1 from its mates
@@ -216,7 +215,7 @@ Status Sim::Prepare() {
       std::size_t j = i;
       while (j + 1 < n && guards_.guard_of_point[static_cast<std::size_t>(w[j + 1].point)] == g) ++j;
       const double c = config_.traffic.Clearance(x.block_at[i] >= 0);
-      Zone z{static_cast<std::size_t>(g),
+      GuardRun z{static_cast<std::size_t>(g),
              {i > 0 ? w[i - 1].point : kNoPoint, j + 1 < n ? w[j + 1].point : kNoPoint},
              x.s[i] - c, x.s[j] + c, i, j};
       if (!x.zones.empty() && x.zones.back().guard == z.guard &&
@@ -229,7 +228,7 @@ Status Sim::Prepare() {
       }
       i = j + 1;
     }
-    for (Zone& z : x.zones) {  // released at the first stop after the guard
+    for (GuardRun& z : x.zones) {  // released at the first stop after the guard
       for (std::size_t k = z.last + 1; k < n; ++k) {
         if (w[k].dwell > 0 || w[k].action == WaypointAction::kWait || k + 1 == n) {
           z.end_s = std::min(z.end_s, x.s[k]);
@@ -469,7 +468,7 @@ SimResult Sim::Run() {
         const double s1 = S(a.ctrl, c1);
         for (std::size_t z = 0; z < x.zones.size() && why.empty(); ++z) {
           ZoneState& st = x.zstate[z];
-          const Zone& zone = x.zones[z];
+          const GuardRun& zone = x.zones[z];
           if (st.done || st.granted) continue;
           if (zone.start_s >= s1 - kEps) break;
           if (!st.requested) {
