@@ -130,7 +130,7 @@ Result<std::size_t> TrafficController::AddRobot(const std::string& id, PointId a
   }
   if (s.index.count(id)) return InvalidArgument("traffic: duplicate robot id " + id);
   const std::size_t r = s.robots.size();
-  RobotState x;
+  ControlledRobot x;
   x.id = id;
   x.at = at;
   x.route = {at};
@@ -156,7 +156,7 @@ Status TrafficController::SetRoute(std::size_t r, std::vector<PointId> points) {
   return impl_->Assign(r, std::move(points));
 }
 std::vector<PointId> TrafficController::RemainingRoute(std::size_t r) const {
-  const RobotState& x = impl_->robots.at(r);
+  const ControlledRobot& x = impl_->robots.at(r);
   if (x.route.empty()) return {};
   return {x.route.begin() + static_cast<std::ptrdiff_t>(x.pos), x.route.end()};
 }
@@ -171,7 +171,7 @@ void TrafficController::SetRouteBound(std::shared_ptr<const RouteTable> routes) 
   impl_->bound_routes = std::move(routes);
 }
 void TrafficController::CopyRemainingRoute(std::size_t r, std::vector<PointId>& out) const {
-  const RobotState& x = impl_->robots.at(r);
+  const ControlledRobot& x = impl_->robots.at(r);
   if (x.route.empty()) {
     out.clear();
     return;
@@ -179,7 +179,7 @@ void TrafficController::CopyRemainingRoute(std::size_t r, std::vector<PointId>& 
   out.assign(x.route.begin() + static_cast<std::ptrdiff_t>(x.pos), x.route.end());
 }
 bool TrafficController::RemainingRouteIs(std::size_t r, const std::vector<PointId>& route) const {
-  const RobotState& x = impl_->robots.at(r);
+  const ControlledRobot& x = impl_->robots.at(r);
   if (x.route.empty()) return route.empty();
   return std::equal(x.route.begin() + static_cast<std::ptrdiff_t>(x.pos), x.route.end(), route.begin(), route.end());
 }
@@ -190,7 +190,7 @@ bool TrafficController::InExclusiveCorridor(PointId p) const {
   return c >= 0 && impl_->cstate[static_cast<std::size_t>(c)].exclusive;
 }
 bool TrafficController::HasRoute(std::size_t r) const {
-  const RobotState& x = impl_->robots.at(r);
+  const ControlledRobot& x = impl_->robots.at(r);
   return !x.removed && x.pos + 1 < x.route.size();
 }
 PointId TrafficController::At(std::size_t r) const { return impl_->robots.at(r).at; }
@@ -215,7 +215,7 @@ TrafficDecision TrafficController::Request(std::size_t r, double t) {
 }
 void TrafficController::LeftPoint(std::size_t r) {
   Impl& s = *impl_;
-  const RobotState& x = s.robots.at(r);
+  const ControlledRobot& x = s.robots.at(r);
   if (x.next == kNoPoint) return;
   int& h = s.holder[static_cast<std::size_t>(x.at)];
   if (h == static_cast<int>(r)) h = -1;
@@ -225,7 +225,7 @@ void TrafficController::Remove(std::size_t r) { impl_->Remove(r); }
 Status TrafficController::Place(std::size_t r, PointId at) {
   Impl& s = *impl_;
   if (r >= s.robots.size()) return InvalidArgument("traffic: unknown robot index");
-  RobotState& x = s.robots[r];
+  ControlledRobot& x = s.robots[r];
   if (!x.removed) return Error{ErrorCode::kFailedPrecondition, "traffic: robot " + x.id + " is on the floor"};
   if (at < 0 || static_cast<std::size_t>(at) >= s.M().point_count()) {
     return NotFound("traffic: robot " + x.id + " placed at an unknown point");
@@ -272,15 +272,15 @@ int TrafficController::BlockerOf(PointId p, std::size_t r, double envelope) cons
   return impl_->PointBlocker(p, r, envelope);
 }
 int TrafficController::WaitsOn(std::size_t r) const {
-  const RobotState& x = impl_->robots.at(r);
+  const ControlledRobot& x = impl_->robots.at(r);
   return x.wait == WaitKind::kNone ? -1 : x.waits_on;
 }
 double TrafficController::WaitedFor(std::size_t r, double t) const {
-  const RobotState& x = impl_->robots.at(r);
+  const ControlledRobot& x = impl_->robots.at(r);
   return x.wait == WaitKind::kNone ? 0.0 : t - x.wait_start;
 }
 void TrafficController::WaitOn(std::size_t r, int other, double t, const std::string& why) {
-  RobotState& x = impl_->robots.at(r);
+  ControlledRobot& x = impl_->robots.at(r);
   if (other < 0 || static_cast<std::size_t>(other) >= impl_->robots.size() || static_cast<std::size_t>(other) == r) {
     if (x.wait != WaitKind::kNone) impl_->ClearWait(x);
     return;
@@ -288,7 +288,7 @@ void TrafficController::WaitOn(std::size_t r, int other, double t, const std::st
   (void)impl_->Wait(r, WaitKind::kPoint, other, t, why);
 }
 void TrafficController::RestartWaitClock(std::size_t r, double t) {
-  RobotState& x = impl_->robots.at(r);
+  ControlledRobot& x = impl_->robots.at(r);
   Impl::ForgetProgress(x);
   if (x.wait == WaitKind::kNone) return;
   x.wait_start = t;
@@ -297,7 +297,7 @@ void TrafficController::RestartWaitClock(std::size_t r, double t) {
 const std::string& TrafficController::why(std::size_t r) const { return impl_->robots.at(r).why; }
 std::string TrafficController::Describe(std::size_t r) const {
   const Impl& s = *impl_;
-  const RobotState& x = s.robots.at(r);
+  const ControlledRobot& x = s.robots.at(r);
   std::string out = x.id + (x.removed ? " (off the floor)" : "") + " at " + s.Name(x.at);
   if (x.next != kNoPoint) out += " -> " + s.Name(x.next);
   out += " route";

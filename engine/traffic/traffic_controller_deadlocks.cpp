@@ -194,7 +194,7 @@ bool TrafficController::Impl::StartAllowed(std::size_t r,
 }
 
 PointId TrafficController::Impl::StickyBan(std::size_t r) {
-  RobotState& x = robots[r];
+  ControlledRobot& x = robots[r];
   if (x.avoiding == kNoPoint) return kNoPoint;
   if (x.avoiding != x.at && (x.route.empty() || x.avoiding != x.route.back()) &&
       PointBlocker(x.avoiding, r) == x.avoiding_holder) {
@@ -207,7 +207,7 @@ PointId TrafficController::Impl::StickyBan(std::size_t r) {
 
 // See traffic_controller_impl.h.
 int TrafficController::Impl::StickyCorridor(std::size_t r) {
-  RobotState& x = robots[r];
+  ControlledRobot& x = robots[r];
   const int c = x.avoiding_corridor;
   if (c < 0) return -1;
   auto inside = [&](PointId p) { return p != kNoPoint && lanes.interior_of[static_cast<std::size_t>(p)] == c; };
@@ -224,7 +224,7 @@ int TrafficController::Impl::StickyCorridor(std::size_t r) {
 // Re-plans robot r's route to its goal avoiding what it waits for; true when applied.
 bool TrafficController::Impl::TryDetour(std::size_t r, PointId ban_point, int ban_corridor,
                                         int ban_guard, bool need_free_first_hop) {
-  RobotState& x = robots[r];
+  ControlledRobot& x = robots[r];
   if (x.pos + 1 >= x.route.size()) return false;
   const int holder = ban_point != kNoPoint ? PointBlocker(ban_point, r) : -1;
   if (ban_point == kNoPoint) ban_point = StickyBan(r);
@@ -252,7 +252,7 @@ bool TrafficController::Impl::TryDetour(std::size_t r, PointId ban_point, int ba
 }
 
 int TrafficController::Impl::NextCorridor(std::size_t w) const {
-  const RobotState& x = robots[w];
+  const ControlledRobot& x = robots[w];
   if (x.wait == WaitKind::kCorridor && x.wait_corridor >= 0) return x.wait_corridor;
   return x.pos < x.arcs.size() ? CorridorOf(x.arcs[x.pos]) : -1;
 }
@@ -265,7 +265,7 @@ int TrafficController::Impl::NextCorridor(std::size_t w) const {
 // back, thousands of times, while the robot at the aisle's end waited on it until both were
 // blocked (the one at the end had a way round).
 bool TrafficController::Impl::TryBackOff(std::size_t r, PointId avoid, PointId ban_point, int keep_out) {
-  RobotState& x = robots[r];
+  ControlledRobot& x = robots[r];
   const PointId goal = x.pos + 1 < x.route.size() ? x.route.back() : kNoPoint;
   for (ArcId a : M().out_arcs(x.at)) {
     const PointId n = M().arc(a).to;
@@ -308,7 +308,7 @@ bool TrafficController::Impl::Siding(PointId p) const {
 
 // Breadth-first search for the nearest free siding not on `keep_clear`; routes r there.
 bool TrafficController::Impl::StepAside(std::size_t r, const std::vector<PointId>& keep_clear) {
-  RobotState& x = robots[r];
+  ControlledRobot& x = robots[r];
   if (x.removed || x.working || x.next != kNoPoint || x.pos + 1 < x.route.size()) return false;
   // Kept clear: the given points, the service point it leaves (the next robot, or
   // formation, to serve there must be able to come), and every point within
@@ -356,7 +356,7 @@ bool TrafficController::Impl::StepAside(std::size_t r, const std::vector<PointId
 }
 
 bool TrafficController::Impl::StandingIdle(std::size_t r) const {
-  const RobotState& y = robots[r];
+  const ControlledRobot& y = robots[r];
   return y.idle && !y.removed && !y.working && y.next == kNoPoint && y.pos + 1 >= y.route.size();
 }
 
@@ -388,7 +388,7 @@ bool TrafficController::Impl::BreakCycle(const std::vector<std::size_t>& members
   // re-plan would still have got it through.
   std::stable_partition(order.begin(), order.end(), [&](std::size_t v) { return !Livelocked(robots[v], t); });
   for (std::size_t v : order) {
-    RobotState& x = robots[v];
+    ControlledRobot& x = robots[v];
     if (x.working || x.next != kNoPoint || t < x.next_break_try) continue;
     for (std::size_t u : members) {  // Wang2019 §3.3 case ②: it gives way to the one waiting for it
       if (robots[u].waits_on == static_cast<int>(v) && MayGiveWay(v, u, t) && GiveWay(v, u, t)) return true;
@@ -423,7 +423,7 @@ std::size_t TrafficController::Impl::ResolveDeadlocks(double t) {
     while (v >= 0 && walk[static_cast<std::size_t>(v)] == 0) {
       walk[static_cast<std::size_t>(v)] = walk_id;
       path.push_back(static_cast<std::size_t>(v));
-      const RobotState& x = robots[static_cast<std::size_t>(v)];
+      const ControlledRobot& x = robots[static_cast<std::size_t>(v)];
       v = x.wait != WaitKind::kNone ? x.waits_on : -1;
     }
     // Wang2019 §3.3 case ②: along the chain, a waiting robot that waits for another than the
@@ -449,7 +449,7 @@ std::size_t TrafficController::Impl::ResolveDeadlocks(double t) {
     } else if (v < 0 && path.size() >= 2) {
       // The chain ends at a robot that does not wait: nudge it aside if it is idle.
       const std::size_t h = path.back();
-      const RobotState& w = robots[path[path.size() - 2]];
+      const ControlledRobot& w = robots[path[path.size() - 2]];
       if (StandingIdle(h)) {
         std::vector<PointId> keep(w.route.begin() + static_cast<std::ptrdiff_t>(w.pos),
                                   w.route.end());

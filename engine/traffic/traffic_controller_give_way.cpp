@@ -24,7 +24,7 @@ constexpr std::size_t kHeadOnLookahead = 16;
 constexpr std::size_t kGiveWayCandidates = 4;
 constexpr std::size_t kGiveWaySearch = 64;
 
-bool AheadOn(const RobotState& x, PointId p) {
+bool AheadOn(const ControlledRobot& x, PointId p) {
   for (std::size_t k = x.pos + 1; k < x.route.size() && k <= x.pos + kHeadOnLookahead; ++k) {
     if (x.route[k] == p) return true;
   }
@@ -34,13 +34,13 @@ bool AheadOn(const RobotState& x, PointId p) {
 }  // namespace
 
 bool TrafficController::Impl::HeadOnPair(std::size_t w, std::size_t h) const {
-  const RobotState& a = robots[w];
-  const RobotState& b = robots[h];
+  const ControlledRobot& a = robots[w];
+  const ControlledRobot& b = robots[h];
   return !a.removed && !b.removed && AheadOn(a, b.at) && AheadOn(b, a.at);
 }
 
 bool TrafficController::Impl::OnWayOf(std::size_t w, PointId p, double clearance) const {
-  const RobotState& y = robots[w];
+  const ControlledRobot& y = robots[w];
   for (std::size_t k = y.pos; k < y.route.size(); ++k) {
     const PointId q = y.route[k];
     if (q == p) return true;
@@ -52,19 +52,19 @@ bool TrafficController::Impl::OnWayOf(std::size_t w, PointId p, double clearance
 }
 
 bool TrafficController::Impl::MayGiveWay(std::size_t h, std::size_t w, double t) const {
-  const RobotState& x = robots[h];
+  const ControlledRobot& x = robots[h];
   if (x.gave_way_to == static_cast<int>(w) && t - x.gave_way_at < config.blocked_after) return false;
   // Not to a robot that waited blocked_after: it was reported blocked, its orders went back, and
   // its wait says nothing about where it will drive (on a dense grid a robot gave way to a
   // blocked one, came back and gave way again, all run long).
-  const RobotState& y = robots[w];
+  const ControlledRobot& y = robots[w];
   if (y.wait != WaitKind::kNone && t - y.wait_start >= config.blocked_after) return false;
   return config.head_on_give_way && x.wait != WaitKind::kNone && !x.working && x.next == kNoPoint &&
          x.pos + 1 < x.route.size() && x.group == 0 && x.envelope == 0.0 && Lower(h, w) && HeadOnPair(w, h);
 }
 
 bool TrafficController::Impl::GiveWay(std::size_t h, std::size_t w, double t) {
-  RobotState& x = robots[h];
+  ControlledRobot& x = robots[h];
   const double clearance = config.point_clearance + robots[w].envelope;
   // Breadth-first over free points, never into an intersection (but within the one it stands
   // in) nor against a corridor's holders; the first free points off w's way, with the way
@@ -123,7 +123,7 @@ bool TrafficController::Impl::GiveWay(std::size_t h, std::size_t w, double t) {
 }
 
 int TrafficController::Impl::GivingWayTo(std::size_t r, double t) {
-  RobotState& x = robots[r];
+  ControlledRobot& x = robots[r];
   if (x.give_way_to < 0) return -1;
   const auto w = static_cast<std::size_t>(x.give_way_to);
   const double clearance = config.point_clearance + robots[w].envelope + x.envelope;

@@ -13,7 +13,7 @@ namespace dispatch::engine {
 
 // Time until robot h has driven through corridor c (approach included) and one arc beyond.
 double TrafficController::Impl::ClearTime(std::size_t h, int c, double now) const {
-  const RobotState& x = robots[h];
+  const ControlledRobot& x = robots[h];
   double t = x.working ? std::max(0.0, x.work_end - now) : 0.0;
   bool entered = lanes.interior_of[static_cast<std::size_t>(x.at)] == c;
   for (std::size_t k = x.pos; k < x.arcs.size(); ++k) {
@@ -33,7 +33,7 @@ double TrafficController::Impl::ClearTime(std::size_t h, int c, double now) cons
 // (-1: none). Only robots standing on or driving to a point within as many arcs of c's far end
 // as r's drive through c takes are looked at (a bounded search backwards from that end).
 int TrafficController::Impl::PriorityOncoming(std::size_t r, int c, int d, double t) const {
-  const RobotState& x = robots[r];
+  const ControlledRobot& x = robots[r];
   if (std::find(x.corridors.begin(), x.corridors.end(), c) != x.corridors.end()) return -1;  // it holds c
   double through = 0.0;  // r's time to the end of c
   bool in = false;
@@ -55,7 +55,7 @@ int TrafficController::Impl::PriorityOncoming(std::size_t r, int c, int d, doubl
     for (PointId p : frontier) {
       const int h = holder[static_cast<std::size_t>(p)];
       if (h >= 0 && static_cast<std::size_t>(h) != r && (best < 0 || Lower(static_cast<std::size_t>(best), static_cast<std::size_t>(h)))) {
-        const RobotState& o = robots[static_cast<std::size_t>(h)];
+        const ControlledRobot& o = robots[static_cast<std::size_t>(h)];
         if (!o.removed && o.wait == WaitKind::kNone && !Mates(x, o) && Lower(r, static_cast<std::size_t>(h))) {
           // When does it enter c, and which way?
           double arrive = o.working ? std::max(0.0, o.work_end - t) : 0.0;
@@ -82,7 +82,7 @@ int TrafficController::Impl::PriorityOncoming(std::size_t r, int c, int d, doubl
 }
 
 TrafficDecision TrafficController::Impl::HeadOn(std::size_t r, int c, int oncoming, double t) {
-  RobotState& x = robots[r];
+  ControlledRobot& x = robots[r];
   if (x.head_on_decided != c) {
     x.head_on_decided = c;
     ++stats.head_on_conflicts;

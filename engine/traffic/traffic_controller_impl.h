@@ -14,12 +14,12 @@
 #include <utility>
 #include <vector>
 
+#include "engine/common/numbers.h"
 #include "engine/traffic/traffic_controller.h"
 
 namespace dispatch::engine {
 namespace traffic_detail {
 
-inline constexpr double kInf = std::numeric_limits<double>::infinity();
 enum class WaitKind { kNone, kPoint, kCorridor, kGrant };
 
 // The facts a wait's reason is formatted from (site, and up to three ids); site 0: none.
@@ -28,7 +28,7 @@ struct WhyKey {
   bool operator==(const WhyKey&) const = default;
 };
 
-struct RobotState {
+struct ControlledRobot {
   std::string id;
   PointId at = kNoPoint;
   PointId next = kNoPoint;
@@ -126,8 +126,7 @@ struct RouteQueryHash {
 
 using traffic_detail::CorridorState;
 using traffic_detail::Detour;
-using traffic_detail::kInf;
-using traffic_detail::RobotState;
+using traffic_detail::ControlledRobot;
 using traffic_detail::WaitKind;
 using traffic_detail::WhyKey;
 
@@ -142,21 +141,21 @@ struct TrafficController::Impl {
   // Robots off the floor that still stand somewhere (SetStanding): index and position.
   std::vector<std::pair<std::size_t, Eigen::Vector2d>> standing;
   std::vector<CorridorState> cstate;
-  std::vector<RobotState> robots;
+  std::vector<ControlledRobot> robots;
   std::unordered_map<std::string, std::size_t> index;
-  std::uint64_t route_epochs = 0;  // the last RobotState::route_epoch handed out
-  void Touch(RobotState& x) { x.route_epoch = ++route_epochs; }
+  std::uint64_t route_epochs = 0;  // the last ControlledRobot::route_epoch handed out
+  void Touch(ControlledRobot& x) { x.route_epoch = ++route_epochs; }
   // Robot x asks to leave its point at time t: its progress towards its goal
-  // (RobotState::progress_*), measured on the bound route table (not without one).
-  void NoteProgress(RobotState& x, double t);
-  static void ForgetProgress(RobotState& x) { x.progress_goal = kNoPoint; }
+  // (ControlledRobot::progress_*), measured on the bound route table (not without one).
+  void NoteProgress(ControlledRobot& x, double t);
+  static void ForgetProgress(ControlledRobot& x) { x.progress_goal = kNoPoint; }
   // A detour livelock: re-planned back and forth (three times again at points it had
   // re-planned at) and no closer to its goal for blocked_after.
-  bool Livelocked(const RobotState& x, double t) const {
+  bool Livelocked(const ControlledRobot& x, double t) const {
     return x.progress_goal != kNoPoint && x.replans_again >= 3 && t - x.progress_since >= config.blocked_after;
   }
   // A re-plan of robot x (a detour, a back-off) at the point it stands at.
-  void Replanned(RobotState& x) {
+  void Replanned(ControlledRobot& x) {
     ++stats.replans;
     if (std::find(x.replanned_at.begin(), x.replanned_at.end(), x.at) != x.replanned_at.end()) {
       ++x.replans_again;
@@ -211,7 +210,7 @@ struct TrafficController::Impl {
   }
   int CorridorOf(ArcId a) const { return lanes.CorridorOfArc(M(), a); }
   int Priority(std::size_t r) const {
-    const RobotState& x = robots[r];
+    const ControlledRobot& x = robots[r];
     return x.working ? 2 : (x.loaded ? 1 : 0);
   }
   // True when robot a yields to robot b (a has lower priority).
@@ -222,7 +221,7 @@ struct TrafficController::Impl {
     return a > b;
   }
   // Robots of one formation (a shared group) may come closer than eps1.
-  static bool Mates(const RobotState& a, const RobotState& b) {
+  static bool Mates(const ControlledRobot& a, const ControlledRobot& b) {
     for (int g : {a.group, a.group2, a.group3}) {
       if (g > 0 && (b.group == g || b.group2 == g || b.group3 == g)) return true;
     }
@@ -264,19 +263,19 @@ struct TrafficController::Impl {
   // lets go of one it held. OccupyGuard(r, g): it stands inside intersection g (-1: none).
   void OccupyGuard(std::size_t r) { OccupyGuard(r, M().IntersectionOf(robots[r].at)); }
   void OccupyGuard(std::size_t r, int g);
-  void ClearWait(RobotState& x);
+  void ClearWait(ControlledRobot& x);
   TrafficDecision Wait(std::size_t r, WaitKind kind, int on, double t, std::string why);
   // Wait with a reason made by `why()` only when `key` differs from the one it was last made
   // from (the text depends on the key alone).
   template <typename Why>
   TrafficDecision WaitFor(std::size_t r, WaitKind kind, int on, double t, const WhyKey& key, Why why) {
-    RobotState& x = robots[r];
+    ControlledRobot& x = robots[r];
     if (x.why_key == key) return Wait(r, kind, on, t, std::move(x.why), key);
     return Wait(r, kind, on, t, why(), key);
   }
   TrafficDecision Wait(std::size_t r, WaitKind kind, int on, double t, std::string why, const WhyKey& key);
 
-  double RouteCost(const RobotState& x) const;
+  double RouteCost(const ControlledRobot& x) const;
   double ClearTime(std::size_t h, int c, double now) const;
   Status Assign(std::size_t r, std::vector<PointId> points);
   TrafficDecision HeadOn(std::size_t r, int c, int oncoming, double t);  // traffic_controller_head_on.cpp

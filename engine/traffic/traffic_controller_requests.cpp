@@ -20,19 +20,19 @@ int TrafficController::Impl::PointBlocker(PointId q, std::size_t r, double envel
   if (h >= 0 && static_cast<std::size_t>(h) != r) return h;
   // Chu2024 eqs. (10)-(12): eps1 between singles, eps1 + D_f single-formation, eps1 + 2 D_f
   // between formations: each agent's envelope adds to the clearance.
-  const RobotState& me = robots[r];
-  auto mates = [&](const RobotState& o) { return Mates(me, o); };
+  const ControlledRobot& me = robots[r];
+  auto mates = [&](const ControlledRobot& o) { return Mates(me, o); };
   const double own = config.point_clearance + std::clamp(envelope, 0.0, config.max_envelope) - 1e-9;
   for (const auto& [n, d] : near[static_cast<std::size_t>(q)]) {
     const int hn = holder[static_cast<std::size_t>(n)];
     if (hn < 0 || static_cast<std::size_t>(hn) == r) continue;
-    const RobotState& other = robots[static_cast<std::size_t>(hn)];
+    const ControlledRobot& other = robots[static_cast<std::size_t>(hn)];
     if (mates(other)) continue;
     if (d < own + other.envelope) return hn;
   }
   for (const auto& [s, xy] : standing) {  // off the floor, still standing there
     if (s == r) continue;
-    const RobotState& other = robots[s];
+    const ControlledRobot& other = robots[s];
     if (mates(other)) continue;
     if ((point_xy[static_cast<std::size_t>(q)] - xy).norm() < own + other.envelope) return static_cast<int>(s);
   }
@@ -41,11 +41,11 @@ int TrafficController::Impl::PointBlocker(PointId q, std::size_t r, double envel
 
 int TrafficController::Impl::RegionBlocker(PointId q, std::size_t r) const {
   const int f = region_of[static_cast<std::size_t>(q)];
-  const RobotState& x = robots[r];
+  const ControlledRobot& x = robots[r];
   if (f < 0 || (x.at != kNoPoint && region_of[static_cast<std::size_t>(x.at)] == f)) return -1;
   auto in = [&](PointId p) { return p != kNoPoint && region_of[static_cast<std::size_t>(p)] == f; };
   for (std::size_t h = 0; h < robots.size(); ++h) {
-    const RobotState& o = robots[h];
+    const ControlledRobot& o = robots[h];
     if (h == r || o.removed || Mates(x, o)) continue;
     if (in(o.at) || in(o.next)) return static_cast<int>(h);
   }
@@ -67,7 +67,7 @@ int TrafficController::Impl::CorridorBlocker(int c, int d, std::size_t r) const 
   const PointId at = robots[r].at;
   const long mine = s.exclusive && at >= 0 && lanes.interior_of[static_cast<std::size_t>(at)] == c ? index(at) : -1;
   for (int h : s.holders) {
-    const RobotState& o = robots[static_cast<std::size_t>(h)];
+    const ControlledRobot& o = robots[static_cast<std::size_t>(h)];
     // A teammate (a member leaving its team's agent) is exempt, as in PointBlocker.
     if (static_cast<std::size_t>(h) == r || Mates(robots[r], o)) continue;
     if (mine >= 0 && o.next == kNoPoint) {
@@ -99,7 +99,7 @@ void TrafficController::Impl::DropCorridor(int c, std::size_t r) {
 
 // Keeps only the corridors the robot is inside of or drives on / looks ahead into.
 void TrafficController::Impl::ReconcileCorridors(std::size_t r) {
-  RobotState& x = robots[r];
+  ControlledRobot& x = robots[r];
   if (x.corridors.empty()) return;
   std::vector<int>& held = corridor_scratch;  // DropCorridor edits x.corridors
   held = x.corridors;
@@ -113,7 +113,7 @@ void TrafficController::Impl::ReconcileCorridors(std::size_t r) {
 }
 
 void TrafficController::Impl::ReleaseGuard(std::size_t r) {
-  RobotState& x = robots[r];
+  ControlledRobot& x = robots[r];
   if (x.guard < 0) return;
   (void)grants.Release(static_cast<std::size_t>(x.guard), x.id);
   x.guard = -1;
@@ -121,7 +121,7 @@ void TrafficController::Impl::ReleaseGuard(std::size_t r) {
 }
 
 void TrafficController::Impl::OccupyGuard(std::size_t r, int g) {
-  RobotState& x = robots[r];
+  ControlledRobot& x = robots[r];
   if (!config.intersection_grants) g = -1;
   if (g >= 0 && x.guard == g && x.granted) return;
   ReleaseGuard(r);
@@ -131,7 +131,7 @@ void TrafficController::Impl::OccupyGuard(std::size_t r, int g) {
   x.granted = true;
 }
 
-void TrafficController::Impl::ClearWait(RobotState& x) {
+void TrafficController::Impl::ClearWait(ControlledRobot& x) {
   x.wait = WaitKind::kNone;
   x.waits_on = -1;
   x.head_on_decided = -1;
@@ -144,7 +144,7 @@ TrafficDecision TrafficController::Impl::Wait(std::size_t r, WaitKind kind, int 
 
 TrafficDecision TrafficController::Impl::Wait(std::size_t r, WaitKind kind, int on, double t, std::string why,
                                               const WhyKey& key) {
-  RobotState& x = robots[r];
+  ControlledRobot& x = robots[r];
   x.why_key = key;
   if (x.wait == WaitKind::kNone) {
     x.wait_start = t;
@@ -156,14 +156,14 @@ TrafficDecision TrafficController::Impl::Wait(std::size_t r, WaitKind kind, int 
   return TrafficDecision::kWait;
 }
 
-double TrafficController::Impl::RouteCost(const RobotState& x) const {
+double TrafficController::Impl::RouteCost(const ControlledRobot& x) const {
   double c = 0;
   for (std::size_t k = x.pos; k < x.arcs.size(); ++k) c += ArcTime(x.arcs[k]);
   return c;
 }
 
 Status TrafficController::Impl::Assign(std::size_t r, std::vector<PointId> points) {
-  RobotState& x = robots[r];
+  ControlledRobot& x = robots[r];
   if (x.removed) return Error{ErrorCode::kFailedPrecondition, "traffic: robot " + x.id + " is off the floor"};
   if (x.next != kNoPoint) return Error{ErrorCode::kFailedPrecondition, "traffic: robot " + x.id + " is driving"};
   if (points.empty() || points.front() != x.at) {
@@ -191,7 +191,7 @@ Status TrafficController::Impl::Assign(std::size_t r, std::vector<PointId> point
   return Ok{};
 }
 
-void TrafficController::Impl::NoteProgress(RobotState& x, double t) {
+void TrafficController::Impl::NoteProgress(ControlledRobot& x, double t) {
   if (!bound_routes) return;
   const PointId goal = x.route.back();
   if (goal == x.progress_goal && x.at == x.progress_at) return;
@@ -206,7 +206,7 @@ void TrafficController::Impl::NoteProgress(RobotState& x, double t) {
 }
 
 TrafficDecision TrafficController::Impl::Request(std::size_t r, double t) {
-  RobotState& x = robots[r];
+  ControlledRobot& x = robots[r];
   if (x.removed || x.next != kNoPoint || x.pos + 1 >= x.route.size()) {
     x.why = "nothing to request";
     x.why_key = {};
@@ -251,11 +251,11 @@ TrafficDecision TrafficController::Impl::Request(std::size_t r, double t) {
 }
 
 int TrafficController::Impl::WorkAhead(std::size_t r, std::size_t from, bool box_exit, double t) const {
-  const RobotState& x = robots[r];
+  const ControlledRobot& x = robots[r];
   for (std::size_t k = from; k < x.route.size(); ++k) {
     const PointId p = x.route[k];
     if (const int w = PointBlocker(p, r); w >= 0 && k > x.pos + 1) {
-      const RobotState& o = robots[static_cast<std::size_t>(w)];
+      const ControlledRobot& o = robots[static_cast<std::size_t>(w)];
       const bool long_work = o.work_end > t + config.blocked_after;
       if (o.working && o.next == kNoPoint && !Mates(x, o) && ((box_exit && k == from) || long_work)) return w;
     }
@@ -277,7 +277,7 @@ bool TrafficController::Impl::TurnOff(PointId p, PointId next) const {
 }
 
 TrafficDecision TrafficController::Impl::Check(std::size_t r, PointId q, double t) {
-  RobotState& x = robots[r];
+  ControlledRobot& x = robots[r];
   if (const int w = GivingWayTo(r, t); w >= 0) {  // Wang2019 §3.3 case ②
     x.wait_point = q;
     return WaitFor(r, WaitKind::kPoint, w, t, WhyKey{5, q, w},
@@ -323,7 +323,7 @@ TrafficDecision TrafficController::Impl::Check(std::size_t r, PointId q, double 
     // seed 1, 942.8 s), a robot waiting inside an intersection for an aisle let its grant go,
     // and a crossing movement was granted around it.
     if (x.guard < 0 || M().IntersectionOf(x.at) != x.guard) ReleaseGuard(r);
-    const RobotState& o = robots[static_cast<std::size_t>(w)];
+    const ControlledRobot& o = robots[static_cast<std::size_t>(w)];
     x.wait_point = o.at;
     const bool at_exit = entering && o.at == exit;
     return WaitFor(r, WaitKind::kPoint, w, t, WhyKey{3, w, o.at, at_exit ? g : -1}, [&] {
@@ -364,7 +364,7 @@ TrafficDecision TrafficController::Impl::Check(std::size_t r, PointId q, double 
 }
 
 void TrafficController::Impl::Arrived(std::size_t r) {
-  RobotState& x = robots[r];
+  ControlledRobot& x = robots[r];
   if (x.next == kNoPoint) return;
   const PointId prev = x.at;
   x.at = x.next;
@@ -379,7 +379,7 @@ void TrafficController::Impl::Arrived(std::size_t r) {
 }
 
 void TrafficController::Impl::Remove(std::size_t r) {
-  RobotState& x = robots[r];
+  ControlledRobot& x = robots[r];
   for (PointId p : {x.at, x.next}) {
     if (p != kNoPoint && holder[static_cast<std::size_t>(p)] == static_cast<int>(r)) {
       holder[static_cast<std::size_t>(p)] = -1;
