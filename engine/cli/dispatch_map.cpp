@@ -1,6 +1,6 @@
 // dispatch-map: look at a warehouse map from the command line.
 //   dispatch-map summary --map chu2024
-//   dispatch-map routes  --map chu2024 [--from P1 --to D-T3] [--method floyd|dijkstra|auto|lazy]
+//   dispatch-map routes  --map chu2024 [--from P1 --to D-T3] [--method floyd|dijkstra|auto|lazy|hub_labels]
 //   dispatch-map svg     --map chu2024 --out chu2024.svg
 //   dispatch-map export  --map chu2024 --out chu2024.json
 #include <CLI/CLI.hpp>
@@ -125,9 +125,10 @@ int RunRoutes(const WarehouseMap& loaded, const RouteTableOptions& options, cons
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   if (!table.ok()) return Fail(table.error().message);
   const RouteTableBuildInfo info = (*table)->build_info();
-  std::printf("Route table: %s over %zu vertices / %zu arcs%s, built in %.3f s\n",
+  std::printf("Route table: %s over %zu vertices / %zu arcs%s, built in %.3f s, %.1f MiB%s\n",
               info.method.c_str(), info.vertex_count, info.arc_count,
-              info.turn_expanded ? " (turn-expanded)" : "", seconds);
+              info.turn_expanded ? " (turn-expanded)" : "", seconds,
+              static_cast<double>(info.table_bytes) / (1 << 20), info.method == "lazy" ? " (cache bound)" : "");
   std::vector<std::pair<PointId, PointId>> pairs;
   if (!from.empty() || !to.empty()) {
     auto f = FindPointOrStation(*map, from);
@@ -185,8 +186,8 @@ int Main(int argc, char** argv) {
       ->check(CLI::PositiveNumber);
   routes->add_option("--turn-penalty", options.turn_penalty_s, "Seconds per 90 degree turn")
       ->capture_default_str()->check(CLI::NonNegativeNumber);
-  routes->add_option("--method", method, "floyd, dijkstra, auto or lazy")->capture_default_str()
-      ->check(CLI::IsMember({"floyd", "dijkstra", "auto", "lazy"}));
+  routes->add_option("--method", method, "floyd, dijkstra, auto, lazy or hub_labels")->capture_default_str()
+      ->check(CLI::IsMember(RouteTableMethodNames()));
   routes->add_option("--samples", samples, "Sample size (station->pick->drop)")
       ->capture_default_str()->check(CLI::Range(1, 1000));
   auto* svg = app.add_subcommand("svg", "Render the map to an SVG file");
@@ -205,10 +206,7 @@ int Main(int argc, char** argv) {
     return 0;
   }
   if (routes->parsed()) {
-    const std::map<std::string, RouteTableMethod> methods = {
-        {"floyd", RouteTableMethod::kFloyd}, {"dijkstra", RouteTableMethod::kDijkstra},
-        {"auto", RouteTableMethod::kAuto}, {"lazy", RouteTableMethod::kLazy}};
-    options.method = methods.at(method);
+    options.method = ParseRouteTableMethod(method).value();
     return RunRoutes(*map, options, from, to, samples);
   }
   if (svg->parsed()) {

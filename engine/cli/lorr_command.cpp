@@ -28,6 +28,9 @@ LorrCommands AddLorrCommands(CLI::App& app, LorrArgs& run, LorrArgs& check) {
   l->add_option("--seed", run.seed, "Seed of the planner's tie-breaks")->capture_default_str();
   l->add_option("--route-cache-mb", run.route_cache_mb, "The lazy route table's cache on large floors, MiB")
       ->capture_default_str()->check(CLI::PositiveNumber);
+  l->add_option("--route-table", run.route_table,
+                "floyd (dense; lazy above 4,096 cells), dijkstra, auto, lazy or hub_labels (any floor, bounded memory)")
+      ->capture_default_str()->check(CLI::IsMember(RouteTableMethodNames()));
   commands.run = l;
   auto* c = app.add_subcommand("lorr-check", "Replay a LoRR output JSON against its problem and check every rule");
   c->add_option("--problem", check.problem, "The problem JSON")->required();
@@ -50,6 +53,7 @@ int RunLorr(const LorrArgs& a) {
   options.strategy = a.strategy;
   options.seed = a.seed;
   options.route_cache_bytes = a.route_cache_mb << 20;
+  options.route_method = ParseRouteTableMethod(a.route_table).value();
   const auto run_begin = std::chrono::steady_clock::now();
   Result<LifelongRecord> record = RunLifelong(*problem, options);
   if (!record) {
@@ -60,8 +64,9 @@ int RunLorr(const LorrArgs& a) {
   const std::vector<double>& times = record->planner_seconds;
   const double mean_ms = times.empty() ? 0.0 : 1000.0 * std::accumulate(times.begin(), times.end(), 0.0) / static_cast<double>(times.size());
   const double max_ms = times.empty() ? 0.0 : 1000.0 * *std::max_element(times.begin(), times.end());
-  std::printf("%s: %d robots, %d steps, strategy %s, planner turn-pibt (seed %llu)\n", problem->name.c_str(),
-              record->team_size, record->steps, record->strategy.c_str(), static_cast<unsigned long long>(a.seed));
+  std::printf("%s: %d robots, %d steps, strategy %s, planner turn-pibt (seed %llu), routes %s\n",
+              problem->name.c_str(), record->team_size, record->steps, record->strategy.c_str(),
+              static_cast<unsigned long long>(a.seed), record->routes.c_str());
   std::printf("tasks finished %d, makespan %d, planner errors %d, schedule errors %d, entry timeouts %d\n",
               record->tasks_finished, record->makespan, record->planner_errors, record->schedule_errors,
               record->entry_timeouts);

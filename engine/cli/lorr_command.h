@@ -26,6 +26,7 @@ struct LorrArgs {
   std::string strategy = "exact";
   std::uint64_t seed = 0;
   std::size_t route_cache_mb = 4096;
+  std::string route_table = "floyd";  // RouteTableMethodNames()
 };
 
 struct LorrCommands {

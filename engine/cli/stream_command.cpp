@@ -53,6 +53,9 @@ Result<Setup> Prepare(const StreamArgs& a) {
   s.map = std::make_shared<const WarehouseMap>(std::move(loaded).value());
   RouteTableOptions route_options;
   route_options.turn_penalty_s = a.turn_s;  // T_d counts turning as the plans do
+  auto method = ParseRouteTableMethod(a.route_table);
+  if (!method.ok()) return method.error();
+  route_options.method = *method;
   auto routes = MakeRouteTable(s.map, route_options);
   if (!routes.ok()) return routes.error();
   s.routes = std::move(routes).value();
@@ -306,6 +309,10 @@ StreamCommands AddStreamCommands(CLI::App& app, StreamArgs& stream_args, StreamA
         ->check(CLI::NonNegativeNumber);
     c->add_option("--routing", a.routing, "Routes of the rules planner: floyd (shortest) or heat (Wang2019)")
         ->capture_default_str();
+    c->add_option("--route-table", a.route_table,
+                  "The shortest-route table: floyd (dense; lazy above 4,096 points), dijkstra, auto, lazy or "
+                  "hub_labels (any floor, bounded memory)")
+        ->capture_default_str()->check(CLI::IsMember(RouteTableMethodNames()));
     c->add_option("--priority", a.priority, "Traffic priority within a class: index or release (Wang2019)")
         ->capture_default_str()->check(CLI::IsMember({"index", "release"}));
     c->add_option("--head-on-priority", a.head_on_priority,

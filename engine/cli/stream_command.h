@@ -39,6 +39,7 @@ struct StreamArgs {
   bool head_on_priority = false;           // TrafficControllerConfig::head_on_priority
   bool head_on_give_way = false;           // TrafficControllerConfig::head_on_give_way
   std::string execution;                   // TrafficControllerConfig::execution ("": the planner's default)
+  std::string route_table = "floyd";       // RouteTableOptions::method (RouteTableMethodNames())
 };
 
 struct StreamCommands {

@@ -29,6 +29,7 @@ class Run {
         planner_(problem.grid, std::move(routes), options.seed) {
     const std::size_t n = problem.starts.size();
     record_.strategy = std::string(allocator_->name());
+    record_.routes = std::string(routes_->method());
     record_.team_size = static_cast<int>(n);
     for (int cell : problem.starts) poses_.push_back({cell, 0});
     record_.starts = poses_;
@@ -198,6 +199,7 @@ Result<LifelongRecord> RunLifelong(const LorrProblem& problem, const LifelongOpt
   if (!allocator) return allocator.error();
   RouteTableOptions route_options;
   route_options.lazy_cache_bytes = options.route_cache_bytes;
+  route_options.method = options.route_method;
   Result<std::unique_ptr<RouteTable>> routes = MakeRouteTable(problem.grid.map(), route_options);
   if (!routes) return routes.error();
   Run run(problem, options, std::move(allocator).value(), std::shared_ptr<const RouteTable>(std::move(routes).value()));

@@ -34,6 +34,7 @@
 #include "engine/common/result.h"
 #include "engine/lifelong/grid_motion.h"
 #include "engine/lifelong/lorr_problem.h"
+#include "engine/routing/route_table.h"
 
 namespace dispatch::engine {
 
@@ -48,6 +49,9 @@ struct LifelongOptions {
   std::size_t route_cache_bytes = std::size_t{4} << 30;
   // Polled between steps: true stops the run early (its record holds the steps done).
   std::function<bool()> cancelled;
+  // kFloyd: the dense table below RouteTableOptions::lazy_threshold_points, the lazy one above;
+  // kHubLabels: hub labels on any floor (memory bounded by the labels, no search per goal).
+  RouteTableMethod route_method = RouteTableMethod::kFloyd;
 };
 
 struct LifelongError {
@@ -89,6 +93,7 @@ struct LifelongRecord {
   std::vector<std::vector<std::pair<int, int>>> planner_schedule;  // the same, as proposed
   std::vector<LifelongEvent> events;
   std::vector<RevealedTask> tasks;
+  std::string routes;  // the route table that ran (RouteTable::method())
 };
 
 Result<LifelongRecord> RunLifelong(const LorrProblem& problem, const LifelongOptions& options);

@@ -4,6 +4,7 @@
 
 #include "engine/routing/cost_graph.h"
 #include "engine/routing/floyd_route_table.h"
+#include "engine/routing/hub_label_route_table.h"
 #include "engine/routing/lazy_route_table.h"
 
 namespace dispatch::engine {
@@ -34,6 +35,24 @@ Error NoRouteError(const WarehouseMap& map, PointId from, PointId to) {
   return Unreachable(what);
 }
 
+const std::vector<std::string>& RouteTableMethodNames() {
+  static const std::vector<std::string> names = {"floyd", "dijkstra", "auto", "lazy", "hub_labels"};
+  return names;
+}
+
+Result<RouteTableMethod> ParseRouteTableMethod(std::string_view name) {
+  static constexpr RouteTableMethod kMethods[] = {RouteTableMethod::kFloyd, RouteTableMethod::kDijkstra,
+                                                  RouteTableMethod::kAuto, RouteTableMethod::kLazy,
+                                                  RouteTableMethod::kHubLabels};
+  const auto& names = RouteTableMethodNames();
+  std::string known;
+  for (std::size_t i = 0; i < names.size(); ++i) {
+    if (names[i] == name) return kMethods[i];
+    known += (i ? ", " : "") + names[i];
+  }
+  return InvalidArgument("unknown route table method '" + std::string(name) + "' (known: " + known + ")");
+}
+
 RouteTableMethod ChooseDenseMethod(std::size_t vertices, std::size_t arcs) {
   const double n = static_cast<double>(vertices);
   const double m = static_cast<double>(arcs);
@@ -56,6 +75,11 @@ Result<std::unique_ptr<RouteTable>> MakeRouteTable(std::shared_ptr<const Warehou
   const std::size_t arcs = options.turn_penalty_s > 0.0 ? 3 * map->arcs().size()
                                                         : map->arcs().size();
   RouteTableOptions resolved = options;
+  if (options.method == RouteTableMethod::kHubLabels) {
+    auto labels = HubLabelRouteTable::Build(std::move(map), options, cancelled);
+    if (!labels.ok()) return labels.error();
+    return std::unique_ptr<RouteTable>(std::move(labels).value());
+  }
   if (options.method == RouteTableMethod::kLazy || vertices > options.lazy_threshold_points) {
     auto lazy = LazyRouteTable::Build(std::move(map), resolved);
     if (!lazy.ok()) return lazy.error();

@@ -5,8 +5,9 @@
 // metres come from Path().
 //
 // Implementations: FloydRouteTable (dense N x N tables, O(1) Cost/NextHop; built by blocked
-// Floyd or all-pairs Dijkstra) and LazyRouteTable (per-destination reverse Dijkstra, cached,
-// memory-bounded). Both give the same answers (dense costs are float-precision: relative
+// Floyd or all-pairs Dijkstra), LazyRouteTable (per-destination reverse Dijkstra, cached,
+// memory-bounded) and HubLabelRouteTable (hub labels: any pair without a search, memory
+// bounded by the labels). All give the same costs (dense costs are float-precision: relative
 // difference <= ~1e-5). Every RouteTable is safe for concurrent const calls.
 #pragma once
 
@@ -68,6 +69,7 @@ enum class RouteTableMethod {
   kDijkstra,  // dense, one Dijkstra per source (same tables as kFloyd)
   kAuto,      // the dense method expected faster for this graph (see ChooseDenseMethod)
   kLazy,      // per-destination reverse Dijkstra, cached (LazyRouteTable)
+  kHubLabels, // hub labels over a contraction hierarchy: any pair, bounded memory (HubLabelRouteTable)
 };
 
 struct RouteTableOptions {
@@ -88,6 +90,11 @@ struct RouteTableOptions {
   int threads = 2;  // worker threads for dense builds (>= 1)
 };
 
+// The methods by name, as the command lines and configuration take them: "floyd", "dijkstra",
+// "auto", "lazy", "hub_labels". kInvalidArgument listing them for another name.
+const std::vector<std::string>& RouteTableMethodNames();
+Result<RouteTableMethod> ParseRouteTableMethod(std::string_view name);
+
 // kAuto's rule, a cost model calibrated with routing_bench (Release, 2 cores): blocked Floyd
 // costs ~n^3 * kFloydNsPerRelax, all-pairs Dijkstra ~n * (n + m) * log2(n) * kDijkstraNsPerOp
 // (both divided by the thread count); the cheaper one wins. Returns kFloyd or kDijkstra.
@@ -99,8 +106,9 @@ RouteTableMethod ChooseDenseMethod(std::size_t vertices, std::size_t arcs);
 // kUnreachable naming both points ("no route from point 'a' (3) to point 'b' (7)").
 Error NoRouteError(const WarehouseMap& map, PointId from, PointId to);
 
-// Builds the table chosen by `options` (see lazy_threshold_points). `cancelled` is polled on
-// the calling thread during dense builds; a cancelled build returns kFailedPrecondition.
+// Builds the table chosen by `options` (see lazy_threshold_points; kHubLabels is built
+// whatever the size). `cancelled` is polled on the calling thread during dense and hub label
+// builds; a cancelled build returns kFailedPrecondition.
 // Errors: kInvalidArgument for a null map or bad options.
 Result<std::unique_ptr<RouteTable>> MakeRouteTable(std::shared_ptr<const WarehouseMap> map,
                                                    const RouteTableOptions& options,

@@ -1,5 +1,6 @@
-// routing_bench: all-pairs builders on random sparse road-like graphs, and the lazy table's
-// first (uncached) and cached query on a large grid map.
+// routing_bench: all-pairs builders on random sparse road-like graphs; on large grid maps the
+// lazy table's first (uncached) and cached query, and the hub label table's build (time and
+// size as counters) and its Cost and NextHop between random pairs (issue 19 §1).
 //
 //   cmake -S . -B build-bench -DCMAKE_BUILD_TYPE=Release -DDISPATCH_BUILD_BENCHMARKS=ON
 //       -DDISPATCH_BUILD_TESTS=OFF  (one line)
@@ -13,6 +14,7 @@
 #include <cmath>
 #include <cstdio>
 #include <memory>
+#include <mutex>
 #include <random>
 #include <string>
 
@@ -21,6 +23,7 @@
 #include "engine/map/map_builder.h"
 #include "engine/routing/dijkstra.h"
 #include "engine/routing/floyd.h"
+#include "engine/routing/hub_label_route_table.h"
 #include "engine/routing/lazy_route_table.h"
 
 namespace dispatch::engine {
@@ -159,7 +162,60 @@ void BM_Chu2024FloydRouteTable(benchmark::State& state) {
 }
 BENCHMARK(BM_Chu2024FloydRouteTable)->Unit(benchmark::kMillisecond)->UseRealTime();
 
+// One hub label table per map, built on first use (so that a filtered run builds none).
+struct LabelledMap {
+  std::shared_ptr<const WarehouseMap> map;
+  std::once_flag once;
+  std::unique_ptr<HubLabelRouteTable> table;
+  const HubLabelRouteTable& Get() {
+    std::call_once(once, [this] { table = HubLabelRouteTable::Build(map, {}).value(); });
+    return *table;
+  }
+};
+
+// The build: wall time, and the labels' size as counters.
+void HubLabelBuild(benchmark::State& state, std::shared_ptr<const WarehouseMap> map) {
+  std::unique_ptr<HubLabelRouteTable> table;
+  for (auto _ : state) table = HubLabelRouteTable::Build(map, {}).value();
+  const HubLabelStats& s = table->label_stats();
+  const double vertices = static_cast<double>(table->build_info().vertex_count);
+  state.counters["vertices"] = vertices;
+  state.counters["shortcuts"] = static_cast<double>(s.shortcuts);
+  state.counters["mean_label"] = static_cast<double>(s.label_entries) / (2.0 * vertices);
+  state.counters["max_label"] = static_cast<double>(s.max_label);
+  state.counters["MiB"] = static_cast<double>(s.bytes) / (1 << 20);
+  state.counters["contract_s"] = s.contract_seconds;
+  state.counters["label_s"] = s.label_seconds;
+}
+
+// Cost or NextHop between random pairs: no pair is cheaper for having been asked before.
+void HubLabelQuery(benchmark::State& state, std::shared_ptr<LabelledMap> labelled, bool next_hop) {
+  const HubLabelRouteTable& table = labelled->Get();
+  std::mt19937 rng(7);
+  std::uniform_int_distribution<PointId> pick(0, static_cast<PointId>(table.point_count()) - 1);
+  for (auto _ : state) {
+    const PointId from = pick(rng), to = pick(rng);
+    if (next_hop) {
+      benchmark::DoNotOptimize(table.NextHop(from, to));
+    } else {
+      benchmark::DoNotOptimize(table.Cost(from, to));
+    }
+  }
+}
+
 }  // namespace
+
+// Registers BM_HubLabelBuild/<name>, BM_HubLabelCost/<name> and BM_HubLabelNextHop/<name>.
+void RegisterHubLabelBenchmarks(const std::string& name, std::shared_ptr<const WarehouseMap> map) {
+  auto labelled = std::make_shared<LabelledMap>();
+  labelled->map = map;
+  benchmark::RegisterBenchmark(("BM_HubLabelBuild/" + name).c_str(), HubLabelBuild, map)
+      ->Iterations(1)->Unit(benchmark::kMillisecond)->UseRealTime();
+  benchmark::RegisterBenchmark(("BM_HubLabelCost/" + name).c_str(), HubLabelQuery, labelled, false)
+      ->Unit(benchmark::kNanosecond);
+  benchmark::RegisterBenchmark(("BM_HubLabelNextHop/" + name).c_str(), HubLabelQuery, labelled, true)
+      ->Unit(benchmark::kNanosecond);
+}
 
 // Registers BM_LazyFirstQuery/<name> and BM_LazyCachedQuery/<name> for `map` (with and
 // without turn penalty).
@@ -180,16 +236,22 @@ void RegisterLazyMapBenchmarks(const std::string& name, std::shared_ptr<const Wa
 int main(int argc, char** argv) {
   benchmark::Initialize(&argc, argv);
   if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
-  dispatch::engine::RegisterLazyMapBenchmarks("grid300x300", dispatch::engine::GridMap(300));
-  // The public LoRR floor (38,586 free cells), when ../shared is where the build expects it.
-  const std::string large = std::string(DISPATCH_SHARED_DIR) +
-      "/benchmarks/lorr2024/example_problems/warehouse.domain/maps/warehouse_large.map";
-  auto map = dispatch::engine::LoadMovingAiMapFile(large);
-  if (map.ok()) {
-    dispatch::engine::RegisterLazyMapBenchmarks(
-        "warehouse_large", std::make_shared<const dispatch::engine::WarehouseMap>(std::move(map).value()));
-  } else {
-    std::fprintf(stderr, "routing_bench: skipping warehouse_large: %s\n", map.error().message.c_str());
+  const auto grid = dispatch::engine::GridMap(300);
+  dispatch::engine::RegisterLazyMapBenchmarks("grid300x300", grid);
+  dispatch::engine::RegisterHubLabelBenchmarks("grid300x300", grid);
+  // The public LoRR floors (38,586 and 54,320 free cells), when ../shared is where the build
+  // expects it.
+  for (const char* floor : {"warehouse_large", "sortation_large"}) {
+    const std::string file = std::string(DISPATCH_SHARED_DIR) +
+        "/benchmarks/lorr2024/example_problems/warehouse.domain/maps/" + floor + ".map";
+    auto map = dispatch::engine::LoadMovingAiMapFile(file);
+    if (!map.ok()) {
+      std::fprintf(stderr, "routing_bench: skipping %s: %s\n", floor, map.error().message.c_str());
+      continue;
+    }
+    const auto shared = std::make_shared<const dispatch::engine::WarehouseMap>(std::move(map).value());
+    dispatch::engine::RegisterLazyMapBenchmarks(floor, shared);
+    dispatch::engine::RegisterHubLabelBenchmarks(floor, shared);
   }
   benchmark::RunSpecifiedBenchmarks();
   benchmark::Shutdown();

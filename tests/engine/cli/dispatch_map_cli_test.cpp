@@ -37,6 +37,30 @@ TEST(DispatchMapCliTest, RoutesBetweenNamedPointsAndStations) {
   EXPECT_THAT(sample.output, HasSubstr("Route table: lazy"));
 }
 
+// The route's line: from, to, length and time (the via column may differ between routes of
+// equal cost).
+std::string RouteFigures(const std::string& output) {
+  std::istringstream lines(output);
+  std::string line, last;
+  while (std::getline(lines, line)) {
+    if (!line.empty()) last = line;
+  }
+  std::istringstream fields(last);
+  std::string from, to, length, time;
+  fields >> from >> to >> length >> time;
+  return from + " " + to + " " + length + " " + time;
+}
+
+TEST(DispatchMapCliTest, HubLabelsGiveTheFloydRoutesCost) {
+  const CliRun floyd = RunMap("routes --map chu2024 --from P1 --to D-T3 --turn-penalty 2");
+  const CliRun labels = RunMap("routes --map chu2024 --from P1 --to D-T3 --turn-penalty 2 --method hub_labels");
+  ASSERT_EQ(labels.status, 0) << labels.output;
+  EXPECT_THAT(labels.output, HasSubstr("Route table: hub_labels"));
+  EXPECT_THAT(labels.output, HasSubstr("MiB"));
+  EXPECT_EQ(RouteFigures(labels.output), RouteFigures(floyd.output)) << floyd.output << labels.output;
+  EXPECT_THAT(RouteFigures(labels.output), HasSubstr("park-P1 D-T3"));
+}
+
 TEST(DispatchMapCliTest, WritesAnSvg) {
   const auto path = std::filesystem::path(DISPATCH_BINARY_DIR) / "dispatch_map_cli_test.svg";
   const CliRun r = RunMap("svg --map chu2024 --out " + path.string());

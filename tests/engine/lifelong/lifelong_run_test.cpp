@@ -87,6 +87,22 @@ TEST(LifelongRunTest, ThePublicRandomInstanceRunsLegallyAndTheOutputHasTheCompet
   EXPECT_EQ(report.steps, 100);
 }
 
+// Hub labels answer the dense table's costs on a grid (whole cells: exact sums), so the same
+// allocations and the same moves follow.
+TEST(LifelongRunTest, HubLabelsRunTheDenseTablesRun) {
+  const LorrProblem problem = Load(LorrExample("random.domain/random_32_32_20_100.json"));
+  LifelongOptions options;
+  options.steps = 60;
+  const LifelongRecord dense = RunLifelong(problem, options).value();
+  options.route_method = RouteTableMethod::kHubLabels;
+  const LifelongRecord labels = RunLifelong(problem, options).value();
+  EXPECT_EQ(dense.routes, "floyd");
+  EXPECT_EQ(labels.routes, "hub_labels");
+  EXPECT_GT(labels.tasks_finished, 5);
+  EXPECT_EQ(labels.tasks_finished, dense.tasks_finished);
+  EXPECT_EQ(labels.actual_actions, dense.actual_actions);
+}
+
 // The checker finds what a run that broke the rules would write.
 TEST(LifelongRunTest, TheCheckerFindsBrokenOutputs) {
   const LorrProblem problem = Load(WriteProblem("tamper", {".....", "@@.@@"}, {"0", "4"}, {"2,7", "1,3"}, 2, 1.0));

@@ -1,0 +1,54 @@
+// HubLabelRouteTable: a RouteTable for large floors that answers any pair without a search per
+// destination (issue 19 §1): hub labels (hub_labels.h) over the map's cost graph. Cost is a
+// merge of two labels (~1 us on the LoRR floors); NextHop tries each arc leaving the point
+// (Cost of its head + the arc); Path repeats NextHop. Memory is the labels' (build_info
+// table_bytes), whatever the destinations asked; the build is a one-off preprocessing
+// (hub_label_bench and the README give its time on the LoRR floors).
+//
+// With turn penalties the labels are built over the arc-expanded graph plus one sink vertex
+// per point, joined from each of its arrival vertices at cost 0, so that Cost(u, v) is one
+// query to v's sink. Answers equal LazyRouteTable's costs up to rounding; among routes of equal
+// cost NextHop takes the arc whose head is nearest the destination, then the lowest arc id.
+// Path needs a graph without cycles of arcs that cost nothing (a map's arcs all have a
+// length). Immutable after Build: safe for concurrent const calls.
+#pragma once
+
+#include <memory>
+
+#include "engine/routing/cost_graph.h"
+#include "engine/routing/hub_labels.h"
+#include "engine/routing/route_table.h"
+
+namespace dispatch::engine {
+
+class HubLabelRouteTable final : public RouteTable {
+ public:
+  // `cancelled` is polled during the build (kFailedPrecondition when it says stop).
+  static Result<std::unique_ptr<HubLabelRouteTable>> Build(std::shared_ptr<const WarehouseMap> map,
+                                                           const RouteTableOptions& options,
+                                                           const CancelCheck& cancelled = {});
+
+  std::size_t point_count() const override { return graph_.point_count; }
+  double Cost(PointId from, PointId to) const override;
+  PointId NextHop(PointId from, PointId to) const override;
+  Result<Route> Path(PointId from, PointId to) const override;
+  std::string_view method() const override { return "hub_labels"; }
+  RouteTableBuildInfo build_info() const override;
+  const HubLabelStats& label_stats() const { return labels_.stats(); }
+
+ private:
+  HubLabelRouteTable() = default;
+  bool Known(PointId p) const { return p >= 0 && static_cast<std::size_t>(p) < graph_.point_count; }
+  // The vertex a route to point p ends at: p, or p's sink with turn penalties.
+  VertexId Target(PointId p) const;
+  // The arc of search_ leaving v on a cheapest route to `target` (whose cost from v is `left`;
+  // see the tie rule above); -1 when none is found.
+  std::int32_t BestArc(VertexId v, VertexId target, double left) const;
+
+  std::shared_ptr<const WarehouseMap> map_;
+  MapCostGraph graph_;
+  CostGraph search_;  // graph_.graph, plus the sinks and their arcs with turn penalties
+  HubLabels labels_;
+};
+
+}  // namespace dispatch::engine
