@@ -1,11 +1,28 @@
 #include "engine/routing/hub_label_route_table.h"
 
 #include <algorithm>
+#include <atomic>
 #include <utility>
 
 #include "engine/common/numbers.h"
 
 namespace dispatch::engine {
+namespace {
+
+std::atomic<std::uint64_t> next_label_table_id{1};
+
+struct SpreadCache {
+  std::uint64_t table = 0;
+  VertexId target = kNoVertex;
+  std::vector<double> by_hub;
+};
+
+SpreadCache& ThreadSpread() {
+  thread_local SpreadCache cache;
+  return cache;
+}
+
+}  // namespace
 
 Result<std::unique_ptr<HubLabelRouteTable>> HubLabelRouteTable::Build(std::shared_ptr<const WarehouseMap> map,
                                                                       const RouteTableOptions& options,
@@ -34,6 +51,7 @@ Result<std::unique_ptr<HubLabelRouteTable>> HubLabelRouteTable::Build(std::share
   auto labels = HubLabels::Build(t->search_, {}, cancelled);
   if (!labels.ok()) return labels.error();
   t->labels_ = std::move(labels).value();
+  t->id_ = next_label_table_id.fetch_add(1);
   return t;
 }
 
@@ -41,13 +59,29 @@ VertexId HubLabelRouteTable::Target(PointId p) const {
   return graph_.expanded ? static_cast<VertexId>(graph_.graph.vertex_count() + static_cast<std::size_t>(p)) : p;
 }
 
+const std::vector<double>& HubLabelRouteTable::SpreadTo(VertexId target) const {
+  SpreadCache& c = ThreadSpread();
+  if (c.table == id_ && c.target == target) return c.by_hub;
+  if (c.table == id_) {
+    labels_.Unspread(c.target, c.by_hub);
+  } else {
+    c.by_hub.assign(labels_.vertex_count(), kInf);
+  }
+  labels_.Spread(target, c.by_hub);
+  c.table = id_;
+  c.target = target;
+  return c.by_hub;
+}
+
 double HubLabelRouteTable::Cost(PointId from, PointId to) const {
   if (!Known(from) || !Known(to)) return kInf;
   if (from == to) return 0.0;
+  const SpreadCache& c = ThreadSpread();
+  if (c.table == id_ && c.target == Target(to)) return labels_.DistanceVia(from, c.by_hub);
   return labels_.Distance(from, Target(to));
 }
 
-std::int32_t HubLabelRouteTable::BestArc(VertexId v, VertexId target, double left) const {
+std::int32_t HubLabelRouteTable::BestArc(VertexId v, const std::vector<double>& target, double left) const {
   // An arc is on a cheapest route when its cost plus what is left from its head is `left`;
   // of those, the one whose head is nearest the target (so a walk never goes round a loop of
   // arcs that cost nothing), then the lowest id.
@@ -56,7 +90,7 @@ std::int32_t HubLabelRouteTable::BestArc(VertexId v, VertexId target, double lef
   double best_rest = kInf;
   for (std::int32_t id : search_.out_arcs(v)) {
     const CostArc& a = search_.arc(id);
-    const double rest = labels_.Distance(a.to, target);
+    const double rest = labels_.DistanceVia(a.to, target);
     if (a.cost + rest > left + slack) continue;
     if (best < 0 || rest < best_rest || (rest == best_rest && id < best)) {
       best = id;
@@ -67,9 +101,11 @@ std::int32_t HubLabelRouteTable::BestArc(VertexId v, VertexId target, double lef
 }
 
 PointId HubLabelRouteTable::NextHop(PointId from, PointId to) const {
-  const double left = Cost(from, to);
-  if (from == to || left == kInf) return kNoPoint;
-  const std::int32_t id = BestArc(from, Target(to), left);
+  if (!Known(from) || !Known(to) || from == to) return kNoPoint;
+  const std::vector<double>& target = SpreadTo(Target(to));
+  const double left = labels_.DistanceVia(from, target);
+  if (left == kInf) return kNoPoint;
+  const std::int32_t id = BestArc(from, target, left);
   if (id < 0) return kNoPoint;
   return map_->arc(graph_.map_arc[static_cast<std::size_t>(id)]).to;
 }
@@ -77,8 +113,9 @@ PointId HubLabelRouteTable::NextHop(PointId from, PointId to) const {
 Result<Route> HubLabelRouteTable::Path(PointId from, PointId to) const {
   if (!Known(from) || !Known(to)) return NoRouteError(*map_, from, to);
   if (from == to) return Route{{from}, {}, 0.0, 0.0};
-  const VertexId target = Target(to);
-  double left = labels_.Distance(from, target);
+  const VertexId sink = Target(to);
+  const std::vector<double>& target = SpreadTo(sink);
+  double left = labels_.DistanceVia(from, target);
   if (left == kInf) return NoRouteError(*map_, from, to);
   std::vector<VertexId> path{from};
   // Each hop leaves on a cheapest route; the sink (turn penalties) is not part of the route.
@@ -86,10 +123,10 @@ Result<Route> HubLabelRouteTable::Path(PointId from, PointId to) const {
     const std::int32_t id = BestArc(v, target, left);
     if (id < 0 || path.size() > search_.vertex_count()) {
       return Error{ErrorCode::kFailedPrecondition, "hub labels: no cheapest arc out of vertex " + std::to_string(v) +
-                                             " towards point " + std::to_string(to)};
+                                                       " towards point " + std::to_string(to)};
     }
     const CostArc& a = search_.arc(id);
-    if (a.to == target && graph_.expanded) break;
+    if (a.to == sink && graph_.expanded) break;
     left -= a.cost;
     v = a.to;
     path.push_back(v);

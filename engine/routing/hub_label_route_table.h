@@ -3,7 +3,9 @@
 // merge of two labels (~1 us on the LoRR floors); NextHop tries each arc leaving the point
 // (Cost of its head + the arc); Path repeats NextHop. Memory is the labels' (build_info
 // table_bytes), whatever the destinations asked; the build is a one-off preprocessing
-// (hub_label_bench and the README give its time on the LoRR floors).
+// (routing_bench and the README give its time on the LoRR floors). NextHop and Path read the
+// destination's label spread over an array by hub, kept per thread (8 bytes per searched
+// vertex per thread that asks).
 //
 // With turn penalties the labels are built over the arc-expanded graph plus one sink vertex
 // per point, joined from each of its arrival vertices at cost 0, so that Cost(u, v) is one
@@ -13,7 +15,9 @@
 // length). Immutable after Build: safe for concurrent const calls.
 #pragma once
 
+#include <cstdint>
 #include <memory>
+#include <vector>
 
 #include "engine/routing/cost_graph.h"
 #include "engine/routing/hub_labels.h"
@@ -41,14 +45,19 @@ class HubLabelRouteTable final : public RouteTable {
   bool Known(PointId p) const { return p >= 0 && static_cast<std::size_t>(p) < graph_.point_count; }
   // The vertex a route to point p ends at: p, or p's sink with turn penalties.
   VertexId Target(PointId p) const;
-  // The arc of search_ leaving v on a cheapest route to `target` (whose cost from v is `left`;
-  // see the tie rule above); -1 when none is found.
-  std::int32_t BestArc(VertexId v, VertexId target, double left) const;
+  // `target`'s backward label spread by hub (HubLabels::Spread), kept per thread for the
+  // last target it asked of this table: a walk, or a run of NextHop calls towards one
+  // destination, spreads it once. Valid until this thread's next call with another target.
+  const std::vector<double>& SpreadTo(VertexId target) const;
+  // The arc of search_ leaving v on a cheapest route to the spread target (whose cost from v
+  // is `left`; see the tie rule above); -1 when none is found.
+  std::int32_t BestArc(VertexId v, const std::vector<double>& target, double left) const;
 
   std::shared_ptr<const WarehouseMap> map_;
   MapCostGraph graph_;
   CostGraph search_;  // graph_.graph, plus the sinks and their arcs with turn penalties
   HubLabels labels_;
+  std::uint64_t id_ = 0;  // unique per table ever built (the per-thread spread's key)
 };
 
 }  // namespace dispatch::engine

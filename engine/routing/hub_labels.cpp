@@ -312,4 +312,24 @@ double HubLabels::Distance(VertexId from, VertexId to) const {
                   bwd_hub_.data() + bwd_begin_[t], bwd_dist_.data() + bwd_begin_[t], bwd_end_[t] - bwd_begin_[t]);
 }
 
+void HubLabels::Spread(VertexId to, std::vector<double>& by_hub) const {
+  const auto t = static_cast<std::size_t>(to);
+  for (std::uint64_t k = bwd_begin_[t]; k < bwd_end_[t]; ++k) by_hub[static_cast<std::size_t>(bwd_hub_[k])] = bwd_dist_[k];
+}
+
+void HubLabels::Unspread(VertexId to, std::vector<double>& by_hub) const {
+  const auto t = static_cast<std::size_t>(to);
+  for (std::uint64_t k = bwd_begin_[t]; k < bwd_end_[t]; ++k) by_hub[static_cast<std::size_t>(bwd_hub_[k])] = kInf;
+}
+
+double HubLabels::DistanceVia(VertexId from, const std::vector<double>& by_hub) const {
+  if (from < 0 || static_cast<std::size_t>(from) >= vertex_count()) return kInf;
+  const auto s = static_cast<std::size_t>(from);
+  double best = kInf;
+  for (std::uint64_t k = fwd_begin_[s]; k < fwd_end_[s]; ++k) {
+    best = std::min(best, fwd_dist_[k] + by_hub[static_cast<std::size_t>(fwd_hub_[k])]);
+  }
+  return best;
+}
+
 }  // namespace dispatch::engine

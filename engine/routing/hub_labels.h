@@ -56,6 +56,14 @@ class HubLabels {
   double Distance(VertexId from, VertexId to) const;
   const HubLabelStats& stats() const { return stats_; }
 
+  // Many queries towards one vertex: Spread writes `to`'s backward label into `by_hub` (sized
+  // vertex_count(), +infinity everywhere else), after which DistanceVia(from, by_hub) answers
+  // Distance(from, to) by reading from's forward label alone, with no merge; Unspread puts
+  // the infinities back. For a walk along a route or a bid's robots towards one goal.
+  void Spread(VertexId to, std::vector<double>& by_hub) const;
+  void Unspread(VertexId to, std::vector<double>& by_hub) const;
+  double DistanceVia(VertexId from, const std::vector<double>& by_hub) const;
+
  private:
   // All labels side by side; vertex v's are [begin[v], end[v]) (stored in the order they were
   // built), entries sorted by hub (the hub's rank: 0 = contracted first).
