@@ -19,10 +19,9 @@
 namespace dispatch::engine {
 namespace {
 
-using testing::ExpectValidRoute;
+using testing::ExpectReferenceAnswers;
 using testing::RandomCostGraph;
 using testing::RandomMap;
-using testing::ReferenceCosts;
 
 void ExpectExact(const CostGraph& graph, const HubLabels& labels) {
   const auto n = static_cast<VertexId>(graph.vertex_count());
@@ -140,21 +139,7 @@ TEST_P(HubLabelRouteTableTest, SameAnswersAsTheReference) {
   EXPECT_EQ(table->method(), "hub_labels");
   EXPECT_EQ(table->build_info().turn_expanded, c.penalty > 0);
   EXPECT_GT(table->build_info().table_bytes, 0u);
-  const auto n = static_cast<PointId>(map->point_count());
-  for (PointId u = 0; u < n; ++u) {
-    const std::vector<double> ref = ReferenceCosts(*map, u, options.speed, c.penalty);
-    for (PointId v = 0; v < n; ++v) {
-      const double expected = ref[static_cast<std::size_t>(v)];
-      if (std::isinf(expected)) {
-        ASSERT_TRUE(std::isinf(table->Cost(u, v))) << u << "->" << v;
-      } else {
-        ASSERT_NEAR(table->Cost(u, v), expected, 1e-9 * std::max(1.0, expected)) << u << "->" << v;
-      }
-      EXPECT_EQ(std::isinf(expected), table->NextHop(u, v) == kNoPoint && u != v);
-      ExpectValidRoute(*map, *table, u, v, options.speed, c.penalty);
-      if (::testing::Test::HasFatalFailure()) return;
-    }
-  }
+  ExpectReferenceAnswers(*map, *table, options.speed, c.penalty);
 }
 
 INSTANTIATE_TEST_SUITE_P(RandomMaps, HubLabelRouteTableTest,

@@ -16,6 +16,7 @@ namespace dispatch::engine {
 namespace {
 
 using testing::CostsAgree;
+using testing::ExpectReferenceAnswers;
 using testing::ExpectValidRoute;
 using testing::RandomMap;
 using testing::ReferenceCosts;
@@ -37,22 +38,10 @@ TEST_P(LazyRouteTableModelTest, SameAnswersAsTheDenseTableAndReference) {
   const auto dense = FloydRouteTable::Build(map, options).value();
   const auto lazy = LazyRouteTable::Build(map, options).value();
   EXPECT_EQ(lazy->method(), "lazy");
-  const auto n = static_cast<PointId>(map->point_count());
-  for (PointId u = 0; u < n; ++u) {
-    const std::vector<double> ref = ReferenceCosts(*map, u, options.speed, c.penalty);
-    for (PointId v = 0; v < n; ++v) {
-      const double expected = ref[static_cast<std::size_t>(v)];
-      if (std::isinf(expected)) {
-        ASSERT_TRUE(std::isinf(lazy->Cost(u, v))) << u << "->" << v;
-      } else {
-        ASSERT_NEAR(lazy->Cost(u, v), expected, 1e-9 * std::max(1.0, expected)) << u << "->" << v;
-      }
-      ASSERT_TRUE(CostsAgree(dense->Cost(u, v), lazy->Cost(u, v)));
-      EXPECT_EQ(std::isinf(expected), lazy->NextHop(u, v) == kNoPoint && u != v);
-      ExpectValidRoute(*map, *lazy, u, v, options.speed, c.penalty);
-      if (::testing::Test::HasFatalFailure()) return;
-    }
-  }
+  ExpectReferenceAnswers(*map, *lazy, options.speed, c.penalty, [&](PointId u, PointId v) {
+    ASSERT_TRUE(CostsAgree(dense->Cost(u, v), lazy->Cost(u, v)));
+  });
+  if (::testing::Test::HasFatalFailure()) return;
   EXPECT_EQ(lazy->searches(), map->point_count());  // one search per destination
 }
 

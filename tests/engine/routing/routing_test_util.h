@@ -168,4 +168,27 @@ inline void ExpectValidRoute(const WarehouseMap& map, const RouteTable& table, P
   EXPECT_EQ(table.NextHop(from, to), r.points.size() > 1 ? r.points[1] : kNoPoint);
 }
 
+// Every pair of `map`'s points: the reference's cost (exact to 1e-9), a NextHop exactly when a
+// route exists, and a valid route of that cost (ExpectValidRoute). `also(u, v)` adds a check.
+template <class Also = void (*)(PointId, PointId)>
+void ExpectReferenceAnswers(const WarehouseMap& map, const RouteTable& table, double speed, double penalty,
+                            Also also = [](PointId, PointId) {}) {
+  const auto n = static_cast<PointId>(map.point_count());
+  for (PointId u = 0; u < n; ++u) {
+    const std::vector<double> ref = ReferenceCosts(map, u, speed, penalty);
+    for (PointId v = 0; v < n; ++v) {
+      const double expected = ref[static_cast<std::size_t>(v)];
+      if (std::isinf(expected)) {
+        ASSERT_TRUE(std::isinf(table.Cost(u, v))) << u << "->" << v;
+      } else {
+        ASSERT_NEAR(table.Cost(u, v), expected, 1e-9 * std::max(1.0, expected)) << u << "->" << v;
+      }
+      also(u, v);
+      EXPECT_EQ(std::isinf(expected), table.NextHop(u, v) == kNoPoint && u != v);
+      ExpectValidRoute(map, table, u, v, speed, penalty);
+      if (::testing::Test::HasFatalFailure()) return;
+    }
+  }
+}
+
 }  // namespace dispatch::engine::testing
