@@ -44,11 +44,9 @@ Result<std::unique_ptr<HubLabelRouteTable>> HubLabelRouteTable::Build(std::share
     }
     auto search = CostGraph::Build(v + p, std::move(arcs));
     if (!search.ok()) return search.error();
-    t->search_ = std::move(search).value();
-  } else {
-    t->search_ = t->graph_.graph;
+    t->with_sinks_ = std::move(search).value();
   }
-  auto labels = HubLabels::Build(t->search_, {}, cancelled);
+  auto labels = HubLabels::Build(t->search(), {}, cancelled);
   if (!labels.ok()) return labels.error();
   t->labels_ = std::move(labels).value();
   t->id_ = next_label_table_id.fetch_add(1);
@@ -88,8 +86,9 @@ std::int32_t HubLabelRouteTable::BestArc(VertexId v, const std::vector<double>& 
   const double slack = 1e-9 * std::max(1.0, left);
   std::int32_t best = -1;
   double best_rest = kInf;
-  for (std::int32_t id : search_.out_arcs(v)) {
-    const CostArc& a = search_.arc(id);
+  const CostGraph& graph = search();
+  for (std::int32_t id : graph.out_arcs(v)) {
+    const CostArc& a = graph.arc(id);
     const double rest = labels_.DistanceVia(a.to, target);
     if (a.cost + rest > left + slack) continue;
     if (best < 0 || rest < best_rest || (rest == best_rest && id < best)) {
@@ -121,11 +120,11 @@ Result<Route> HubLabelRouteTable::Path(PointId from, PointId to) const {
   // Each hop leaves on a cheapest route; the sink (turn penalties) is not part of the route.
   for (VertexId v = from; v != to;) {
     const std::int32_t id = BestArc(v, target, left);
-    if (id < 0 || path.size() > search_.vertex_count()) {
+    if (id < 0 || path.size() > search().vertex_count()) {
       return Error{ErrorCode::kFailedPrecondition, "hub labels: no cheapest arc out of vertex " + std::to_string(v) +
                                                        " towards point " + std::to_string(to)};
     }
-    const CostArc& a = search_.arc(id);
+    const CostArc& a = search().arc(id);
     if (a.to == sink && graph_.expanded) break;
     left -= a.cost;
     v = a.to;

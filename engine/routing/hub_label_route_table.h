@@ -49,13 +49,16 @@ class HubLabelRouteTable final : public RouteTable {
   // last target it asked of this table: a walk, or a run of NextHop calls towards one
   // destination, spreads it once. Valid until this thread's next call with another target.
   const std::vector<double>& SpreadTo(VertexId target) const;
-  // The arc of search_ leaving v on a cheapest route to the spread target (whose cost from v
+  // The arc of search() leaving v on a cheapest route to the spread target (whose cost from v
   // is `left`; see the tie rule above); -1 when none is found.
   std::int32_t BestArc(VertexId v, const std::vector<double>& target, double left) const;
 
   std::shared_ptr<const WarehouseMap> map_;
   MapCostGraph graph_;
-  CostGraph search_;  // graph_.graph, plus the sinks and their arcs with turn penalties
+  // The graph the labels cover: graph_.graph, or with turn penalties with_sinks_ (it plus the
+  // sinks and their arcs).
+  const CostGraph& search() const { return graph_.expanded ? with_sinks_ : graph_.graph; }
+  CostGraph with_sinks_;
   HubLabels labels_;
   std::uint64_t id_ = 0;  // unique per table ever built (the per-thread spread's key)
 };

@@ -172,15 +172,15 @@ class HubLabelBuilder {
       if (Stop(static_cast<std::size_t>(next_rank) + 1)) return false;
       rank_[i] = next_rank++;
       order_.push_back(v);
-      std::vector<std::pair<std::pair<VertexId, VertexId>, double>> added;
-      Shortcuts(v, added);
-      shortcuts_ += added.size();
+      Shortcuts(v, added_);
+      shortcuts_ += added_.size();
       up_out_[i] = out_[i];
       up_in_[i] = in_[i];
       for (const Edge& e : out_[i]) Detach(in_[static_cast<std::size_t>(e.to)], v);
       for (const Edge& e : in_[i]) Detach(out_[static_cast<std::size_t>(e.to)], v);
-      for (const auto& [ends, w] : added) AddOrImprove(ends.first, ends.second, w);
-      std::vector<VertexId> neighbours;
+      for (const auto& [ends, w] : added_) AddOrImprove(ends.first, ends.second, w);
+      std::vector<VertexId>& neighbours = neighbours_;
+      neighbours.clear();
       for (const Edge& e : out_[i]) neighbours.push_back(e.to);
       for (const Edge& e : in_[i]) neighbours.push_back(e.to);
       out_[i].clear();
@@ -283,7 +283,8 @@ class HubLabelBuilder {
   std::vector<int> deleted_, level_, priority_;
   std::vector<double> dist_;                       // witness searches
   std::vector<VertexId> touched_;
-  std::vector<std::pair<std::pair<VertexId, VertexId>, double>> scratch_;
+  std::vector<std::pair<std::pair<VertexId, VertexId>, double>> scratch_, added_;  // Priority's, Contract's
+  std::vector<VertexId> neighbours_;                                               // Contract's
   std::size_t shortcuts_ = 0;
   std::vector<double> best_;                       // labelling, by hub rank
   std::vector<std::int32_t> cand_hub_;
