@@ -216,8 +216,10 @@ double AuctionAllocator::FlowBound(const FleetState& state, std::size_t robot, P
 bool AuctionAllocator::CostsAreSampledTimes(const RouteTable& routes, double speed) {
   const RouteTableBuildInfo info = routes.build_info();
   // A weighted table (routing = heat) costs the route its NextHop follows at the same arc
-  // times: the sampler's times too.
-  return (info.method == "lazy" || info.method == "weighted") && !info.turn_expanded && info.speed == speed;
+  // times: the sampler's times too. Hub labels sum the same arc times in another order: equal
+  // up to rounding, far below the slack FlowBound's density lookups allow.
+  return (info.method == "lazy" || info.method == "weighted" || info.method == "hub_labels") &&
+         !info.turn_expanded && info.speed == speed;
 }
 
 RouteSampler& AuctionAllocator::Sampler(const FleetState& state) {
@@ -366,6 +368,8 @@ std::vector<Bid> AuctionAllocator::ComputeReachBids(const FleetState& state, Poi
   const ZoneId pick_zone = predictor.ZoneAt(state.map().point(first_pick).position);
   std::vector<Bid> bids;
   bids.reserve(state.robot_count());
+  const bool legs_are_times = CostsAreSampledTimes(routes, c.speed);  // as in ComputeBids
+  legs_.assign(state.robot_count(), -1.0);
   for (std::size_t i = 0; i < state.robot_count(); ++i) {
     const QueueSummary& s = state.summary(i);
     if (!state.HasRoom(i, true)) {
@@ -373,6 +377,7 @@ std::vector<Bid> AuctionAllocator::ComputeReachBids(const FleetState& state, Poi
       continue;
     }
     const double leg = routes.Cost(s.end_point, first_pick);
+    if (legs_are_times && std::isfinite(leg)) legs_[i] = leg;
     if (!std::isfinite(leg)) {
       bids.push_back(UnreachableBid(state.robot_id(i), s.end_time));
       continue;
@@ -389,7 +394,7 @@ std::vector<Bid> AuctionAllocator::ComputeReachBids(const FleetState& state, Poi
   const double on_arrival = 0.0;
   IndexZones(&pick_run, 1, run_zones_);
   auto bound = [&](std::size_t i) {
-    return FlowBound(state, i, first_pick, sampler, density, &pick_run, 1, run_zones_, &on_arrival);
+    return FlowBound(state, i, first_pick, sampler, density, &pick_run, 1, run_zones_, &on_arrival, legs_[i]);
   };
   PriceLowest(c, bids, keep, bound, [&](std::size_t i) {
     const QueueSummary& s = state.summary(i);

@@ -55,9 +55,9 @@ class AuctionAllocator final : public Allocator {
   std::vector<Bid> ComputeReachBids(const FleetState& state, PointId first_pick,
                                     std::size_t keep = 0);
 
-  // True when the table's costs are exactly the sampler's travel times: a lazy table, plain or
-  // weighted (double sums, from the destination outward as RouteSampler::TimeToTarget adds
-  // them), no turn penalty, the allocation's speed.
+  // True when the table's costs are the sampler's travel times: a lazy table, plain or weighted
+  // (exactly: double sums, from the destination outward as RouteSampler::TimeToTarget adds
+  // them), or hub labels (up to rounding); no turn penalty, the allocation's speed.
   static bool CostsAreSampledTimes(const RouteTable& routes, double speed);
 
  private:
@@ -114,7 +114,7 @@ class AuctionAllocator final : public Allocator {
   std::vector<double> flow_bounds_;  // PriceLowest's bound(i) per robot (0 until taken)
   std::vector<bool> bounded_;        // PriceLowest: bound(i) taken
   std::vector<double> kept_;        // PriceLowest's k lowest full bids, ascending
-  std::vector<double> legs_;        // ComputeBids: per robot its route cost to the first pick
+  std::vector<double> legs_;        // ComputeBids, ComputeReachBids: per robot its time to the first pick (< 0: unknown)
 
   struct MixedSample {
     double f = std::numeric_limits<double>::quiet_NaN();  // NaN: empty (never equal)

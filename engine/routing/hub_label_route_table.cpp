@@ -14,7 +14,11 @@ std::atomic<std::uint64_t> next_label_table_id{1};
 struct SpreadCache {
   std::uint64_t table = 0;
   VertexId target = kNoVertex;
-  std::vector<double> by_hub;
+  HubSpread by_hub;
+  // Cost's last target, of table `asked_table`, and how many calls in a row asked it again.
+  std::uint64_t asked_table = 0;
+  VertexId asked = kNoVertex;
+  int asked_again = 0;
 };
 
 SpreadCache& ThreadSpread() {
@@ -57,13 +61,13 @@ VertexId HubLabelRouteTable::Target(PointId p) const {
   return graph_.expanded ? static_cast<VertexId>(graph_.graph.vertex_count() + static_cast<std::size_t>(p)) : p;
 }
 
-const std::vector<double>& HubLabelRouteTable::SpreadTo(VertexId target) const {
+const HubSpread& HubLabelRouteTable::SpreadTo(VertexId target) const {
   SpreadCache& c = ThreadSpread();
   if (c.table == id_ && c.target == target) return c.by_hub;
   if (c.table == id_) {
     labels_.Unspread(c.target, c.by_hub);
   } else {
-    c.by_hub.assign(labels_.vertex_count(), kInf);
+    c.by_hub.Reset(labels_.vertex_count());
   }
   labels_.Spread(target, c.by_hub);
   c.table = id_;
@@ -74,59 +78,44 @@ const std::vector<double>& HubLabelRouteTable::SpreadTo(VertexId target) const {
 double HubLabelRouteTable::Cost(PointId from, PointId to) const {
   if (!Known(from) || !Known(to)) return kInf;
   if (from == to) return 0.0;
-  const SpreadCache& c = ThreadSpread();
-  if (c.table == id_ && c.target == Target(to)) return labels_.DistanceVia(from, c.by_hub);
-  return labels_.Distance(from, Target(to));
-}
-
-std::int32_t HubLabelRouteTable::BestArc(VertexId v, const std::vector<double>& target, double left) const {
-  // An arc is on a cheapest route when its cost plus what is left from its head is `left`;
-  // of those, the one whose head is nearest the target (so a walk never goes round a loop of
-  // arcs that cost nothing), then the lowest id.
-  const double slack = 1e-9 * std::max(1.0, left);
-  std::int32_t best = -1;
-  double best_rest = kInf;
-  const CostGraph& graph = search();
-  for (std::int32_t id : graph.out_arcs(v)) {
-    const CostArc& a = graph.arc(id);
-    const double rest = labels_.DistanceVia(a.to, target);
-    if (a.cost + rest > left + slack) continue;
-    if (best < 0 || rest < best_rest || (rest == best_rest && id < best)) {
-      best = id;
-      best_rest = rest;
-    }
+  const VertexId target = Target(to);
+  SpreadCache& c = ThreadSpread();
+  if (c.table == id_ && c.target == target) return labels_.DistanceVia(from, c.by_hub);
+  // The third call in a row towards one target spreads it (a bid's robots, a search's
+  // heuristic): from then on one label is read per call instead of two merged.
+  if (c.asked_table == id_ && c.asked == target) {
+    if (++c.asked_again >= 2) return labels_.DistanceVia(from, SpreadTo(target));
+  } else {
+    c.asked_table = id_;
+    c.asked = target;
+    c.asked_again = 0;
   }
-  return best;
+  return labels_.Distance(from, target);
 }
 
 PointId HubLabelRouteTable::NextHop(PointId from, PointId to) const {
   if (!Known(from) || !Known(to) || from == to) return kNoPoint;
-  const std::vector<double>& target = SpreadTo(Target(to));
-  const double left = labels_.DistanceVia(from, target);
-  if (left == kInf) return kNoPoint;
-  const std::int32_t id = BestArc(from, target, left);
-  if (id < 0) return kNoPoint;
-  return map_->arc(graph_.map_arc[static_cast<std::size_t>(id)]).to;
+  const HubLabels::FirstHop hop = labels_.FirstVia(from, SpreadTo(Target(to)));
+  if (hop.arc < 0) return kNoPoint;
+  return map_->arc(graph_.map_arc[static_cast<std::size_t>(hop.arc)]).to;
 }
 
 Result<Route> HubLabelRouteTable::Path(PointId from, PointId to) const {
   if (!Known(from) || !Known(to)) return NoRouteError(*map_, from, to);
   if (from == to) return Route{{from}, {}, 0.0, 0.0};
   const VertexId sink = Target(to);
-  const std::vector<double>& target = SpreadTo(sink);
-  double left = labels_.DistanceVia(from, target);
-  if (left == kInf) return NoRouteError(*map_, from, to);
+  const HubSpread& target = SpreadTo(sink);
   std::vector<VertexId> path{from};
   // Each hop leaves on a cheapest route; the sink (turn penalties) is not part of the route.
   for (VertexId v = from; v != to;) {
-    const std::int32_t id = BestArc(v, target, left);
-    if (id < 0 || path.size() > search().vertex_count()) {
+    const HubLabels::FirstHop hop = labels_.FirstVia(v, target);
+    if (hop.cost == kInf && v == from) return NoRouteError(*map_, from, to);
+    if (hop.arc < 0 || path.size() > search().vertex_count()) {
       return Error{ErrorCode::kFailedPrecondition, "hub labels: no cheapest arc out of vertex " + std::to_string(v) +
                                                        " towards point " + std::to_string(to)};
     }
-    const CostArc& a = search().arc(id);
+    const CostArc& a = search().arc(hop.arc);
     if (a.to == sink && graph_.expanded) break;
-    left -= a.cost;
     v = a.to;
     path.push_back(v);
   }

@@ -1,18 +1,20 @@
 // HubLabelRouteTable: a RouteTable for large floors that answers any pair without a search per
 // destination (issue 19 §1): hub labels (hub_labels.h) over the map's cost graph. Cost is a
-// merge of two labels (~1 us on the LoRR floors); NextHop tries each arc leaving the point
-// (Cost of its head + the arc); Path repeats NextHop. Memory is the labels' (build_info
+// merge of two labels (~1 us on the LoRR floors); NextHop reads the first arc kept with the
+// cheapest hub's entry (one label); Path repeats it. Memory is the labels' (build_info
 // table_bytes), whatever the destinations asked; the build is a one-off preprocessing
 // (routing_bench and the README give its time on the LoRR floors). NextHop and Path read the
-// destination's label spread over an array by hub, kept per thread (8 bytes per searched
-// vertex per thread that asks).
+// destination's label spread over arrays by hub, kept per thread (12 bytes per searched
+// vertex per thread that asks); so does Cost from its third call in a row towards one
+// destination.
 //
 // With turn penalties the labels are built over the arc-expanded graph plus one sink vertex
 // per point, joined from each of its arrival vertices at cost 0, so that Cost(u, v) is one
 // query to v's sink. Answers equal LazyRouteTable's costs up to rounding; among routes of equal
-// cost NextHop takes the arc whose head is nearest the destination, then the lowest arc id.
-// Path needs a graph without cycles of arcs that cost nothing (a map's arcs all have a
-// length). Immutable after Build: safe for concurrent const calls.
+// cost NextHop takes the first arc towards the cheapest hub of lowest rank (HubLabels::First),
+// so a walk of NextHops need not follow one Path (each is a cheapest route). Path needs a
+// graph without cycles of arcs that cost nothing (a map's arcs all have a length). Immutable
+// after Build: safe for concurrent const calls.
 #pragma once
 
 #include <cstdint>
@@ -48,10 +50,7 @@ class HubLabelRouteTable final : public RouteTable {
   // `target`'s backward label spread by hub (HubLabels::Spread), kept per thread for the
   // last target it asked of this table: a walk, or a run of NextHop calls towards one
   // destination, spreads it once. Valid until this thread's next call with another target.
-  const std::vector<double>& SpreadTo(VertexId target) const;
-  // The arc of search() leaving v on a cheapest route to the spread target (whose cost from v
-  // is `left`; see the tie rule above); -1 when none is found.
-  std::int32_t BestArc(VertexId v, const std::vector<double>& target, double left) const;
+  const HubSpread& SpreadTo(VertexId target) const;
 
   std::shared_ptr<const WarehouseMap> map_;
   MapCostGraph graph_;

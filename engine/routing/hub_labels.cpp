@@ -45,17 +45,26 @@ double Tolerance(double d) { return 1e-9 * std::max(1.0, d); }
 // Builds the hierarchy, then the labels (hub_labels.h).
 class HubLabelBuilder {
  public:
+  // An arc of the hierarchy (the graph's, or a shortcut): towards `to` in out_, from `to` in
+  // in_, costing w; `first` is the graph arc its route starts with (from its tail).
   struct Edge {
     VertexId to = kNoVertex;
     double w = 0.0;
+    std::int32_t first = -1;
+  };
+  struct Shortcut {
+    VertexId from = kNoVertex, to = kNoVertex;
+    double w = 0.0;
+    std::int32_t first = -1;
   };
 
   HubLabelBuilder(const CostGraph& graph, const HubLabelOptions& options, const CancelCheck& cancelled)
       : n_(graph.vertex_count()), options_(options), cancelled_(cancelled), out_(n_), in_(n_),
         up_out_(n_), up_in_(n_), rank_(n_, -1), deleted_(n_, 0), level_(n_, 0), priority_(n_, 0),
         dist_(n_, kInf) {
-    for (const CostArc& a : graph.arcs()) {
-      if (a.from != a.to) AddOrImprove(a.from, a.to, a.cost);
+    for (std::size_t id = 0; id < graph.arc_count(); ++id) {
+      const CostArc& a = graph.arcs()[id];
+      if (a.from != a.to) AddOrImprove(a.from, a.to, a.cost, static_cast<std::int32_t>(id));
     }
   }
 
@@ -70,7 +79,7 @@ class HubLabelBuilder {
     labels_.stats_.label_seconds = SecondsSince(labelled);
     labels_.stats_.shortcuts = shortcuts_;
     labels_.stats_.label_entries = labels_.fwd_hub_.size() + labels_.bwd_hub_.size();
-    labels_.stats_.bytes = labels_.stats_.label_entries * (sizeof(std::int32_t) + sizeof(double)) +
+    labels_.stats_.bytes = labels_.stats_.label_entries * (2 * sizeof(std::int32_t) + sizeof(double)) +
                            4 * n_ * sizeof(std::uint64_t);
     return std::move(labels_);
   }
@@ -79,19 +88,20 @@ class HubLabelBuilder {
   static Error Cancelled() { return {ErrorCode::kFailedPrecondition, "hub label build cancelled"}; }
   bool Stop(std::size_t done) const { return done % 256 == 0 && cancelled_ && cancelled_(); }
 
-  // u -> x costs at most w: a new arc, or a cheaper one in place of the old.
-  void AddOrImprove(VertexId u, VertexId x, double w) {
+  // u -> x costs at most w, starting with graph arc `first`: a new arc, or a cheaper one in
+  // place of the old.
+  void AddOrImprove(VertexId u, VertexId x, double w, std::int32_t first) {
     auto& out = out_[static_cast<std::size_t>(u)];
     auto it = std::find_if(out.begin(), out.end(), [x](const Edge& e) { return e.to == x; });
     if (it != out.end()) {
       if (w >= it->w) return;
-      it->w = w;
+      *it = {x, w, first};
       auto& in = in_[static_cast<std::size_t>(x)];
-      std::find_if(in.begin(), in.end(), [u](const Edge& e) { return e.to == u; })->w = w;
+      *std::find_if(in.begin(), in.end(), [u](const Edge& e) { return e.to == u; }) = {u, w, first};
       return;
     }
-    out.push_back({x, w});
-    in_[static_cast<std::size_t>(x)].push_back({u, w});
+    out.push_back({x, w, first});
+    in_[static_cast<std::size_t>(x)].push_back({u, w, first});
   }
 
   // Dijkstra from `u` over the remaining graph without `skip`, up to cost `limit` or the
@@ -123,8 +133,8 @@ class HubLabelBuilder {
     }
   }
 
-  // The shortcuts contracting v needs now, as (from, to, cost).
-  void Shortcuts(VertexId v, std::vector<std::pair<std::pair<VertexId, VertexId>, double>>& found) {
+  // The shortcuts contracting v needs now (each starts as its arc into v).
+  void Shortcuts(VertexId v, std::vector<Shortcut>& found) {
     found.clear();
     const auto& out = out_[static_cast<std::size_t>(v)];
     for (const Edge& in : in_[static_cast<std::size_t>(v)]) {
@@ -136,7 +146,7 @@ class HubLabelBuilder {
       Witness(in.to, v, limit);
       for (const Edge& o : out) {
         if (o.to == in.to) continue;
-        if (dist_[static_cast<std::size_t>(o.to)] > in.w + o.w) found.push_back({{in.to, o.to}, in.w + o.w});
+        if (dist_[static_cast<std::size_t>(o.to)] > in.w + o.w) found.push_back({in.to, o.to, in.w + o.w, in.first});
       }
     }
   }
@@ -178,7 +188,7 @@ class HubLabelBuilder {
       up_in_[i] = in_[i];
       for (const Edge& e : out_[i]) Detach(in_[static_cast<std::size_t>(e.to)], v);
       for (const Edge& e : in_[i]) Detach(out_[static_cast<std::size_t>(e.to)], v);
-      for (const auto& [ends, w] : added_) AddOrImprove(ends.first, ends.second, w);
+      for (const Shortcut& c : added_) AddOrImprove(c.from, c.to, c.w, c.first);
       std::vector<VertexId>& neighbours = neighbours_;
       neighbours.clear();
       for (const Edge& e : out_[i]) neighbours.push_back(e.to);
@@ -204,16 +214,21 @@ class HubLabelBuilder {
   }
 
   // One label of vertex v (rank r): its upward neighbours' labels plus the arc to each,
-  // merged, then pruned against the opposite labels of its hubs (hub_labels.h).
+  // merged, then pruned against the opposite labels of its hubs (hub_labels.h). Each entry's
+  // first arc: forward, the first arc of v's upward arc it came by; backward, the hub's first
+  // arc towards the neighbour it came from (then on along the arc to v), or that arc's first
+  // when the hub is the neighbour itself.
   void BuildLabel(VertexId v, const std::vector<Edge>& up, bool forward) {
     HubLabels& l = labels_;
     const auto& hub = forward ? l.fwd_hub_ : l.bwd_hub_;
     const auto& dist = forward ? l.fwd_dist_ : l.bwd_dist_;
+    const auto& arc = forward ? l.fwd_arc_ : l.bwd_arc_;
     const auto& begin = forward ? l.fwd_begin_ : l.bwd_begin_;
     const auto& end = forward ? l.fwd_end_ : l.bwd_end_;
     const std::int32_t r = rank_[static_cast<std::size_t>(v)];
     cand_hub_.clear();
     best_[static_cast<std::size_t>(r)] = 0.0;
+    best_arc_[static_cast<std::size_t>(r)] = -1;
     cand_hub_.push_back(r);
     for (const Edge& e : up) {
       const auto x = static_cast<std::size_t>(e.to);
@@ -221,12 +236,19 @@ class HubLabelBuilder {
         const auto h = static_cast<std::size_t>(hub[k]);
         const double d = e.w + dist[k];
         if (best_[h] == kInf) cand_hub_.push_back(hub[k]);
-        best_[h] = std::min(best_[h], d);
+        if (d < best_[h]) {
+          best_[h] = d;
+          best_arc_[h] = forward || arc[k] < 0 ? e.first : arc[k];
+        }
       }
     }
     std::sort(cand_hub_.begin(), cand_hub_.end());
     cand_dist_.clear();
-    for (std::int32_t h : cand_hub_) cand_dist_.push_back(best_[static_cast<std::size_t>(h)]);
+    cand_arc_.clear();
+    for (std::int32_t h : cand_hub_) {
+      cand_dist_.push_back(best_[static_cast<std::size_t>(h)]);
+      cand_arc_.push_back(best_arc_[static_cast<std::size_t>(h)]);
+    }
     for (std::int32_t h : cand_hub_) best_[static_cast<std::size_t>(h)] = kInf;
     // Prune: the true distance between v and hub h is the best route over the candidate's
     // hubs and h's final opposite label (h ranks higher, so its labels are built).
@@ -236,6 +258,7 @@ class HubLabelBuilder {
     const auto& oend = forward ? l.bwd_end_ : l.fwd_end_;
     auto& out_hub = forward ? l.fwd_hub_ : l.bwd_hub_;
     auto& out_dist = forward ? l.fwd_dist_ : l.bwd_dist_;
+    auto& out_arc = forward ? l.fwd_arc_ : l.bwd_arc_;
     const std::uint64_t first = out_hub.size();
     for (std::size_t k = 0; k < cand_hub_.size(); ++k) {
       const std::int32_t h = cand_hub_[k];
@@ -247,6 +270,7 @@ class HubLabelBuilder {
       }
       out_hub.push_back(h);
       out_dist.push_back(cand_dist_[k]);
+      out_arc.push_back(cand_arc_[k]);
     }
     const auto i = static_cast<std::size_t>(v);
     (forward ? l.fwd_begin_ : l.bwd_begin_)[i] = first;
@@ -261,6 +285,7 @@ class HubLabelBuilder {
     l.bwd_begin_.assign(n_, 0);
     l.bwd_end_.assign(n_, 0);
     best_.assign(n_, kInf);
+    best_arc_.assign(n_, -1);
     for (std::size_t k = n_; k-- > 0;) {
       if (Stop(n_ - k)) return false;
       const VertexId v = order_[k];
@@ -283,11 +308,12 @@ class HubLabelBuilder {
   std::vector<int> deleted_, level_, priority_;
   std::vector<double> dist_;                       // witness searches
   std::vector<VertexId> touched_;
-  std::vector<std::pair<std::pair<VertexId, VertexId>, double>> scratch_, added_;  // Priority's, Contract's
-  std::vector<VertexId> neighbours_;                                               // Contract's
+  std::vector<Shortcut> scratch_, added_;           // Priority's, Contract's
+  std::vector<VertexId> neighbours_;               // Contract's
   std::size_t shortcuts_ = 0;
   std::vector<double> best_;                       // labelling, by hub rank
-  std::vector<std::int32_t> cand_hub_;
+  std::vector<std::int32_t> best_arc_;             // labelling, by hub rank: best_'s first arc
+  std::vector<std::int32_t> cand_hub_, cand_arc_;
   std::vector<double> cand_dist_;
   HubLabels labels_;
 };
@@ -313,22 +339,63 @@ double HubLabels::Distance(VertexId from, VertexId to) const {
                   bwd_hub_.data() + bwd_begin_[t], bwd_dist_.data() + bwd_begin_[t], bwd_end_[t] - bwd_begin_[t]);
 }
 
-void HubLabels::Spread(VertexId to, std::vector<double>& by_hub) const {
+HubLabels::FirstHop HubLabels::First(VertexId from, VertexId to) const {
+  const std::size_t n = vertex_count();
+  if (from < 0 || to < 0 || static_cast<std::size_t>(from) >= n || static_cast<std::size_t>(to) >= n) return {};
+  if (from == to) return {0.0, -1};
+  const auto s = static_cast<std::size_t>(from);
   const auto t = static_cast<std::size_t>(to);
-  for (std::uint64_t k = bwd_begin_[t]; k < bwd_end_[t]; ++k) by_hub[static_cast<std::size_t>(bwd_hub_[k])] = bwd_dist_[k];
+  FirstHop best;
+  std::uint64_t i = fwd_begin_[s], j = bwd_begin_[t];
+  while (i < fwd_end_[s] && j < bwd_end_[t]) {
+    if (fwd_hub_[i] < bwd_hub_[j]) {
+      ++i;
+    } else if (bwd_hub_[j] < fwd_hub_[i]) {
+      ++j;
+    } else {
+      const double c = fwd_dist_[i] + bwd_dist_[j];
+      if (c < best.cost) best = {c, fwd_arc_[i] >= 0 ? fwd_arc_[i] : bwd_arc_[j]};
+      ++i;
+      ++j;
+    }
+  }
+  return best;
 }
 
-void HubLabels::Unspread(VertexId to, std::vector<double>& by_hub) const {
+void HubLabels::Spread(VertexId to, HubSpread& by_hub) const {
   const auto t = static_cast<std::size_t>(to);
-  for (std::uint64_t k = bwd_begin_[t]; k < bwd_end_[t]; ++k) by_hub[static_cast<std::size_t>(bwd_hub_[k])] = kInf;
+  for (std::uint64_t k = bwd_begin_[t]; k < bwd_end_[t]; ++k) {
+    const auto h = static_cast<std::size_t>(bwd_hub_[k]);
+    by_hub.dist[h] = bwd_dist_[k];
+    by_hub.arc[h] = bwd_arc_[k];
+  }
 }
 
-double HubLabels::DistanceVia(VertexId from, const std::vector<double>& by_hub) const {
+void HubLabels::Unspread(VertexId to, HubSpread& by_hub) const {
+  const auto t = static_cast<std::size_t>(to);
+  for (std::uint64_t k = bwd_begin_[t]; k < bwd_end_[t]; ++k) by_hub.dist[static_cast<std::size_t>(bwd_hub_[k])] = kInf;
+}
+
+double HubLabels::DistanceVia(VertexId from, const HubSpread& by_hub) const {
   if (from < 0 || static_cast<std::size_t>(from) >= vertex_count()) return kInf;
   const auto s = static_cast<std::size_t>(from);
+  const double* to_go = by_hub.dist.data();
   double best = kInf;
   for (std::uint64_t k = fwd_begin_[s]; k < fwd_end_[s]; ++k) {
-    best = std::min(best, fwd_dist_[k] + by_hub[static_cast<std::size_t>(fwd_hub_[k])]);
+    best = std::min(best, fwd_dist_[k] + to_go[static_cast<std::size_t>(fwd_hub_[k])]);
+  }
+  return best;
+}
+
+HubLabels::FirstHop HubLabels::FirstVia(VertexId from, const HubSpread& by_hub) const {
+  if (from < 0 || static_cast<std::size_t>(from) >= vertex_count()) return {};
+  const auto s = static_cast<std::size_t>(from);
+  const double* to_go = by_hub.dist.data();
+  FirstHop best;
+  for (std::uint64_t k = fwd_begin_[s]; k < fwd_end_[s]; ++k) {
+    const auto h = static_cast<std::size_t>(fwd_hub_[k]);
+    const double c = fwd_dist_[k] + to_go[h];
+    if (c < best.cost) best = {c, fwd_arc_[k] >= 0 ? fwd_arc_[k] : by_hub.arc[h]};
   }
   return best;
 }

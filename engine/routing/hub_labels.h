@@ -13,6 +13,9 @@
 //     the labels already built finds a shorter one); the same backwards.
 // Distance(s, t) is then the minimum over the hubs s's forward and t's backward label share:
 // a merge of two arrays sorted by hub, ~100-300 entries each on the LoRR warehouse floors.
+// Each entry also keeps the first graph arc of its route (forward: from the vertex towards the
+// hub; backward: from the hub towards the vertex), so the first arc of a cheapest route comes
+// with the same merge (First): a route is walked one label scan per arc.
 //
 // Distances are double sums of the graph's arc costs in another order than Dijkstra's: equal
 // up to rounding (relative 1e-12). Immutable once built: safe to query from many threads.
@@ -20,6 +23,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <limits>
 #include <vector>
 
 #include "engine/common/result.h"
@@ -31,6 +35,17 @@ struct HubLabelOptions {
   // A witness search stops after settling this many vertices; the shortcut is then added
   // (never wrong, only one more arc).
   int witness_settle_limit = 500;
+};
+
+// A backward label spread over arrays by hub (HubLabels::Spread): sized vertex_count(), +infinity
+// where the label has no entry.
+struct HubSpread {
+  std::vector<double> dist;
+  std::vector<std::int32_t> arc;  // where dist is finite: the entry's first arc
+  void Reset(std::size_t vertex_count) {
+    dist.assign(vertex_count, std::numeric_limits<double>::infinity());
+    arc.assign(vertex_count, -1);
+  }
 };
 
 struct HubLabelStats {
@@ -56,13 +71,25 @@ class HubLabels {
   double Distance(VertexId from, VertexId to) const;
   const HubLabelStats& stats() const { return stats_; }
 
-  // Many queries towards one vertex: Spread writes `to`'s backward label into `by_hub` (sized
-  // vertex_count(), +infinity everywhere else), after which DistanceVia(from, by_hub) answers
-  // Distance(from, to) by reading from's forward label alone, with no merge; Unspread puts
-  // the infinities back. For a walk along a route or a bid's robots towards one goal.
-  void Spread(VertexId to, std::vector<double>& by_hub) const;
-  void Unspread(VertexId to, std::vector<double>& by_hub) const;
-  double DistanceVia(VertexId from, const std::vector<double>& by_hub) const;
+  // The cost of a cheapest route and the graph arc it starts with (of the cheapest hubs, the
+  // lowest ranked one's): the arc's cost plus the cost from its head is the route's up to
+  // rounding. {0, -1} when from == to; {+infinity, -1} when there is no route or an id is out
+  // of range.
+  struct FirstHop {
+    double cost = std::numeric_limits<double>::infinity();
+    std::int32_t arc = -1;
+  };
+  FirstHop First(VertexId from, VertexId to) const;
+
+  // Many queries towards one vertex: Spread writes `to`'s backward label into `by_hub` (Reset
+  // to vertex_count()), after which DistanceVia(from, by_hub) answers Distance(from, to) and
+  // FirstVia(from, by_hub) First(from, to) by reading from's forward label alone, with no
+  // merge; Unspread puts the infinities back.
+  // For a walk along a route or a bid's robots towards one goal.
+  void Spread(VertexId to, HubSpread& by_hub) const;
+  void Unspread(VertexId to, HubSpread& by_hub) const;
+  double DistanceVia(VertexId from, const HubSpread& by_hub) const;
+  FirstHop FirstVia(VertexId from, const HubSpread& by_hub) const;
 
  private:
   // All labels side by side; vertex v's are [begin[v], end[v]) (stored in the order they were
@@ -70,6 +97,7 @@ class HubLabels {
   std::vector<std::uint64_t> fwd_begin_, fwd_end_, bwd_begin_, bwd_end_;
   std::vector<std::int32_t> fwd_hub_, bwd_hub_;
   std::vector<double> fwd_dist_, bwd_dist_;
+  std::vector<std::int32_t> fwd_arc_, bwd_arc_;  // per entry: its first graph arc (-1: the own entry)
   HubLabelStats stats_;
   friend class HubLabelBuilder;
 };

@@ -74,6 +74,8 @@ Result<TrafficController> TrafficController::Create(std::shared_ptr<const Wareho
   impl->dist.assign(n, kInf);
   impl->via.assign(n, -1);
   impl->seen.assign(n, 0);
+  impl->lower_memo.assign(n, kInf);
+  impl->lower_seen.assign(n, 0);
   impl->point_xy.reserve(n);
   impl->guard_of.reserve(n);
   impl->search_begin.assign(1, 0);
@@ -162,6 +164,7 @@ std::vector<PointId> TrafficController::RemainingRoute(std::size_t r) const {
 }
 void TrafficController::SetRouteBound(std::shared_ptr<const RouteTable> routes) {
   impl_->bound_routes.reset();
+  impl_->lower_to = kNoPoint;  // the memo was the old table's
   if (!routes || routes->point_count() != impl_->M().point_count()) return;
   const RouteTableBuildInfo info = routes->build_info();
   if (info.turn_expanded || !(info.speed > 0.0)) return;

@@ -52,6 +52,22 @@ Detour TrafficController::Impl::Route(PointId from, PointId to, PointId ban_poin
   return a.detour;
 }
 
+double TrafficController::Impl::BoundCost(PointId v, PointId to) {
+  if (to != lower_to) {
+    lower_to = to;
+    if (++lower_stamp == 0) {
+      std::fill(lower_seen.begin(), lower_seen.end(), 0);
+      lower_stamp = 1;
+    }
+  }
+  const auto i = static_cast<std::size_t>(v);
+  if (lower_seen[i] != lower_stamp) {
+    lower_seen[i] = lower_stamp;
+    lower_memo[i] = bound_routes->Cost(v, to);
+  }
+  return lower_memo[i];
+}
+
 // The cost of Search(q)'s route (+infinity when there is none within q.bound), by A* with
 // the route bound's exact unobstructed times as heuristic (consistent: bans only remove
 // arcs), which goes straight for the goal where Search's straight-line heuristic sweeps.
@@ -69,7 +85,7 @@ double TrafficController::Impl::CheapestCost(const traffic_detail::RouteQuery& q
   heap.clear();
   const double* costs = bound_routes->CostsTo(to);  // read in place when the table allows
   const PointId target = to;  // (a structured binding: lambdas may not capture it before C++20 in clang 14)
-  auto lower = [&](PointId v) { return costs ? costs[static_cast<std::size_t>(v)] : bound_routes->Cost(v, target); };
+  auto lower = [&](PointId v) { return costs ? costs[static_cast<std::size_t>(v)] : BoundCost(v, target); };
   // Ties to the entry furthest along (on a grid many routes cost the same: without this the
   // search would sweep all of them).
   auto later = [](const OpenItem& a, const OpenItem& b) { return a.key != b.key ? a.key > b.key : a.h < b.h; };
@@ -132,7 +148,7 @@ Detour TrafficController::Impl::Search(const traffic_detail::RouteQuery& q) {
   const RouteTable* table = bound_routes.get();
   const double* costs = table ? table->CostsTo(to) : nullptr;  // read in place when the table allows
   const PointId target = to;  // (see CheapestCost)
-  auto lower = [&](PointId v) { return costs ? costs[static_cast<std::size_t>(v)] : table->Cost(v, target); };
+  auto lower = [&](PointId v) { return costs ? costs[static_cast<std::size_t>(v)] : BoundCost(v, target); };
   if (++stamp == 0) {
     std::fill(seen.begin(), seen.end(), 0);
     stamp = 1;

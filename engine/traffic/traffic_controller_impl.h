@@ -187,6 +187,13 @@ struct TrafficController::Impl {
   // bounds of ArcTime sums (its speed may exceed config.speed).
   std::shared_ptr<const RouteTable> bound_routes;
   double bound_scale = 1.0;
+  // BoundCost's memo: bound_routes' costs to lower_to, for the points stamped lower_stamp
+  // (a search's heuristic asks each point it relaxes, CheapestCost then Search again).
+  std::vector<double> lower_memo;
+  std::vector<std::uint32_t> lower_seen;
+  std::uint32_t lower_stamp = 0;
+  PointId lower_to = kNoPoint;
+  double BoundCost(PointId v, PointId to);
   // A*'s open list (a binary heap on key, then point; h kept for the staleness test).
   struct OpenItem {
     double key;

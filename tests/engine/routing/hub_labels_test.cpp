@@ -1,5 +1,5 @@
 // Hub labels (issue 19 §1): model tests against Dijkstra on random digraphs (zero-cost,
-// parallel and one-way arcs, unreachable pairs) and obstacle grids; the route table over them
+// parallel and one-way arcs, unreachable pairs) and obstacle grids, distances and first arcs; the route table over them
 // against the reference costs and routes of every other table, turn penalties included, and on
 // a public LoRR floor against the lazy table.
 #include "engine/routing/hub_labels.h"
@@ -23,19 +23,43 @@ using testing::ExpectReferenceAnswers;
 using testing::RandomCostGraph;
 using testing::RandomMap;
 
+// Every pair: Dijkstra's distance; the first arc (First, and FirstVia over the target's
+// spread label, which must agree) leaves the source and starts a cheapest route.
 void ExpectExact(const CostGraph& graph, const HubLabels& labels) {
   const auto n = static_cast<VertexId>(graph.vertex_count());
-  for (VertexId s = 0; s < n; ++s) {
-    const ShortestPathTree tree = Dijkstra(graph, s);
-    for (VertexId t = 0; t < n; ++t) {
-      const double expected = tree.dist[static_cast<std::size_t>(t)];
+  std::vector<std::vector<double>> dist;
+  for (VertexId s = 0; s < n; ++s) dist.push_back(Dijkstra(graph, s).dist);
+  HubSpread spread;
+  spread.Reset(graph.vertex_count());
+  for (VertexId t = 0; t < n; ++t) {
+    labels.Spread(t, spread);
+    for (VertexId s = 0; s < n; ++s) {
+      const double expected = dist[static_cast<std::size_t>(s)][static_cast<std::size_t>(t)];
       const double got = labels.Distance(s, t);
+      const HubLabels::FirstHop first = labels.First(s, t);
+      const HubLabels::FirstHop via = labels.FirstVia(s, spread);
+      ASSERT_EQ(first.cost, got) << s << "->" << t;
+      ASSERT_EQ(via.cost, got) << s << "->" << t;
+      ASSERT_EQ(via.arc, first.arc) << s << "->" << t;
+      ASSERT_EQ(labels.DistanceVia(s, spread), got) << s << "->" << t;
       if (std::isinf(expected)) {
         ASSERT_TRUE(std::isinf(got)) << s << "->" << t << ": " << got;
-      } else {
-        ASSERT_NEAR(got, expected, 1e-9 * std::max(1.0, expected)) << s << "->" << t;
+        ASSERT_EQ(first.arc, -1) << s << "->" << t;
+        continue;
       }
+      const double tolerance = 1e-9 * std::max(1.0, expected);
+      ASSERT_NEAR(got, expected, tolerance) << s << "->" << t;
+      if (s == t) {
+        ASSERT_EQ(first.arc, -1);
+        continue;
+      }
+      ASSERT_GE(first.arc, 0) << s << "->" << t;
+      const CostArc& a = graph.arc(first.arc);
+      ASSERT_EQ(a.from, s) << s << "->" << t;
+      ASSERT_NEAR(a.cost + dist[static_cast<std::size_t>(a.to)][static_cast<std::size_t>(t)], expected, tolerance)
+          << s << "->" << t << " by arc " << first.arc;
     }
+    labels.Unspread(t, spread);
   }
 }
 
@@ -103,6 +127,10 @@ TEST(HubLabelsTest, UnknownVerticesAreUnreachableAndBadOptionsRefused) {
   EXPECT_TRUE(std::isinf(labels.Distance(-1, 0)));
   EXPECT_TRUE(std::isinf(labels.Distance(0, 30)));
   EXPECT_EQ(labels.Distance(5, 5), 0.0);
+  EXPECT_EQ(labels.First(5, 5).cost, 0.0);
+  EXPECT_EQ(labels.First(5, 5).arc, -1);
+  EXPECT_TRUE(std::isinf(labels.First(0, 30).cost));
+  EXPECT_EQ(labels.First(-1, 0).arc, -1);
   EXPECT_EQ(HubLabels::Build(graph, {.witness_settle_limit = 0}).error().code, ErrorCode::kInvalidArgument);
   const HubLabels empty = HubLabels::Build(CostGraph::Build(0, {}).value()).value();
   EXPECT_EQ(empty.vertex_count(), 0u);
