@@ -11,6 +11,7 @@
 #include <sstream>
 
 #include "engine/dispatch/strategy.h"
+#include "engine/routing/route_table.h"
 #include "engine/traffic/traffic_controller.h"
 
 namespace dispatch::server {
@@ -71,6 +72,7 @@ std::vector<Key> Keys() {
        [](const nlohmann::json& j, ServerConfig& c) { c.execution = j.is_null() ? std::string() : j.get<std::string>(); },
        [](const ServerConfig& c) { return c.execution.empty() ? nlohmann::json(nullptr) : nlohmann::json(c.execution); }},
       MakeKey("route_cache_mb", &ServerConfig::route_cache_mb),
+      MakeKey("route_table", &ServerConfig::route_table),
       MakeKey("finished_retained", &ServerConfig::finished_retained),
       MakeKey("journal_runs", &ServerConfig::journal_runs),
       MakeKey("journal_max_mb", &ServerConfig::journal_max_mb),
@@ -184,6 +186,9 @@ engine::Status ValidateServerConfig(const ServerConfig& c) {
     return InvalidArgument("blocked_recovery must be >= 0 seconds (0: a blocked robot stays in fault)");
   }
   if (c.route_cache_mb < 1) return InvalidArgument("route_cache_mb must be >= 1");
+  if (auto method = engine::ParseRouteTableMethod(c.route_table); !method.ok()) {
+    return InvalidArgument("route_table: " + method.error().message);
+  }
   if (c.finished_retained < 0) return InvalidArgument("finished_retained must be >= 0");
   if (c.max_queue < 0) return InvalidArgument("max_queue must be >= 0 (0: no limit)");
   if (c.formation_max_queue < 0) return InvalidArgument("formation_max_queue must be >= 0 (0: no limit)");
@@ -258,6 +263,9 @@ engine::Result<ParsedCommandLine> ParseCommandLine(int argc, char** argv) {
       ->capture_default_str();
   app.add_option("--route-cache-mb", flags.route_cache_mb,
                  "Lazy route table cache bound, MiB (large grid floors)")->capture_default_str();
+  app.add_option("--route-table", flags.route_table,
+                 "floyd | dijkstra | auto | lazy | hub_labels (large floors: no search per destination)")
+      ->capture_default_str();
   app.add_option("--finished-retained", flags.finished_retained,
                  "Finished orders kept in memory (the newest); older ones are read from the database")
       ->capture_default_str();

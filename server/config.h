@@ -76,6 +76,10 @@ struct ServerConfig {
   // all-pairs table does not fit), MiB. It should hold the destinations in use at once (every
   // robot's next stop): on a 38k-cell floor one destination takes 0.46 MB.
   int route_cache_mb = 1024;
+  // The route table (engine RouteTableMethod names): floyd | dijkstra | auto (dense tables; a
+  // floor above their bound gets the lazy table) | lazy | hub_labels (any pair without a
+  // search per destination, memory bounded by its labels: large floors, issue 19).
+  std::string route_table = "floyd";
   // Finished orders (completed, cancelled, failed) kept in memory beyond the open ones: the
   // newest this many; older ones are read from the database when asked for (issue 15 §3b).
   int finished_retained = 1000;

@@ -88,6 +88,7 @@ engine::Result<StartedJournal> StartJournal(const ServerConfig& config, const Di
   setup.allocation = options.allocation;
   setup.core = CoreOptionsOf(options);
   setup.route_cache_bytes = static_cast<std::size_t>(config.route_cache_mb) << 20;
+  setup.route_table = config.route_table;
   setup.time_scale = options.time_scale;
   auto encoded = storage::EncodeRunSetup(setup);
   if (!encoded.ok()) return encoded.error();
@@ -161,6 +162,9 @@ engine::Result<std::unique_ptr<DispatchServer>> DispatchServer::Start(const Serv
   route_options.speed = allocation.speed;
   route_options.turn_penalty_s = allocation.turn_time;
   route_options.lazy_cache_bytes = static_cast<std::size_t>(config.route_cache_mb) << 20;
+  auto method = engine::ParseRouteTableMethod(config.route_table);
+  if (!method.ok()) return method.error();
+  route_options.method = *method;
   auto routes = engine::MakeRouteTable(map, route_options);
   if (!routes.ok()) return routes.error();
   std::shared_ptr<const engine::RouteTable> shared_routes = std::move(routes).value();

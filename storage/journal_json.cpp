@@ -6,6 +6,7 @@
 #include <limits>
 #include <stdexcept>
 
+#include "engine/routing/route_table.h"
 #include "storage/record_json.h"
 
 namespace dispatch::storage {
@@ -159,6 +160,7 @@ Result<std::string> EncodeRunSetup(const RunSetup& s) {
                  {"head_on_give_way", t.head_on_give_way},
                  {"execution", engine::PlanExecutionName(t.execution)}};
     j["route_cache_bytes"] = s.route_cache_bytes;
+    j["route_table"] = s.route_table;
     j["time_scale"] = s.time_scale;
     return j.dump();
   });
@@ -236,6 +238,8 @@ Result<RunSetup> DecodeRunSetup(const std::string& text) {
     }
     if (!known) return Corrupt("run setup", "unknown head-on policy " + head_on);
     s.route_cache_bytes = j.at("route_cache_bytes").get<std::size_t>();
+    s.route_table = j.value("route_table", std::string("floyd"));  // journals before it: floyd
+    if (!engine::ParseRouteTableMethod(s.route_table).ok()) return Corrupt("run setup", "unknown route table " + s.route_table);
     s.time_scale = j.at("time_scale").get<double>();
     return s;
   });

@@ -30,6 +30,9 @@ struct RunSetup {
   engine::AllocationConfig allocation;
   engine::CoreOptions core;
   std::size_t route_cache_bytes = 0;  // the lazy route table's bound (results do not depend on it)
+  // The route table's method (RouteTableMethodNames): tables may break ties between routes of
+  // equal cost differently, so a replay builds the same one. Journals before it: "floyd".
+  std::string route_table = "floyd";
   double time_scale = 1.0;            // dispatcher seconds per wall second
 };
 

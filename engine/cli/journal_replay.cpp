@@ -109,6 +109,9 @@ Result<Loaded> Load(storage::JournalStore& journal, std::int64_t wanted) {
   route_options.speed = setup->allocation.speed;
   route_options.turn_penalty_s = setup->allocation.turn_time;
   route_options.lazy_cache_bytes = setup->route_cache_bytes;
+  auto method = ParseRouteTableMethod(setup->route_table);  // the run's table: its ties
+  if (!method.ok()) return method.error();
+  route_options.method = *method;
   auto routes = MakeRouteTable(out.replay.map, route_options);
   if (!routes.ok()) return routes.error();
   out.replay.routes = std::move(routes).value();

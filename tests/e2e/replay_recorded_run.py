@@ -3,7 +3,8 @@
 serves seed Table 1 and then a random stream of 12 orders, a quarter formations (seeded; pick and
 drop points drawn from the seed tables' coordinates, releases spread over a minute); dispatchd
 stops. Run 2: dispatchd starts again on the same database (it recovers the robots and the
-finished orders) and serves a random stream of 36 single-robot orders within 10 s. `dispatch-sim replay
+finished orders), now routing by hub labels (--route-table hub_labels, recorded in the run's
+setup), and serves a random stream of 36 single-robot orders within 10 s. `dispatch-sim replay
 --db` feeds each run's journal through a fresh dispatch core and must reproduce every award,
 grant, hold and order state (exit 0, "matched"). A what-if of run 2 with 3 robots fewer, on
 the simulator's motion model, completes every order later than the same orders with the whole
@@ -85,8 +86,8 @@ def main():
         serve(h, server, stream)
         fleet.stop()
         check(server.stop() == 0, "dispatchd did not stop cleanly")
-        # Run 2: a restart on the same database, single-robot orders.
-        server = h.start_server(["--time-scale", "10"], db=db)
+        # Run 2: a restart on the same database, single-robot orders, another route table.
+        server = h.start_server(["--time-scale", "10", "--route-table", "hub_labels"], db=db)
         fleet = h.start_fleet(server, 18)
         stream = os.path.join(h.work, "stream-single.csv")
         # Twice as many orders as robots, nearly at once: a fleet 3 robots smaller takes longer.

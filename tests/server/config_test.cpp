@@ -23,7 +23,7 @@ TEST(ServerConfigTest, FlagsSetTheConfig) {
                        "--planner", "time-windows", "--turn-time", "1.5", "--drop-time", "0", "--routing", "heat",
                        "--heat-period", "30", "--priority", "release", "--formation-max-queue", "0",
                        "--one-formation-per-pick", "false", "--head-on-priority", "true", "--head-on-give-way", "true",
-                       "--execution", "order"});
+                       "--execution", "order", "--route-table", "hub_labels"});
   ASSERT_TRUE(parsed.ok()) << parsed.error().message;
   const ServerConfig& c = parsed->config;
   EXPECT_TRUE(c.head_on_priority);
@@ -44,6 +44,7 @@ TEST(ServerConfigTest, FlagsSetTheConfig) {
   EXPECT_DOUBLE_EQ(c.turn_time, 1.5);
   EXPECT_EQ(c.drop_time, 0.0);
   EXPECT_EQ(c.routing, "heat");
+  EXPECT_EQ(c.route_table, "hub_labels");
   EXPECT_DOUBLE_EQ(c.heat_period, 30.0);
   EXPECT_EQ(c.priority, "release");
   EXPECT_EQ(c.formation_max_queue, 0);
@@ -96,6 +97,10 @@ TEST(ServerConfigTest, BadValuesAreNamed) {
   auto routing = Parse({"--routing", "astar"});
   ASSERT_FALSE(routing.ok());
   EXPECT_NE(routing.error().message.find("routing must be floyd or heat, got 'astar'"), std::string::npos);
+  auto table = Parse({"--route-table", "ch"});
+  ASSERT_FALSE(table.ok());
+  EXPECT_NE(table.error().message.find("route_table: unknown route table method 'ch' (known: floyd, dijkstra, auto, lazy, hub_labels)"),
+            std::string::npos) << table.error().message;
   EXPECT_FALSE(Parse({"--heat-period", "0"}).ok());
   EXPECT_FALSE(Parse({"--priority", "fifo"}).ok());
   auto execution = Parse({"--execution", "eager"});

@@ -309,6 +309,7 @@ TEST(JournalStoreTest, ARunSetupRoundTrips) {
   s.core.traffic.execution = engine::PlanExecution::kOrder;
   s.core.traffic_control = false;
   s.route_cache_bytes = 1 << 20;
+  s.route_table = "hub_labels";
   s.time_scale = 10;
   auto text = EncodeRunSetup(s);
   ASSERT_TRUE(text.ok()) << text.error().message;
@@ -332,6 +333,7 @@ TEST(JournalStoreTest, ARunSetupRoundTrips) {
   EXPECT_EQ(back->core.traffic.execution, engine::PlanExecution::kOrder);
   EXPECT_FALSE(back->core.traffic_control);
   EXPECT_EQ(back->route_cache_bytes, std::size_t{1} << 20);
+  EXPECT_EQ(back->route_table, "hub_labels");
   auto map = engine::ParseMapJson(back->map_json);
   ASSERT_TRUE(map.ok()) << map.error().message;
   EXPECT_EQ(engine::WriteMapJson(*map), s.map_json) << "the map reads back as written";
@@ -358,6 +360,10 @@ TEST(JournalStoreTest, ARunSetupRoundTrips) {
   EXPECT_FALSE(DecodeRunSetup(old.dump()).value().core.traffic.head_on_give_way);
   old["core"].erase("execution");  // at the planned departures, as before it
   EXPECT_EQ(DecodeRunSetup(old.dump()).value().core.traffic.execution, engine::PlanExecution::kTimes);
+  old["route_table"] = "astar";
+  EXPECT_FALSE(DecodeRunSetup(old.dump()).ok());
+  old.erase("route_table");  // journals before it: the dense table
+  EXPECT_EQ(DecodeRunSetup(old.dump()).value().route_table, "floyd");
   old["core"]["execution"] = "whenever";
   EXPECT_FALSE(DecodeRunSetup(old.dump()).ok());
   old["core"].erase("execution");
