@@ -31,6 +31,10 @@ LorrCommands AddLorrCommands(CLI::App& app, LorrArgs& run, LorrArgs& check) {
   l->add_option("--route-table", run.route_table,
                 "floyd (dense; lazy above 4,096 cells), dijkstra, auto, lazy or hub_labels (any floor, bounded memory)")
       ->capture_default_str()->check(CLI::IsMember(RouteTableMethodNames()));
+  l->add_flag("--reassign,!--no-reassign", run.reassign,
+              "Each step, tasks not opened yet go back to the pool and their robots bid again (while the pool is "
+              "small enough for one exact assignment)")
+      ->capture_default_str();
   commands.run = l;
   auto* c = app.add_subcommand("lorr-check", "Replay a LoRR output JSON against its problem and check every rule");
   c->add_option("--problem", check.problem, "The problem JSON")->required();
@@ -54,6 +58,7 @@ int RunLorr(const LorrArgs& a) {
   options.seed = a.seed;
   options.route_cache_bytes = a.route_cache_mb << 20;
   options.route_method = ParseRouteTableMethod(a.route_table).value();
+  options.reassign = a.reassign;
   const auto run_begin = std::chrono::steady_clock::now();
   Result<LifelongRecord> record = RunLifelong(*problem, options);
   if (!record) {

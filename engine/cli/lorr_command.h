@@ -27,6 +27,7 @@ struct LorrArgs {
   std::uint64_t seed = 0;
   std::size_t route_cache_mb = 4096;
   std::string route_table = "floyd";  // RouteTableMethodNames()
+  bool reassign = true;                // LifelongOptions::reassign
 };
 
 struct LorrCommands {

@@ -1,5 +1,6 @@
 #include "engine/lifelong/lifelong_run.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <unordered_map>
@@ -93,24 +94,45 @@ class Run {
     }
   }
 
-  // Step 1: the waiting tasks to the free robots, through the product's allocator.
+  // Step 1: the waiting tasks to the free robots, through the product's allocator (with
+  // reassign, also the tasks not opened yet to their robots and the free ones).
   Status Schedule(int step) {
     std::vector<FleetRobot> free;
     std::vector<int> robot_of_entry;
+    std::vector<int> pool = waiting_;
+    std::vector<std::pair<int, int>> held;  // (robot, task): tasks back in the pool
+    bool reassign = options_.reassign;
+    if (reassign) {  // only while one assignment over everything fits LifelongOptions' bound
+      double robots = 0.0, tasks = static_cast<double>(waiting_.size());
+      for (std::size_t r = 0; r < poses_.size(); ++r) {
+        const bool unopened = task_of_[r] != -1 && open_.at(task_of_[r]).done == 0;
+        robots += task_of_[r] == -1 || unopened ? 1.0 : 0.0;
+        tasks += unopened ? 1.0 : 0.0;
+      }
+      reassign = std::min(robots, tasks) * std::min(robots, tasks) * std::max(robots, tasks) <= options_.reassign_max_work;
+    }
     for (std::size_t r = 0; r < poses_.size(); ++r) {
-      if (task_of_[r] != -1) continue;
+      if (task_of_[r] != -1) {
+        OpenTask& open = open_.at(task_of_[r]);
+        if (!reassign || open.done > 0) continue;
+        held.emplace_back(static_cast<int>(r), task_of_[r]);
+        pool.push_back(task_of_[r]);
+        open.robot = -1;
+        task_of_[r] = -1;
+      }
       free.push_back({"r" + std::to_string(r), grid_.PointAt(poses_[r].cell), 0.0, RobotKind::kDifferential});
       robot_of_entry.push_back(static_cast<int>(r));
     }
-    if (free.empty() || waiting_.empty()) return Ok{};
+    std::sort(pool.begin(), pool.end());  // reveal order
+    if (free.empty() || pool.empty()) return Ok{};
     AllocationConfig config;
     config.max_queue = 1;
     Result<FleetState> state = FleetState::Create(grid_.map(), routes_, free, config, zones_);
     if (!state) return state.error();
     zones_ = state->zone_index();
     std::vector<Order> orders;
-    orders.reserve(waiting_.size());
-    for (int id : waiting_) {
+    orders.reserve(pool.size());
+    for (int id : pool) {
       const RevealedTask& task = open_.at(id).task;
       Order order;
       order.id = std::to_string(id);
@@ -131,10 +153,28 @@ class Run {
       const int id = std::stoi(order.id);
       task_of_[static_cast<std::size_t>(robot)] = id;
       open_.at(id).robot = robot;
-      record_.planner_schedule[static_cast<std::size_t>(robot)].emplace_back(step + 1, id);
-      record_.actual_schedule[static_cast<std::size_t>(robot)].emplace_back(step + 1, id);
     });
-    std::erase_if(waiting_, [&](int id) { return open_.at(id).robot != -1; });
+    // A robot that won nothing keeps its task if nobody else won it.
+    for (const auto& [robot, id] : held) {
+      OpenTask& open = open_.at(id);
+      if (task_of_[static_cast<std::size_t>(robot)] == -1 && open.robot == -1) {
+        task_of_[static_cast<std::size_t>(robot)] = id;
+        open.robot = robot;
+      }
+    }
+    // Schedule entries for the robots whose task changed.
+    std::vector<int> before(poses_.size(), -1);
+    for (const auto& [robot, id] : held) before[static_cast<std::size_t>(robot)] = id;
+    for (int robot : robot_of_entry) {
+      const auto r = static_cast<std::size_t>(robot);
+      if (task_of_[r] == before[r]) continue;
+      record_.planner_schedule[r].emplace_back(step + 1, task_of_[r]);
+      record_.actual_schedule[r].emplace_back(step + 1, task_of_[r]);
+    }
+    waiting_.clear();
+    for (int id : pool) {
+      if (open_.at(id).robot == -1) waiting_.push_back(id);
+    }
     return Ok{};
   }
 

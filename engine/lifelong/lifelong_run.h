@@ -52,6 +52,15 @@ struct LifelongOptions {
   // kFloyd: the dense table below RouteTableOptions::lazy_threshold_points, the lazy one above;
   // kHubLabels: hub labels on any floor (memory bounded by the labels, no search per goal).
   RouteTableMethod route_method = RouteTableMethod::kFloyd;
+  // Each step, tasks whose first errand no robot has reached yet go back into the pool with
+  // the waiting ones, and their robots bid again with the free ones (the competition lets a
+  // scheduler move a task until it is opened). A robot that wins nothing keeps its task unless
+  // another robot won it. Only in steps where min(robots, tasks)^2 x max(robots, tasks) of
+  // that pool is at most reassign_max_work (the exact strategy's bound for one Hungarian
+  // assignment, ExactOptions::max_one_to_one_work: the LoRR random floor's 100 robots fit,
+  // the warehouse floors' thousands do not); on larger pools only the free robots bid.
+  bool reassign = true;
+  double reassign_max_work = 2e8;
 };
 
 struct LifelongError {

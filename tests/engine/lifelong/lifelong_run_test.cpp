@@ -4,6 +4,9 @@
 
 #include <nlohmann/json.hpp>
 
+#include <map>
+#include <set>
+
 #include "engine/lifelong/lorr_check.h"
 #include "engine/lifelong/lorr_output.h"
 #include "lorr_files.h"
@@ -101,6 +104,52 @@ TEST(LifelongRunTest, HubLabelsRunTheDenseTablesRun) {
   EXPECT_GT(labels.tasks_finished, 5);
   EXPECT_EQ(labels.tasks_finished, dense.tasks_finished);
   EXPECT_EQ(labels.actual_actions, dense.actual_actions);
+}
+
+// Reassignment (LifelongOptions::reassign): each step the tasks no robot has opened go back to
+// the pool. Some tasks change robots, none after it was opened (the checker replays the output
+// and refuses an opened task taken away); without the option, or with a pool beyond its
+// bound, no task ever changes robots.
+TEST(LifelongRunTest, ReassignMovesOnlyTasksNotOpenedYet) {
+  const LorrProblem problem = Load(LorrExample("random.domain/random_32_32_20_100.json"));
+  LifelongOptions options;
+  options.steps = 100;
+  auto robots_per_task = [](const LifelongRecord& record) {
+    std::map<int, std::set<std::size_t>> robots;
+    for (std::size_t r = 0; r < record.actual_schedule.size(); ++r) {
+      for (const auto& [step, task] : record.actual_schedule[r]) {
+        if (task >= 0) robots[task].insert(r);
+      }
+    }
+    std::size_t moved = 0;
+    for (const auto& [task, holders] : robots) moved += holders.size() > 1 ? 1 : 0;
+    return moved;
+  };
+  options.reassign = false;
+  const LifelongRecord kept = RunLifelong(problem, options).value();
+  EXPECT_EQ(robots_per_task(kept), 0u);
+  options.reassign = true;
+  options.reassign_max_work = 0.5;  // below any pool's work (1 robot, 1 task: 1)
+  EXPECT_TRUE(RunLifelong(problem, options).value().actual_actions == kept.actual_actions);
+  options.reassign_max_work = LifelongOptions{}.reassign_max_work;
+  const LifelongRecord moved = RunLifelong(problem, options).value();
+  EXPECT_GT(robots_per_task(moved), 0u);
+  EXPECT_EQ(moved.planner_errors, 0);
+  const LorrCheckReport report = Check(problem, LorrOutputJson(moved, problem.grid));
+  EXPECT_TRUE(report.ok()) << (report.problems.empty() ? "" : report.problems[0]);
+  EXPECT_EQ(report.tasks_finished, moved.tasks_finished);
+  EXPECT_GT(moved.tasks_finished, 20);
+
+  // A task taken by another robot while its robot keeps it (no change of its own that step).
+  auto good = nlohmann::json::parse(LorrOutputJson(kept, problem.grid));
+  const auto [step, task] = kept.actual_schedule[0].front();
+  ASSERT_GE(task, 0);
+  auto stolen = good;
+  stolen["actualSchedule"][1] = std::to_string(step + 1) + ":" + std::to_string(task) + "," +
+                                stolen["actualSchedule"][1].get<std::string>();
+  const LorrCheckReport refused = Check(problem, stolen.dump());
+  ASSERT_FALSE(refused.ok());
+  EXPECT_NE(refused.problems[0].find("held by robots 0 and 1"), std::string::npos) << refused.problems[0];
 }
 
 // The checker finds what a run that broke the rules would write.
