@@ -35,6 +35,9 @@ LorrCommands AddLorrCommands(CLI::App& app, LorrArgs& run, LorrArgs& check) {
               "Each step, tasks not opened yet go back to the pool and their robots bid again (while the pool is "
               "small enough for one exact assignment)")
       ->capture_default_str();
+  l->add_option("--reassign-max-work", run.reassign_max_work,
+                "Reassign only while min(robots, tasks)^2 x max(robots, tasks) of the pool is at most this")
+      ->capture_default_str()->check(CLI::NonNegativeNumber);
   commands.run = l;
   auto* c = app.add_subcommand("lorr-check", "Replay a LoRR output JSON against its problem and check every rule");
   c->add_option("--problem", check.problem, "The problem JSON")->required();
@@ -59,6 +62,7 @@ int RunLorr(const LorrArgs& a) {
   options.route_cache_bytes = a.route_cache_mb << 20;
   options.route_method = ParseRouteTableMethod(a.route_table).value();
   options.reassign = a.reassign;
+  options.reassign_max_work = a.reassign_max_work;
   const auto run_begin = std::chrono::steady_clock::now();
   Result<LifelongRecord> record = RunLifelong(*problem, options);
   if (!record) {

@@ -3,6 +3,7 @@
 // checker of its output.
 //   dispatch-sim lorr --problem FILE.json --steps N [--output out.json] [--plan-ms 100]
 //       [--strategy exact|auction|greedy|psoga] [--seed S] [--route-cache-mb 4096]
+//       [--route-table floyd|...|hub_labels] [--no-reassign] [--reassign-max-work W]
 //   dispatch-sim lorr-check --problem FILE.json --output out.json
 // `lorr` prints tasks finished, makespan, errors and planning time per step (mean, max) and
 // writes the competition's output JSON; exit 0, or 2 when the run had planner errors.
@@ -28,6 +29,7 @@ struct LorrArgs {
   std::size_t route_cache_mb = 4096;
   std::string route_table = "floyd";  // RouteTableMethodNames()
   bool reassign = true;                // LifelongOptions::reassign
+  double reassign_max_work = 5e7;      // LifelongOptions::reassign_max_work
 };
 
 struct LorrCommands {
