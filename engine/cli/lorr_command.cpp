@@ -33,7 +33,7 @@ LorrCommands AddLorrCommands(CLI::App& app, LorrArgs& run, LorrArgs& check) {
       ->capture_default_str()->check(CLI::IsMember(RouteTableMethodNames()));
   l->add_flag("--reassign,!--no-reassign", run.reassign,
               "Each step, tasks not opened yet go back to the pool and their robots bid again (while the pool is "
-              "small enough for one exact assignment)")
+              "within --reassign-max-work)")
       ->capture_default_str();
   l->add_option("--reassign-max-work", run.reassign_max_work,
                 "Reassign only while min(robots, tasks)^2 x max(robots, tasks) of the pool is at most this")
@@ -80,6 +80,7 @@ int RunLorr(const LorrArgs& a) {
               record->tasks_finished, record->makespan, record->planner_errors, record->schedule_errors,
               record->entry_timeouts);
   std::printf("planning per step: mean %.2f ms, max %.2f ms; load %.2f s, run %.2f s\n", mean_ms, max_ms, load_s, run_s);
+  std::printf("tasks not opened yet reassigned in %d of %d steps\n", record->reassign_steps, record->steps);
   if (!a.output.empty()) {
     std::ofstream out(a.output, std::ios::binary);
     out << LorrOutputJson(*record, problem->grid) << '\n';

@@ -29,7 +29,7 @@ struct LorrArgs {
   std::size_t route_cache_mb = 4096;
   std::string route_table = "floyd";  // RouteTableMethodNames()
   bool reassign = true;                // LifelongOptions::reassign
-  double reassign_max_work = 5e7;      // LifelongOptions::reassign_max_work
+  double reassign_max_work = 2e6;      // LifelongOptions::reassign_max_work
 };
 
 struct LorrCommands {

@@ -102,7 +102,7 @@ class Run {
     std::vector<int> pool = waiting_;
     std::vector<std::pair<int, int>> held;  // (robot, task): tasks back in the pool
     bool reassign = options_.reassign;
-    if (reassign) {  // only while one assignment over everything fits LifelongOptions' bound
+    if (reassign) {  // only while the pool's work is within options_.reassign_max_work
       double robots = 0.0, tasks = static_cast<double>(waiting_.size());
       for (std::size_t r = 0; r < poses_.size(); ++r) {
         const bool unopened = task_of_[r] != -1 && open_.at(task_of_[r]).done == 0;
@@ -110,6 +110,7 @@ class Run {
         tasks += unopened ? 1.0 : 0.0;
       }
       reassign = std::min(robots, tasks) * std::min(robots, tasks) * std::max(robots, tasks) <= options_.reassign_max_work;
+      record_.reassign_steps += reassign ? 1 : 0;
     }
     for (std::size_t r = 0; r < poses_.size(); ++r) {
       if (task_of_[r] != -1) {

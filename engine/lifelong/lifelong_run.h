@@ -57,11 +57,12 @@ struct LifelongOptions {
   // scheduler move a task until it is opened). A robot that wins nothing keeps its task unless
   // another robot won it. Only in steps where min(robots, tasks)^2 x max(robots, tasks) of
   // that pool is at most reassign_max_work; on larger pools only the free robots bid. The LoRR
-  // random floor's pools (100 robots) always fit. On sortation_large_2000 (hub labels) 5e7
-  // kept the mean step at 35 ms (10,711 tasks), while 7e7-2e8 reassigned most steps: 12.3k-12.5k
-  // tasks but 114-124 ms per step, over the competition's 100 ms (README).
+  // random floor's pools (100 robots, 150 tasks: at most 1.5e6) always fit. On
+  // sortation_large_2000 a bound of 5e7 to 2e8 can settle into reassigning most steps: a fifth
+  // more tasks, but 113-124 ms per step, over the competition's 100 ms mean (README); whether
+  // it settles there depends on the first step, so 2e6 keeps the large floors' pools out.
   bool reassign = true;
-  double reassign_max_work = 5e7;
+  double reassign_max_work = 2e6;
 };
 
 struct LifelongError {
@@ -104,6 +105,7 @@ struct LifelongRecord {
   std::vector<LifelongEvent> events;
   std::vector<RevealedTask> tasks;
   std::string routes;  // the route table that ran (RouteTable::method())
+  int reassign_steps = 0;  // steps whose pool took back the tasks not opened yet (reassign)
 };
 
 Result<LifelongRecord> RunLifelong(const LorrProblem& problem, const LifelongOptions& options);
