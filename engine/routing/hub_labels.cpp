@@ -339,29 +339,6 @@ double HubLabels::Distance(VertexId from, VertexId to) const {
                   bwd_hub_.data() + bwd_begin_[t], bwd_dist_.data() + bwd_begin_[t], bwd_end_[t] - bwd_begin_[t]);
 }
 
-HubLabels::FirstHop HubLabels::First(VertexId from, VertexId to) const {
-  const std::size_t n = vertex_count();
-  if (from < 0 || to < 0 || static_cast<std::size_t>(from) >= n || static_cast<std::size_t>(to) >= n) return {};
-  if (from == to) return {0.0, -1};
-  const auto s = static_cast<std::size_t>(from);
-  const auto t = static_cast<std::size_t>(to);
-  FirstHop best;
-  std::uint64_t i = fwd_begin_[s], j = bwd_begin_[t];
-  while (i < fwd_end_[s] && j < bwd_end_[t]) {
-    if (fwd_hub_[i] < bwd_hub_[j]) {
-      ++i;
-    } else if (bwd_hub_[j] < fwd_hub_[i]) {
-      ++j;
-    } else {
-      const double c = fwd_dist_[i] + bwd_dist_[j];
-      if (c < best.cost) best = {c, fwd_arc_[i] >= 0 ? fwd_arc_[i] : bwd_arc_[j]};
-      ++i;
-      ++j;
-    }
-  }
-  return best;
-}
-
 void HubLabels::Spread(VertexId to, HubSpread& by_hub) const {
   const auto t = static_cast<std::size_t>(to);
   for (std::uint64_t k = bwd_begin_[t]; k < bwd_end_[t]; ++k) {

@@ -15,7 +15,7 @@
 // a merge of two arrays sorted by hub, ~100-300 entries each on the LoRR warehouse floors.
 // Each entry also keeps the first graph arc of its route (forward: from the vertex towards the
 // hub; backward: from the hub towards the vertex), so the first arc of a cheapest route comes
-// with the same merge (First): a route is walked one label scan per arc.
+// with the same scan (FirstVia): a route is walked one label scan per arc.
 //
 // Distances are double sums of the graph's arc costs in another order than Dijkstra's: equal
 // up to rounding (relative 1e-12). Immutable once built: safe to query from many threads.
@@ -71,20 +71,18 @@ class HubLabels {
   double Distance(VertexId from, VertexId to) const;
   const HubLabelStats& stats() const { return stats_; }
 
-  // The cost of a cheapest route and the graph arc it starts with (of the cheapest hubs, the
-  // lowest ranked one's): the arc's cost plus the cost from its head is the route's up to
-  // rounding. {0, -1} when from == to; {+infinity, -1} when there is no route or an id is out
-  // of range.
+  // A cheapest route's cost and the graph arc it starts with (of the cheapest hubs, the lowest
+  // ranked one's): the arc's cost plus the cost from its head is the route's up to rounding.
+  // {0, -1} when from == to; {+infinity, -1} when there is no route or an id is out of range.
   struct FirstHop {
     double cost = std::numeric_limits<double>::infinity();
     std::int32_t arc = -1;
   };
-  FirstHop First(VertexId from, VertexId to) const;
 
   // Many queries towards one vertex: Spread writes `to`'s backward label into `by_hub` (Reset
   // to vertex_count()), after which DistanceVia(from, by_hub) answers Distance(from, to) and
-  // FirstVia(from, by_hub) First(from, to) by reading from's forward label alone, with no
-  // merge; Unspread puts the infinities back.
+  // FirstVia(from, by_hub) the FirstHop from -> to by reading from's forward label alone, with
+  // no merge; Unspread puts the infinities back.
   // For a walk along a route or a bid's robots towards one goal.
   void Spread(VertexId to, HubSpread& by_hub) const;
   void Unspread(VertexId to, HubSpread& by_hub) const;
