@@ -11,7 +11,7 @@
 // With turn penalties the labels are built over the arc-expanded graph plus one sink vertex
 // per point, joined from each of its arrival vertices at cost 0, so that Cost(u, v) is one
 // query to v's sink. Answers equal LazyRouteTable's costs up to rounding; among routes of equal
-// cost NextHop takes the first arc towards the cheapest hub of lowest rank (HubLabels::First),
+// cost NextHop takes the first arc towards the cheapest hub of lowest rank (HubLabels::FirstHop),
 // so a walk of NextHops need not follow one Path (each is a cheapest route). Path needs a
 // graph without cycles of arcs that cost nothing (a map's arcs all have a length). Immutable
 // after Build: safe for concurrent const calls.
