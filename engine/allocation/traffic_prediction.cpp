@@ -65,12 +65,37 @@ TrafficPredictor::PlanHandle TrafficPredictor::SetPlan(const std::string& robot,
     RemovePlan(robot);
     return PlanHandle{};
   }
-  const double start = plan.start_time(), end = plan.end_time();
-  if (!std::isfinite(start) || !std::isfinite(end)) {
+  Contribution next = Trace(robot, plan, config_.origin_time);
+  if (!next.zones.empty()) Reserve(next.first_bucket + next.zones.size());
+  return Install(robot, std::move(next));
+}
+
+TrafficPredictor::PlanHandle TrafficPredictor::SetTraced(const std::string& robot, const Contribution& trace,
+                                                         std::size_t offset) {
+  if (robot.empty()) throw std::invalid_argument("TrafficPredictor::SetTraced: empty robot id");
+  if (!trace.zones.empty()) Reserve(trace.first_bucket + offset + trace.zones.size());
+  auto [it, inserted] = robots_.try_emplace(robot);
+  Contribution& c = it->second;
+  if (!inserted) Apply(c, -1);
+  c.first_bucket = trace.first_bucket + offset;
+  c.zones.assign(trace.zones.begin(), trace.zones.end());  // the robot's storage kept
+  c.tail = trace.tail;
+  Apply(c, +1);
+  return HandleOf(c);
+}
+
+TrafficPredictor::Contribution TrafficPredictor::Trace(const std::string& robot, const Plan& plan,
+                                                       double origin, double hold) const {
+  Contribution next;
+  if (plan.waypoints.empty()) return next;
+  // A hold adds buckets at the last waypoint only: the walk below ends there (its last branch).
+  const double start = plan.start_time(), end = plan.end_time() + hold;
+  if (!std::isfinite(start) || !std::isfinite(end) || !std::isfinite(origin)) {
     throw std::invalid_argument("TrafficPredictor::SetPlan: non-finite plan times for " + robot);
   }
-  Contribution next;
-  const double origin = config_.origin_time, dt = config_.bucket_seconds;
+  const double dt = config_.bucket_seconds;
+  // s_b of the grid from `origin`: the same expression as BucketStart.
+  const auto at = [origin, dt](std::size_t b) { return origin + static_cast<double>(b) * dt; };
   if (end >= origin && start <= end) {
     // First bucket: the smallest b >= 0 with s_b >= start; last: the largest with s_b <= end.
     const double q0 = std::max(0.0, std::ceil((start - origin) / dt));
@@ -80,11 +105,11 @@ TrafficPredictor::PlanHandle TrafficPredictor::SetPlan(const std::string& robot,
                                   " ends too far after origin_time");
     }
     std::size_t first = static_cast<std::size_t>(std::min(q0, q1 + 2.0));
-    while (first > 0 && BucketStart(first - 1) >= start) --first;
-    while (BucketStart(first) < start) ++first;
+    while (first > 0 && at(first - 1) >= start) --first;
+    while (at(first) < start) ++first;
     std::size_t last_plus_one = static_cast<std::size_t>(std::max(q1, 0.0));
-    while (last_plus_one > 0 && BucketStart(last_plus_one) > end) --last_plus_one;
-    while (BucketStart(last_plus_one) <= end) ++last_plus_one;  // now one past the last
+    while (last_plus_one > 0 && at(last_plus_one) > end) --last_plus_one;
+    while (at(last_plus_one) <= end) ++last_plus_one;  // now one past the last
     next.first_bucket = first;
     if (last_plus_one > first) {
       next.zones.reserve(last_plus_one - first);
@@ -96,7 +121,7 @@ TrafficPredictor::PlanHandle TrafficPredictor::SetPlan(const std::string& robot,
       Eigen::Vector2d last_xy(std::numeric_limits<double>::quiet_NaN(), 0.0);
       ZoneId last_zone = -1;
       for (std::size_t b = first; b < last_plus_one; ++b) {
-        const double t = BucketStart(b);
+        const double t = at(b);
         Eigen::Vector2d xy;
         if (t <= w.front().eta) {
           xy = w.front().xy;
@@ -126,23 +151,28 @@ TrafficPredictor::PlanHandle TrafficPredictor::SetPlan(const std::string& robot,
       }
       next.tail = next.zones.size();
       while (next.tail > 0 && next.zones[next.tail - 1] == next.zones.back()) --next.tail;
-      if (last_plus_one > bucket_stride_) {
-        // Zone-major rows grow by doubling (amortised O(1) per bucket); the tail stays 0.
-        const std::size_t stride = std::max(last_plus_one, 2 * bucket_stride_);
-        std::vector<std::int32_t> grown(stride * index_->zones().size(), 0);
-        for (std::size_t z = 0; z < index_->zones().size(); ++z) {
-          std::copy_n(counts_.begin() + static_cast<std::ptrdiff_t>(z * bucket_stride_),
-                      bucket_count_, grown.begin() + static_cast<std::ptrdiff_t>(z * stride));
-        }
-        counts_ = std::move(grown);
-        bucket_stride_ = stride;
-      }
-      for (std::size_t b = bucket_count_ + 1; b <= last_plus_one; ++b) {
-        bucket_starts_.push_back(BucketStart(b));
-      }
-      bucket_count_ = std::max(bucket_count_, last_plus_one);
     }
   }
+  return next;
+}
+
+void TrafficPredictor::Reserve(std::size_t end) {
+  if (end > bucket_stride_) {
+    // Zone-major rows grow by doubling (amortised O(1) per bucket); the tail stays 0.
+    const std::size_t stride = std::max(end, 2 * bucket_stride_);
+    std::vector<std::int32_t> grown(stride * index_->zones().size(), 0);
+    for (std::size_t z = 0; z < index_->zones().size(); ++z) {
+      std::copy_n(counts_.begin() + static_cast<std::ptrdiff_t>(z * bucket_stride_),
+                  bucket_count_, grown.begin() + static_cast<std::ptrdiff_t>(z * stride));
+    }
+    counts_ = std::move(grown);
+    bucket_stride_ = stride;
+  }
+  for (std::size_t b = bucket_count_ + 1; b <= end; ++b) bucket_starts_.push_back(BucketStart(b));
+  bucket_count_ = std::max(bucket_count_, end);
+}
+
+TrafficPredictor::PlanHandle TrafficPredictor::Install(const std::string& robot, Contribution next) {
   auto [it, inserted] = robots_.try_emplace(robot);
   if (!inserted) Apply(it->second, -1);
   Apply(next, +1);

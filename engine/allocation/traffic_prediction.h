@@ -62,10 +62,13 @@ struct DensityTerm {
 };
 
 class TrafficPredictor {
- private:
-  struct Contribution;
-
  public:
+  // What one robot's plan adds: zones[k] is its zone (or -1) at bucket first_bucket + k.
+  struct Contribution {
+    std::size_t first_bucket = 0;
+    std::vector<ZoneId> zones;
+    std::size_t tail = 0;  // zones[k] == zones.back() for every k >= tail (a plan's final wait)
+  };
   // Density's computation fed one sample at a time, for callers that already know a sample's
   // zone (the auction reuses the zones of an order's route for every bidder). Holds pointers
   // into the predictor: use it only while the predictor is not modified.
@@ -99,6 +102,16 @@ class TrafficPredictor {
   // bucket. Returns the robot's handle (a default one when `plan` is empty). Throws
   // std::invalid_argument on an empty robot id or non-finite plan times.
   PlanHandle SetPlan(const std::string& robot, const Plan& plan);
+  // What SetPlan would add for `plan` followed by a wait of `hold` seconds (>= 0) at its last
+  // waypoint if origin_time were `origin` (the same bucket_seconds), counting nothing: a plan
+  // traced once and moved by whole buckets afterwards (SetTraced: a queue that stays the same
+  // from one allocation round to the next, only later). Throws as SetPlan.
+  Contribution Trace(const std::string& robot, const Plan& plan, double origin, double hold = 0.0) const;
+  // Replaces robot `robot`'s contribution with `trace` moved `offset` buckets later (bucket
+  // trace.first_bucket + offset + k holds trace.zones[k]): with trace = Trace(plan, origin),
+  // what SetPlan adds for the plan moved offset * bucket_seconds later when origin_time is
+  // `origin`, up to rounding at bucket starts. O(buckets of the old and new contribution).
+  PlanHandle SetTraced(const std::string& robot, const Contribution& trace, std::size_t offset);
   // Removes robot `robot`'s contribution; unknown robots are ignored.
   void RemovePlan(const std::string& robot);
   // The handle of robot `robot`'s current plan (a default one if it has none): one hash
@@ -133,16 +146,13 @@ class TrafficPredictor {
   double zone_cell_size() const { return index_->cell_size(); }
 
  private:
-  // What one robot's plan added: zones_[k] is its zone (or -1) at bucket first_bucket + k.
-  struct Contribution {
-    std::size_t first_bucket = 0;
-    std::vector<ZoneId> zones;
-    std::size_t tail = 0;  // zones[k] == zones.back() for every k >= tail (a plan's final wait)
-  };
-
   double BucketStart(std::size_t b) const {
     return config_.origin_time + static_cast<double>(b) * config_.bucket_seconds;
   }
+  // Grows the counts' storage (and bucket_starts_) to hold buckets [0, end).
+  void Reserve(std::size_t end);
+  // Installs `next` as robot's contribution (storage reserved).
+  PlanHandle Install(const std::string& robot, Contribution next);
   // bucket(t) as above; false for NaN or a bucket >= bucket_count_. Inline: the hot path.
   bool StoredBucketOf(double t, std::size_t* bucket) const {
     // A multiply and a truncation, no libm call.

@@ -192,6 +192,48 @@ TEST_F(TrafficPredictionModelTest, CountsEqualRecountAfterRandomSetReplaceRemove
   }
 }
 
+// A plan traced on a grid of its own (from an origin at or before its start, with a final
+// hold) and set moved by whole buckets counts as the moved plan with the hold appended, set
+// by SetPlan would. Times on a 1/16 s grid: moving them is exact.
+TEST_F(TrafficPredictionModelTest, TracedPlansMovedByWholeBucketsCountAsTheMovedPlans) {
+  TrafficPredictionConfig config;
+  config.bucket_seconds = 0.5;
+  TrafficPredictor pred(*map_, config);
+  std::map<std::string, Plan> model;
+  std::mt19937 rng(41);
+  for (int op = 0; op < 80; ++op) {
+    const std::string robot = "R" + std::to_string(rng() % 6);
+    Plan plan = RandomPlan(rng);
+    double departure = -1e9;
+    for (Waypoint& w : plan.waypoints) {
+      w.eta = std::max(std::round(w.eta * 16.0) / 16.0, departure);
+      w.dwell = std::round(w.dwell * 16.0) / 16.0;
+      departure = w.departure();
+    }
+    const double hold = 2.5 * static_cast<double>(rng() % 3);
+    const std::size_t offset = rng() % 40;
+    // The trace's origin: m buckets before 0, at or before the plan's start.
+    const double m = std::max(0.0, std::ceil(-plan.start_time() / config.bucket_seconds));
+    const double origin = -m * config.bucket_seconds;
+    const TrafficPredictor::Contribution trace = pred.Trace(robot, plan, origin, hold);
+    pred.SetTraced(robot, trace, offset);
+    // Bucket j of the trace (time origin + j dt) is bucket j + offset: the plan moved (offset + m) dt.
+    Plan moved = plan;
+    for (Waypoint& w : moved.waypoints) w.eta += (static_cast<double>(offset) + m) * config.bucket_seconds;
+    if (hold > 0.0) {
+      Waypoint w = moved.waypoints.back();
+      w.eta = w.departure();
+      w.dwell = hold;
+      w.action = WaypointAction::kWait;
+      moved.waypoints.push_back(w);
+    }
+    model[robot] = std::move(moved);
+    ExpectCountsMatch(pred, model, rng);
+    if (HasFailure()) return;
+  }
+  EXPECT_THROW(pred.SetTraced("", TrafficPredictor::Contribution{}, 0), std::invalid_argument);
+}
+
 TEST_F(TrafficPredictionModelTest, PlanCountsAtEveryBucketStartWithinItsSpan) {
   TrafficPredictionConfig config;
   config.bucket_seconds = 1.0;
