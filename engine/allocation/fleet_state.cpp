@@ -102,20 +102,97 @@ void FleetState::AppendSegment(Plan& plan, const std::vector<Waypoint>& segment)
   }
 }
 
-void FleetState::Publish(RobotEntry& e) {
+template <typename Predict>
+void FleetState::WithHold(Plan& plan, Predict predict) const {
   if (config_.hold_seconds <= 0.0) {
-    e.prediction = predictor_->SetPlan(e.info.id, e.plan);
+    predict(plan);
     return;
   }
-  // The plan with the hold appended for the predictor, then as it was (no copy of the plan).
-  Waypoint w = e.plan.waypoints.back();
-  w.seq = static_cast<int>(e.plan.waypoints.size());
+  Waypoint w = plan.waypoints.back();
+  w.seq = static_cast<int>(plan.waypoints.size());
   w.eta = w.departure();
   w.action = WaypointAction::kWait;
   w.dwell = config_.hold_seconds;
-  e.plan.waypoints.push_back(w);
-  e.prediction = predictor_->SetPlan(e.info.id, e.plan);
-  e.plan.waypoints.pop_back();
+  plan.waypoints.push_back(w);
+  predict(plan);
+  plan.waypoints.pop_back();
+}
+
+void FleetState::Publish(RobotEntry& e) {
+  WithHold(e.plan, [&](const Plan& held) { e.prediction = predictor_->SetPlan(e.info.id, held); });
+  ++e.revision;
+}
+
+TrafficPredictor::Contribution FleetState::Trace(std::size_t robot) const {
+  const RobotEntry& e = robots_.at(robot);
+  return predictor_->Trace(e.info.id, e.plan, e.info.ready_time, std::max(0.0, config_.hold_seconds));
+}
+
+FleetState::RobotSnapshot FleetState::Snapshot(std::size_t robot) const {
+  const RobotEntry& e = robots_.at(robot);
+  return RobotSnapshot{e.queue, e.plan, e.summary, e.info.ready_time, Trace(robot)};
+}
+
+Status FleetState::Settle(std::size_t robot, std::size_t bucket, const TrafficPredictor::Contribution* trace) {
+  if (robot >= robots_.size()) return NotFound("fleet state: unknown robot index " + std::to_string(robot));
+  RobotEntry& e = robots_[robot];
+  const TrafficPredictor::Contribution own = trace ? TrafficPredictor::Contribution{} : Trace(robot);
+  const TrafficPredictionConfig& grid = predictor_->config();
+  const double ready = grid.origin_time + static_cast<double>(bucket) * grid.bucket_seconds;
+  Move(e, ready - e.info.ready_time);
+  e.info.ready_time = ready;
+  e.prediction = predictor_->SetTraced(e.info.id, trace ? *trace : own, bucket);
+  ++e.revision;
+  return Ok{};
+}
+
+void FleetState::Move(RobotEntry& e, double shift) {
+  for (QueuedTask& q : e.queue) {
+    q.start_time += shift;
+    q.end_time += shift;
+  }
+  for (Waypoint& w : e.plan.waypoints) w.eta += shift;
+  e.summary.end_time += shift;
+}
+
+Status FleetState::Restore(std::size_t robot, const RobotSnapshot& snapshot, std::size_t bucket) {
+  if (robot >= robots_.size()) return NotFound("fleet state: unknown robot index " + std::to_string(robot));
+  RobotEntry& e = robots_[robot];
+  if (snapshot.plan.robot_id != e.info.id || snapshot.plan.waypoints.empty()) {
+    return InvalidArgument("fleet state: a snapshot of another robot or of no plan for " + e.info.id);
+  }
+  const TrafficPredictionConfig& grid = predictor_->config();
+  e.info.ready_time = grid.origin_time + static_cast<double>(bucket) * grid.bucket_seconds;
+  e.info.start = snapshot.plan.waypoints.front().point;
+  e.queue = snapshot.queue;  // element-wise: the entry's strings and vectors keep their storage
+  e.plan.waypoints = snapshot.plan.waypoints;
+  e.summary = snapshot.summary;
+  Move(e, e.info.ready_time - snapshot.ready_time);
+  e.prediction = predictor_->SetTraced(e.info.id, snapshot.trace, bucket);
+  ++e.revision;
+  return Ok{};
+}
+
+Status FleetState::Reset(std::size_t robot, PointId start, double ready_time) {
+  if (robot >= robots_.size()) return NotFound("fleet state: unknown robot index " + std::to_string(robot));
+  RobotEntry& e = robots_[robot];
+  if (start < 0 || static_cast<std::size_t>(start) >= map_->point_count()) {
+    return NotFound("fleet state: robot '" + e.info.id + "' starts at unknown point id " + std::to_string(start));
+  }
+  if (!std::isfinite(ready_time)) {
+    return InvalidArgument("fleet state: robot '" + e.info.id + "' has a non-finite ready time");
+  }
+  e.info.start = start;
+  e.info.ready_time = ready_time;
+  e.queue.clear();
+  e.summary = QueueSummary{start, ready_time, 0.0, 0.0};
+  Waypoint w;
+  w.point = start;
+  w.xy = map_->point(start).position;
+  w.eta = ready_time;
+  e.plan.waypoints.assign(1, w);
+  ++e.revision;
+  return Ok{};
 }
 
 namespace {
@@ -197,6 +274,7 @@ void FleetState::AppendTask(RobotEntry& e, const std::string& order_id, const Pl
   e.summary.travel_time += travel;
   e.summary.work_time += TaskWorkTime(task);
   e.queue.push_back(std::move(q));
+  ++e.revision;
   if (publish) Publish(e);
 }
 

@@ -9,7 +9,7 @@
 // current plan followed by a wait of AllocationConfig::hold_seconds where it ends (so idle,
 // parked and finished robots still count; an idle robot's plan is its start waypoint).
 //
-// Tasks are only ever appended. A single task's plan segment is BuildPlan from the queue's
+// Tasks are only ever appended (Restore and Reset replace a robot's whole entry). A single task's plan segment is BuildPlan from the queue's
 // end point and end time. A formation task (Chu2024 §3.2) is BuildFormationPlans for its three
 // members, where each member's leg to the first pick starts when that member has finished its
 // own earlier queue, and the formation departs when the last member is in its slot (T_r);
@@ -24,6 +24,7 @@
 
 #include <array>
 #include <cstddef>
+#include <cstdint>
 #include <memory>
 #include <optional>
 #include <string>
@@ -138,6 +139,39 @@ class FleetState {
                        std::vector<Waypoint> segment, bool publish = true);
   // Gives the predictor robot's current plan (after AssignPlanned with publish = false).
   void Publish(std::size_t robot) { Publish(robots_.at(robot)); }
+
+  // One robot's queue, plan and summary as a value, with the ready time they were made from
+  // and the prediction's trace (TrafficPredictor::Trace of the plan and its hold on buckets
+  // from that ready time): for a caller that keeps a fleet from round to round and a robot's
+  // replayed queue while it stays the same (RoundRunner), moved to each round's ready time.
+  struct RobotSnapshot {
+    std::vector<QueuedTask> queue;
+    Plan plan;
+    QueueSummary summary;
+    double ready_time = 0.0;
+    TrafficPredictor::Contribution trace;
+  };
+  RobotSnapshot Snapshot(std::size_t robot) const;
+  // The prediction's trace of robot's plan and hold on buckets from its ready time.
+  TrafficPredictor::Contribution Trace(std::size_t robot) const;
+  // Moves robot's entry to the predictor's bucket start `bucket` (every time + that start -
+  // its ready time) and predicts it from `trace` (its Trace() taken before the move; null:
+  // traced here) moved `bucket` buckets: Restore of its own Snapshot without the copies.
+  // Errors: an unknown index.
+  Status Settle(std::size_t robot, std::size_t bucket, const TrafficPredictor::Contribution* trace = nullptr);
+  // Replaces robot's start, ready time, queue, plan and summary with the snapshot's, moved to
+  // the predictor's bucket start `bucket` (every time + that start - snapshot.ready_time), and
+  // its prediction with the trace moved `bucket` buckets (no Publish needed). Reuses the
+  // entry's buffers. Errors (nothing changed): an unknown index, a snapshot of another robot
+  // or of no plan (kInvalidArgument).
+  Status Restore(std::size_t robot, const RobotSnapshot& snapshot, std::size_t bucket);
+  // Robot back to no queue, standing at `start` from `ready_time`, as Create makes it; its
+  // prediction is unchanged until Publish. Errors: an unknown index or start point, a
+  // non-finite ready time.
+  Status Reset(std::size_t robot, PointId start, double ready_time);
+  // Moves on at every change of robot's entry or its prediction (Assign*, Publish, Restore,
+  // Reset): a caller that keeps a fleet between rounds knows which robots a round changed.
+  std::uint64_t revision(std::size_t robot) const { return robots_.at(robot).revision; }
   // Appends a formation task to the three distinct members' queues (team[0] leads).
   Status AssignFormation(const std::array<std::size_t, 3>& team, const std::string& order_id,
                          const PlanTask& task);
@@ -168,6 +202,7 @@ class FleetState {
     Plan plan;
     QueueSummary summary;
     TrafficPredictor::PlanHandle prediction;  // set by Publish
+    std::uint64_t revision = 0;
   };
   FleetState() = default;
   // Appends `segment` (its waypoint 0 repeats the plan's end and is dropped) to the plan.
@@ -178,6 +213,12 @@ class FleetState {
                   const std::vector<Waypoint>& segment, double travel, bool publish = true);
   // Gives the predictor robot e's plan plus a final wait of config_.hold_seconds.
   void Publish(RobotEntry& e);
+  // Every time of e's queue, plan and summary + shift.
+  static void Move(RobotEntry& e, double shift);
+  // Appends the final wait of config_.hold_seconds to `plan` (none when <= 0), calls
+  // `predict` with it, and takes it off again (no copy of the plan).
+  template <typename Predict>
+  void WithHold(Plan& plan, Predict predict) const;
 
   std::shared_ptr<const WarehouseMap> map_;
   std::shared_ptr<const RouteTable> routes_;

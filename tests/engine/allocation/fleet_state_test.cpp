@@ -265,5 +265,64 @@ TEST_F(FleetStateTest, FailedAssignChangesNothing) {
   }
 }
 
+// A robot's entry as a value (Snapshot) moved to a later bucket in another state (Restore) is
+// the entry moved in place (Settle): the same start, plan, summary, queue times and
+// prediction. Reset makes the robot stand again; every change moves the revision.
+TEST_F(FleetStateTest, SnapshotsMoveByWholeBucketsAsTheEntryDoes) {
+  AllocationConfig c;
+  c.hold_seconds = 30.0;
+  c.traffic.bucket_seconds = 0.5;
+  FleetState made = MakeFleet(map_, routes_, {{"A", Pt(*map_, "0,0"), 0.0}}, c);
+  ASSERT_TRUE(made.AssignSingle(0, "o1", Task("2,0", "0,3")).ok());
+  ASSERT_TRUE(made.AssignSingle(0, "o2", Task("5,0", "5,3", 1.0)).ok());
+  const FleetState::RobotSnapshot snap = made.Snapshot(0);
+  FleetState moved = MakeFleet(map_, routes_, {{"A", Pt(*map_, "5,3"), 9.0}}, c);  // elsewhere, later
+  const std::uint64_t before = made.revision(0), moved_before = moved.revision(0);
+  ASSERT_TRUE(moved.Restore(0, snap, 7).ok());
+  ASSERT_TRUE(made.Settle(0, 7).ok());
+  EXPECT_GT(made.revision(0), before);
+  EXPECT_GT(moved.revision(0), moved_before);
+  EXPECT_EQ(made.robot(0).ready_time, 3.5);
+  EXPECT_EQ(moved.robot(0).ready_time, 3.5);
+  EXPECT_EQ(moved.robot(0).start, Pt(*map_, "0,0"));
+  EXPECT_EQ(made.summary(0).end_time, snap.summary.end_time + 3.5);
+  EXPECT_EQ(moved.summary(0).end_time, made.summary(0).end_time);
+  EXPECT_EQ(moved.summary(0).travel_time, made.summary(0).travel_time);
+  ASSERT_EQ(moved.plan(0).waypoints.size(), made.plan(0).waypoints.size());
+  for (std::size_t k = 0; k < made.plan(0).waypoints.size(); ++k) {
+    EXPECT_EQ(moved.plan(0).waypoints[k].point, made.plan(0).waypoints[k].point);
+    EXPECT_EQ(moved.plan(0).waypoints[k].eta, made.plan(0).waypoints[k].eta);
+  }
+  ASSERT_EQ(moved.queue(0).size(), 2u);
+  EXPECT_EQ(moved.queue(0)[1].start_time, made.queue(0)[1].start_time);
+  EXPECT_EQ(moved.queue(0)[1].start_time, snap.queue[1].start_time + 3.5);
+  // Predicted as the moved plan would be by Publish.
+  FleetState published = MakeFleet(map_, routes_, {{"A", Pt(*map_, "0,0"), 3.5}}, c);
+  ASSERT_TRUE(published.AssignSingle(0, "o1", Task("2,0", "0,3")).ok());
+  ASSERT_TRUE(published.AssignSingle(0, "o2", Task("5,0", "5,3", 1.0)).ok());
+  const std::size_t zones = made.predictor().zone_index()->zones().size();
+  for (double t = 0.0; t <= made.summary(0).end_time + 40.0; t += 0.25) {
+    for (std::size_t z = 0; z < zones; ++z) {
+      const ZoneId zone = static_cast<ZoneId>(z);
+      EXPECT_EQ(moved.predictor().CountAt(zone, t), made.predictor().CountAt(zone, t)) << z << " at " << t;
+      EXPECT_EQ(published.predictor().CountAt(zone, t), made.predictor().CountAt(zone, t)) << z << " at " << t;
+    }
+  }
+  FleetState other = MakeFleet(map_, routes_, {{"B", Pt(*map_, "0,0"), 3.5}}, c);
+  EXPECT_FALSE(other.Restore(0, snap, 7).ok());  // a snapshot of A
+  EXPECT_TRUE(other.queue(0).empty());
+
+  const std::uint64_t settled = made.revision(0);
+  ASSERT_TRUE(made.Reset(0, Pt(*map_, "5,3"), 2.0).ok());
+  EXPECT_GT(made.revision(0), settled);
+  EXPECT_TRUE(made.queue(0).empty());
+  ASSERT_EQ(made.plan(0).waypoints.size(), 1u);
+  EXPECT_EQ(made.plan(0).waypoints[0].point, Pt(*map_, "5,3"));
+  EXPECT_EQ(made.summary(0).end_time, 2.0);
+  EXPECT_EQ(made.summary(0).travel_time, 0.0);
+  EXPECT_FALSE(made.Reset(0, 999, 2.0).ok());
+  EXPECT_FALSE(made.Reset(3, Pt(*map_, "5,3"), 2.0).ok());
+}
+
 }  // namespace
 }  // namespace dispatch::engine
