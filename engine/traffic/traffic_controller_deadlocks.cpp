@@ -283,6 +283,14 @@ int TrafficController::Impl::NextCorridor(std::size_t w) const {
 bool TrafficController::Impl::TryBackOff(std::size_t r, PointId avoid, PointId ban_point, int keep_out) {
   ControlledRobot& x = robots[r];
   const PointId goal = x.pos + 1 < x.route.size() ? x.route.back() : kNoPoint;
+  // A robot with nowhere to go, inside the one-robot corridor the other must enter: a step
+  // within it still holds it, and the next back-off steps back (found on a dense grid: an idle
+  // robot nudged between two points of such a corridor for 120 s, until the robot waiting for
+  // it to clear was blocked). It leaves the corridor, or stays.
+  if (goal == kNoPoint && keep_out >= 0 && lanes.interior_of[static_cast<std::size_t>(x.at)] == keep_out &&
+      cstate[static_cast<std::size_t>(keep_out)].exclusive) {
+    return LeaveCorridor(r, avoid, ban_point, keep_out);
+  }
   for (ArcId a : M().out_arcs(x.at)) {
     const PointId n = M().arc(a).to;
     if (n == avoid || n == ban_point || PointBlocker(n, r) >= 0) continue;
@@ -313,6 +321,45 @@ bool TrafficController::Impl::TryBackOff(std::size_t r, PointId avoid, PointId b
     Replanned(x);
     ClearWait(x);
     return true;
+  }
+  return false;
+}
+
+bool TrafficController::Impl::LeaveCorridor(std::size_t r, PointId avoid, PointId ban_point, int corridor) {
+  ControlledRobot& x = robots[r];
+  if (++stamp == 0) {
+    std::fill(seen.begin(), seen.end(), 0);
+    stamp = 1;
+  }
+  std::vector<PointId> frontier{x.at};
+  seen[static_cast<std::size_t>(x.at)] = stamp;
+  for (std::size_t head = 0; head < frontier.size() && head < 64; ++head) {
+    const PointId u = frontier[head];
+    for (ArcId a : M().out_arcs(u)) {
+      const PointId n = M().arc(a).to;
+      const auto ni = static_cast<std::size_t>(n);
+      if (seen[ni] == stamp || n == avoid || n == ban_point || PointBlocker(n, r) >= 0) continue;
+      // As a back-off: never into an intersection but the one it stands in, nor against a
+      // corridor's traffic.
+      const int g = M().IntersectionOf(n);
+      if (g >= 0 && g != M().IntersectionOf(x.at)) continue;
+      const int c = CorridorOf(a);
+      if (c >= 0 && CorridorBlocker(c, lanes.Direction(M(), a), r) >= 0) continue;
+      seen[ni] = stamp;
+      via[ni] = a;
+      if (lanes.interior_of[ni] == corridor) {
+        frontier.push_back(n);
+        continue;
+      }
+      std::vector<PointId> route;
+      for (PointId w = n; w != x.at; w = M().arc(via[static_cast<std::size_t>(w)]).from) route.push_back(w);
+      route.push_back(x.at);
+      std::reverse(route.begin(), route.end());
+      if (!StartAllowed(r, route) || !Assign(r, std::move(route)).ok()) return false;
+      Replanned(x);
+      ClearWait(x);
+      return true;
+    }
   }
   return false;
 }

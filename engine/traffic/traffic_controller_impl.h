@@ -318,6 +318,10 @@ struct TrafficController::Impl {
   // Steps r back to a free neighbour outside `keep_out` (the corridor a robot waiting for r
   // must enter, -1: none) and re-plans from there.
   bool TryBackOff(std::size_t r, PointId avoid, PointId ban_point, int keep_out = -1);
+  // Routes r (with no route of its own) out of corridor `corridor`, whose interior it stands
+  // in, to the nearest point beyond it, through free points and never through `avoid` or
+  // `ban_point`; false when none is in reach.
+  bool LeaveCorridor(std::size_t r, PointId avoid, PointId ban_point, int corridor);
   // The corridor robot w's next arc runs in (the one it waits to enter, or holds), else -1.
   int NextCorridor(std::size_t w) const;
   bool Siding(PointId p) const;
