@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cctype>
 #include <cmath>
+#include <unordered_map>
 
 namespace dispatch::engine {
 
@@ -57,32 +58,93 @@ std::shared_ptr<const FreeSpaceMotion> RoundRunner::FreeSpace(std::vector<std::s
   return free_space_;
 }
 
+namespace {
+
+// The kept fleet's prediction origin moves in steps of about this many seconds (a whole number
+// of buckets), each step a new fleet: its counts cover no more of the past than that.
+constexpr double kOriginStepSeconds = 600.0;
+
+}  // namespace
+
+FleetState* RoundRunner::Prepare(const RoundInput& input, std::vector<std::string>& notes) {
+  // The prediction's buckets start at the round's step of the origin, not at time 0: the same
+  // bucket times (a whole number of buckets later), without counts for the hours already past.
+  TrafficPredictionConfig grid = config_.traffic;
+  const double step = std::max(1.0, std::ceil(kOriginStepSeconds / grid.bucket_seconds)) * grid.bucket_seconds;
+  if (input.now > grid.origin_time) grid.origin_time += std::floor((input.now - grid.origin_time) / step) * step;
+  bool same = kept_.has_value() && kept_origin_ == grid.origin_time && kept_robots_.size() == input.robots.size();
+  for (std::size_t i = 0; same && i < input.robots.size(); ++i) {
+    same = kept_->robot_id(i) == input.robots[i].id && kept_->robot(i).kind == input.robots[i].kind;
+  }
+  if (!same) {
+    std::vector<FleetRobot> robots;
+    for (const RoundRobot& r : input.robots) robots.push_back({r.id, r.start, input.now, r.kind});
+    AllocationConfig config = config_;
+    config.traffic = grid;
+    kept_.reset();
+    auto fleet = FleetState::Create(map_, routes_, robots, config, zone_index_, /*publish=*/false);
+    if (!fleet.ok()) {
+      notes.push_back("allocation: " + fleet.error().message);
+      return nullptr;
+    }
+    kept_.emplace(std::move(fleet).value());
+    kept_origin_ = grid.origin_time;
+    kept_robots_.assign(input.robots.size(), KeptRobot{});
+    zone_index_ = kept_->zone_index();  // one floor, one index: the next fleet skips the grid
+    if (config_.planner == PlannerKind::kRules) kept_->UseFreeSpace(FreeSpace(notes));
+  }
+  FleetState& fleet = *kept_;
+  if (&fleet.routes() != routes_.get()) (void)fleet.UseRoutes(routes_);  // a round's heat routes
+  // A queue is replayed from the first bucket start at or after now.
+  std::size_t ready_bucket = 0;
+  while (grid.origin_time + static_cast<double>(ready_bucket) * grid.bucket_seconds < input.now) ++ready_bucket;
+  // The predictor sees each robot once: its replayed queue (not once per order, nor its
+  // start first), or its start. An entry the last round left as this one needs stays.
+  std::unordered_map<std::string, std::shared_ptr<const Replay>> replays;  // kept for the next round
+  for (std::size_t i = 0; i < input.robots.size(); ++i) {
+    const RoundRobot& robot = input.robots[i];
+    KeptRobot& kept = kept_robots_[i];
+    const bool untouched = kept.installed && fleet.revision(i) == kept.revision;
+    std::shared_ptr<const Replay> replay;
+    std::size_t rounds = 1;  // the rounds `replay` has served this robot, this one included
+    if (robot.has_queue()) {
+      auto last = replays_.find(robot.id);
+      if (last != replays_.end() && last->second->Matches(robot)) replay = last->second;
+      if (replay && replay == kept.replay) rounds = kept.rounds + 1;
+      if (replay && untouched && replay == kept.replay && kept.bucket == ready_bucket) {
+        // As the last round left it.
+      } else if (replay && replay->snapshot && fleet.Restore(i, *replay->snapshot, ready_bucket).ok()) {
+        // Moved to this round's bucket.
+      } else {
+        // A queue that lasted a few rounds will likely last a few more: worth a snapshot (its
+        // copy), to be moved from bucket to bucket instead of replayed again.
+        replay = ReplayAnew(fleet, i, robot, ready_bucket, kept.installed && kept.rounds >= 2);
+        rounds = 1;
+      }
+      if (replay) {
+        notes.insert(notes.end(), replay->notes.begin(), replay->notes.end());
+        replays.emplace(robot.id, replay);
+      }
+    }
+    if (!replay) {
+      if (Status s = fleet.Reset(i, robot.start, input.now); !s.ok()) {
+        notes.push_back("allocation: " + s.error().message);
+        kept_.reset();
+        return nullptr;
+      }
+      fleet.Publish(i);
+    }
+    kept = KeptRobot{true, std::move(replay), ready_bucket, fleet.revision(i), rounds};
+  }
+  replays_ = std::move(replays);
+  return &fleet;
+}
+
 RoundResult RoundRunner::Run(const RoundInput& input) {
   RoundResult out;
-  std::vector<FleetRobot> fleet_robots;
-  for (const RoundRobot& r : input.robots) fleet_robots.push_back({r.id, r.start, input.now, r.kind});
-  // The prediction's buckets start at the round's bucket, not at time 0: the same bucket
-  // times (a whole number of buckets later), without counts for the hours already past (a
-  // round late in a run allocated and cleared zones x buckets since the start).
-  AllocationConfig config = config_;
-  TrafficPredictionConfig& prediction = config.traffic;
-  if (prediction.bucket_seconds > 0.0 && input.now > prediction.origin_time) {
-    prediction.origin_time += std::floor((input.now - prediction.origin_time) / prediction.bucket_seconds) * prediction.bucket_seconds;
-  }
-  auto fleet = FleetState::Create(map_, routes_, fleet_robots, config, zone_index_, /*publish=*/false);
-  if (!fleet.ok()) {
-    out.notes.push_back("allocation: " + fleet.error().message);
-    return out;
-  }
-  FleetState state = std::move(fleet).value();
-  zone_index_ = state.zone_index();  // one floor, one index: the next round skips the grid
-  if (config_.planner == PlannerKind::kRules) state.UseFreeSpace(FreeSpace(out.notes));
-  // The predictor sees each robot once: its replayed queue (not once per order, nor its
-  // start first), or its start.
-  for (std::size_t i = 0; i < input.robots.size(); ++i) {
-    if (input.robots[i].has_queue()) ReplayQueue(state, i, input.robots[i], out.notes);
-    state.Publish(i);
-  }
+  FleetState* fleet = Prepare(input, out.notes);
+  if (fleet == nullptr) return out;
+  FleetState& state = *fleet;
   if (config_.routing == RoutingKind::kHeat && config_.planner == PlannerKind::kRules && !input.pending.empty()) {
     if (Status s = UseHeatRoutes(map_, config_, state, input.now); !s.ok()) {
       out.notes.push_back("allocation: heat routes not used for the bids: " + s.error().message);
@@ -136,6 +198,30 @@ RoundResult RoundRunner::Run(const RoundInput& input) {
     RouteAwardsByHeat(*map_, config_, state, segments, input.now, out.awards, out.notes);
   }
   return out;
+}
+
+bool RoundRunner::Replay::Matches(const RoundRobot& r) const {
+  return r.assignment == robot.assignment && r.start == robot.start && r.last_reached == robot.last_reached &&
+         r.kind == robot.kind && r.queue == robot.queue;
+}
+
+std::shared_ptr<const RoundRunner::Replay> RoundRunner::ReplayAnew(FleetState& fleet, std::size_t index,
+                                                                   const RoundRobot& r, std::size_t bucket,
+                                                                   bool keep) {
+  auto replay = std::make_shared<Replay>();
+  replay->robot = r;
+  // Replayed from ready time 0, then moved to the round's ready bucket: the same robot and
+  // queue give the very same entry whichever round replays it, and a snapshot of it moves to
+  // a later bucket exactly as a new replay would (a round's result is a function of its input
+  // alone: the journal's replay runs only the rounds it recorded).
+  if (Status s = fleet.Reset(index, r.start, 0.0); !s.ok()) {
+    replay->notes.push_back("allocation: queue of " + r.id + " not replayed: " + s.error().message);
+    return nullptr;
+  }
+  ReplayQueue(fleet, index, r, replay->notes);
+  if (keep) replay->snapshot = std::make_shared<const FleetState::RobotSnapshot>(fleet.Snapshot(index));
+  (void)fleet.Settle(index, bucket, replay->snapshot ? &replay->snapshot->trace : nullptr);  // a valid index
+  return replay;
 }
 
 bool RoundRunner::ReplayQueue(FleetState& fleet, std::size_t index, const RoundRobot& r,

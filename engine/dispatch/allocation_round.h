@@ -9,14 +9,26 @@
 // orders one at a time in their allocation order (AllocationOrderLess). Each award carries
 // the winners' new plan segments, to be spliced into their assignments (AppendOrder).
 //
+// A replayed queue starts at the first start of a prediction bucket at or after now (at most
+// TrafficPredictionConfig::bucket_seconds later): replayed once from time 0, it is then the
+// same queue moved by whole buckets in every round until the robot, its start, its progress or
+// its orders change. The runner keeps the fleet from one round to the next: a robot's entry
+// that the last round did not change (no award) and whose queue and ready bucket are the same
+// stays as it is, instead of being replayed and predicted again (a robot reaches a waypoint
+// every second or so; rounds come every 0.1 s on a busy floor). Every entry is what a fresh
+// fleet would hold, so what a round returns is still a function of its input alone (a test
+// runs rounds on one runner and each on a new one).
+//
 // RoundRunner is not thread-safe: one round at a time (it keeps the predictor's zone index
-// between rounds). Inputs are values; nothing else is read.
+// and the replayed queues between rounds). Inputs are values; nothing else is read.
 #pragma once
 
 #include <cstdint>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <string>
+#include <unordered_map>
 #include <vector>
 
 #include "engine/allocation/allocator.h"
@@ -82,6 +94,34 @@ class RoundRunner {
   // replayed.
   bool ReplayQueue(FleetState& fleet, std::size_t index, const RoundRobot& robot,
                    std::vector<std::string>& notes) const;
+  // A robot's replayed queue (from ready time 0) with the notes its replay gave, and what it
+  // was replayed from.
+  struct Replay {
+    RoundRobot robot;
+    std::shared_ptr<const FleetState::RobotSnapshot> snapshot;  // null: not kept
+    std::vector<std::string> notes;
+    bool Matches(const RoundRobot& r) const;
+  };
+  // Replays robot's queue into its entry `index` of `fleet` from ready time 0 and moves it to
+  // `bucket` (FleetState::Settle); with a snapshot when `keep`. Null (nothing changed) when the
+  // entry cannot be reset to the robot's start.
+  std::shared_ptr<const Replay> ReplayAnew(FleetState& fleet, std::size_t index, const RoundRobot& robot,
+                                           std::size_t bucket, bool keep);
+  // The kept fleet made ready for this round (see above): rebuilt when the robots, their
+  // kinds or the prediction's origin step change; each robot's entry its replayed queue from
+  // the round's ready bucket or its start now, as a fresh fleet would hold them. Null (with a
+  // note) when the fleet cannot be built.
+  FleetState* Prepare(const RoundInput& input, std::vector<std::string>& notes);
+  // What the kept fleet's entry of a robot holds: its replay (null: its start, published at
+  // the round's time) from `bucket`, as of revision `revision`; the rounds in a row it has
+  // held that replay.
+  struct KeptRobot {
+    bool installed = false;
+    std::shared_ptr<const Replay> replay;
+    std::size_t bucket = 0;
+    std::uint64_t revision = 0;
+    std::size_t rounds = 0;
+  };
   // The map's free-space regions for four-wheel-steer robots (engine/motion/free_space_plan.h),
   // built by the first round that needs them; null on a map without any (or when they cannot
   // be built: a note says why, once).
@@ -95,6 +135,10 @@ class RoundRunner {
   std::shared_ptr<const ZoneIndex> zone_index_;  // built by the first round, kept
   std::shared_ptr<const FreeSpaceMotion> free_space_;
   bool free_space_tried_ = false;
+  std::unordered_map<std::string, std::shared_ptr<const Replay>> replays_;  // the last round's, by robot id
+  std::optional<FleetState> kept_;  // the fleet kept from round to round, without its awards
+  double kept_origin_ = 0.0;        // its prediction's origin
+  std::vector<KeptRobot> kept_robots_;
 };
 
 }  // namespace dispatch::engine

@@ -4,7 +4,9 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <map>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -161,6 +163,86 @@ TEST_P(BatchStrategyRound, EachAwardHoldsThePartOfThePlanItAdded) {
 }
 
 INSTANTIATE_TEST_SUITE_P(AllocationRound, BatchStrategyRound, ::testing::Values("psoga", "exact"));
+
+// A round's result in full: awards with every bid and the waypoints' exact times, and notes.
+std::string Dump(const RoundResult& r) {
+  std::ostringstream out;
+  out.precision(17);
+  for (const RoundAward& a : r.awards) {
+    out << a.order_id << " -> " << a.award.reason << "\n";
+    for (const Bid& b : a.award.bids) out << "  " << DescribeBid(b) << "\n";
+    for (std::size_t k = 0; k < a.segments.size(); ++k) {
+      out << "  after " << a.after_departure[k] << ":";
+      for (const Waypoint& w : a.segments[k]) out << " " << w.point << "@" << w.eta << "+" << w.dwell;
+      out << "\n";
+    }
+  }
+  for (const std::string& n : r.notes) out << "note " << n << "\n";
+  return out.str();
+}
+
+// What a round returns is a function of its input alone: rounds on one runner (which keeps its
+// fleet and the robots' replayed queues from round to round) return what a new runner returns
+// for each, whether robots move on, stand, wait into a later prediction bucket, or won awards
+// that were never applied.
+TEST(AllocationRound, AKeptFleetGivesWhatANewRunnerGives) {
+  const auto& map = *Chu2024();
+  const auto parks = PointsOfKind(map, PointKind::kPark);
+  const auto picks = PointsOfKind(map, PointKind::kPick);
+  const auto drops = PointsOfKind(map, PointKind::kDrop);
+  RoundRunner kept = Runner();
+  std::vector<RoundRobot> robots;
+  for (std::size_t i = 0; i < 4; ++i) robots.push_back({"R" + std::to_string(i + 1), parks.at(i * 5), {}, 0, {}, {}});
+  std::map<std::string, Assignment> books;
+  int made = 0;
+  const auto round = [&](double now, int orders, bool apply) {
+    RoundInput input;
+    input.now = now;
+    input.robots = robots;
+    for (int k = 0; k < orders; ++k, ++made) {
+      input.pending.push_back(MakeOrder("o" + std::to_string(made), picks.at(static_cast<std::size_t>(made * 37) % picks.size()),
+                                        drops.at(static_cast<std::size_t>(made * 5) % drops.size()), now));
+    }
+    const RoundResult result = kept.Run(input);
+    RoundRunner fresh = Runner();
+    EXPECT_EQ(Dump(result), Dump(fresh.Run(input))) << "round at " << now;
+    EXPECT_EQ(result.awards.size(), static_cast<std::size_t>(orders)) << "round at " << now;
+    if (!apply) return;
+    for (const RoundAward& a : result.awards) {
+      RoundRobot& r = *std::find_if(robots.begin(), robots.end(), [&](const RoundRobot& x) { return x.id == a.award.winners[0]; });
+      Assignment& book = books[r.id];
+      book.robot_id = r.id;
+      AppendOrder(book, a.order_id, a.segments[0], a.after_departure[0], book.order_ids.empty(), now);
+      r.assignment = std::make_shared<const Assignment>(book);
+      r.queue.push_back(*std::find_if(input.pending.begin(), input.pending.end(),
+                                      [&](const auto& o) { return o->id == a.order_id; }));
+    }
+  };
+  const auto progress = [&](std::size_t nth, std::uint64_t reached) {  // of the robots with a queue
+    std::vector<RoundRobot*> busy;
+    for (RoundRobot& r : robots) {
+      if (r.has_queue()) busy.push_back(&r);
+    }
+    ASSERT_LT(nth, busy.size());
+    RoundRobot& r = *busy[nth];
+    const std::size_t at = FindWaypoint(*r.assignment, reached);
+    ASSERT_LT(at, r.assignment->plan.waypoints.size());
+    r.last_reached = reached;
+    r.start = r.assignment->plan.waypoints[at].point;
+  };
+  round(0.0, 3, true);
+  round(0.1, 1, false);  // awarded, never applied: the winner's kept entry changed
+  round(0.2, 1, true);   // the same robots as before, no progress
+  progress(0, 2);
+  round(0.3, 1, true);
+  round(0.4, 0 + 1, false);
+  round(0.9, 1, true);   // a later bucket: queues move by whole buckets
+  progress(1, 1);
+  progress(0, 3);
+  round(1.0, 2, true);
+  round(1.05, 1, true);
+  round(2.75, 2, true);
+}
 
 TEST(AllocationRound, AQueueThatCannotBeReplayedIsNamed) {
   const auto& map = *Chu2024();
