@@ -9,11 +9,12 @@
 // current plan followed by a wait of AllocationConfig::hold_seconds where it ends (so idle,
 // parked and finished robots still count; an idle robot's plan is its start waypoint).
 //
-// Tasks are only ever appended (Restore and Reset replace a robot's whole entry). A single task's plan segment is BuildPlan from the queue's
-// end point and end time. A formation task (Chu2024 §3.2) is BuildFormationPlans for its three
-// members, where each member's leg to the first pick starts when that member has finished its
-// own earlier queue, and the formation departs when the last member is in its slot (T_r);
-// members wait in their slots until then (that wait is in the plan's times, not in T_d/T_w).
+// Tasks are only ever appended (Restore and Reset replace a robot's whole entry). A single
+// task's plan segment is BuildPlan from the queue's end point and end time. A formation task
+// (Chu2024 §3.2) is BuildFormationPlans for its three members, where each member's leg to the
+// first pick starts when that member has finished its own earlier queue, and the formation
+// departs when the last member is in its slot (T_r); members wait in their slots until then
+// (that wait is in the plan's times, not in T_d/T_w).
 //
 // Invariants: every plan is the concatenation of its queue's segments, so a robot never has
 // two overlapping pieces of work (etas non-decreasing along the plan); summaries and the

@@ -214,10 +214,7 @@ std::shared_ptr<const RoundRunner::Replay> RoundRunner::ReplayAnew(FleetState& f
   // queue give the very same entry whichever round replays it, and a snapshot of it moves to
   // a later bucket exactly as a new replay would (a round's result is a function of its input
   // alone: the journal's replay runs only the rounds it recorded).
-  if (Status s = fleet.Reset(index, r.start, 0.0); !s.ok()) {
-    replay->notes.push_back("allocation: queue of " + r.id + " not replayed: " + s.error().message);
-    return nullptr;
-  }
+  if (!fleet.Reset(index, r.start, 0.0).ok()) return nullptr;  // the caller's Reset says why
   ReplayQueue(fleet, index, r, replay->notes);
   if (keep) replay->snapshot = std::make_shared<const FleetState::RobotSnapshot>(fleet.Snapshot(index));
   (void)fleet.Settle(index, bucket, replay->snapshot ? &replay->snapshot->trace : nullptr);  // a valid index

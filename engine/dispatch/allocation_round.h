@@ -17,7 +17,10 @@
 // stays as it is, instead of being replayed and predicted again (a robot reaches a waypoint
 // every second or so; rounds come every 0.1 s on a busy floor). Every entry is what a fresh
 // fleet would hold, so what a round returns is still a function of its input alone (a test
-// runs rounds on one runner and each on a new one).
+// runs rounds on one runner and each on a new one). The prediction's buckets start at the
+// round's ten-minute step (a whole number of buckets after TrafficPredictionConfig::
+// origin_time): a new step builds a new fleet, so the kept counts hold at most ten minutes of
+// the past.
 //
 // RoundRunner is not thread-safe: one round at a time (it keeps the predictor's zone index
 // and the replayed queues between rounds). Inputs are values; nothing else is read.
