@@ -6,9 +6,10 @@
 #     of this run's time): every GoogleTest test but six long simulations (below) and the
 #     fuzz corpus replays (every input ever kept or found by deploy/fuzz.sh), any report
 #     fatal;
-#  2. TSan (build-tsan/): the dispatch core's tests (tests/engine/dispatch) and the service's
-#     tests that do not serve gRPC (the dispatcher loop and its parts, its worker threads, the
-#     order replies, the robot protocol, tokens, config), run directly, no suppressions.
+#  2. TSan (build-tsan/; the test programs' own files at -O0): the dispatch core's tests
+#     (tests/engine/dispatch) and the service's tests that do not serve gRPC (the dispatcher
+#     loop and its parts, its worker threads, the order replies, the robot protocol, tokens,
+#     config), run directly, no suppressions.
 #     The tests that serve gRPC are not run under TSan: Debian's gRPC, abseil and protobuf are
 #     not built with it, their own synchronisation is invisible to it, and it reports
 #     thousands of races inside them (measured 2026-12-05: 7,500 reports over the seven
@@ -58,7 +59,8 @@ for run in "${runs[@]}"; do
       ctest --test-dir build-asan --output-on-failure -j "$jobs" -LE e2e -E "$long"
       ;;
     tsan)
-      cmake -S . -B build-tsan $(generator build-tsan) "${flags[@]}" -DDISPATCH_SANITIZE=thread >/dev/null
+      cmake -S . -B build-tsan $(generator build-tsan) "${flags[@]}" -DDISPATCH_SANITIZE=thread \
+        -DDISPATCH_TEST_CXX_FLAGS=-O0 >/dev/null
       mapfile -t targets < <(sed -nE 's/^dispatch_add_test\(([a-z_]+) .*/\1/p' tests/engine/dispatch/CMakeLists.txt)
       targets+=(server_dispatcher_parts_test server_worker_thread_test server_order_replies_test
                 server_robot_protocol_test server_auth_test server_config_test server_explanation_test)
