@@ -7,10 +7,9 @@
 #include "storage/journal_json.h"
 
 namespace dispatch::storage {
-namespace {
 
 // A prepared statement, finalized when it goes out of scope.
-class Stmt {
+class JournalStore::Stmt {
  public:
   Stmt(sqlite3* db, const char* sql) { rc_ = sqlite3_prepare_v2(db, sql, -1, &stmt_, nullptr); }
   ~Stmt() { sqlite3_finalize(stmt_); }
@@ -33,7 +32,7 @@ class Stmt {
   int rc_ = SQLITE_OK;
 };
 
-}  // namespace
+JournalStore::JournalStore(sqlite3* db) : db_(db) {}
 
 Result<std::unique_ptr<JournalStore>> JournalStore::Open(const std::string& path, bool read_only) {
   sqlite3* db = nullptr;
@@ -51,24 +50,70 @@ Result<std::unique_ptr<JournalStore>> JournalStore::Open(const std::string& path
     if (Status s = store->Exec("SELECT 1 FROM core_runs LIMIT 1"); !s.ok()) {
       return engine::IoError("'" + path + "' has no dispatch journal (core_runs): " + s.error().message);
     }
+    store->setups_apart_ = store->HasTable("core_run_setups");
     return store;
   }
-  const char* schema =
-      "PRAGMA journal_mode = WAL;"
-      "PRAGMA synchronous = NORMAL;"
-      "PRAGMA cache_size = -256;"  // 256 KiB: the journal is written, hardly read back
-      "CREATE TABLE IF NOT EXISTS core_runs ("
-      "  run INTEGER PRIMARY KEY AUTOINCREMENT, started_time REAL NOT NULL, setup TEXT NOT NULL,"
-      "  entries INTEGER NOT NULL DEFAULT 0, bytes INTEGER NOT NULL DEFAULT 0,"
-      "  truncated INTEGER NOT NULL DEFAULT 0);"
-      "CREATE TABLE IF NOT EXISTS core_journal ("
-      "  run INTEGER NOT NULL, seq INTEGER NOT NULL, time REAL NOT NULL, kind TEXT NOT NULL,"
-      "  input TEXT NOT NULL, output TEXT NOT NULL, PRIMARY KEY (run, seq)) WITHOUT ROWID;";
-  if (Status s = store->Exec(schema); !s.ok()) return engine::IoError("cannot open journal '" + path + "': " + s.error().message);
+  if (Status s = store->Exec("PRAGMA journal_mode = WAL;"
+                              "PRAGMA synchronous = NORMAL;"
+                              "PRAGMA cache_size = -256;");  // 256 KiB: the journal is written, hardly read back
+      !s.ok()) {
+    return engine::IoError("cannot open journal '" + path + "': " + s.error().message);
+  }
+  if (Status s = store->Upgrade(); !s.ok()) return engine::IoError("cannot open journal '" + path + "': " + s.error().message);
   return store;
 }
 
-JournalStore::~JournalStore() { sqlite3_close(db_); }
+JournalStore::~JournalStore() {
+  append_.reset();  // its statements are finalized before the connection closes
+  sqlite3_close(db_);
+}
+
+bool JournalStore::HasTable(const char* name) {
+  Stmt q(db_, "SELECT 1 FROM sqlite_master WHERE type = 'table' AND name = ?");
+  q.Text(1, name);
+  return q.ok() && sqlite3_step(q.get()) == SQLITE_ROW;
+}
+
+// The layout (see the header): a run's setup (megabytes: the map) apart from its counters,
+// which every Append updates (SQLite rewrites a whole row on update: with the setup in it, each
+// Append read and wrote the map again), and the entries in a rowid table (a WITHOUT ROWID table
+// keeps whole rows in its b-tree's keys, and an entry can be kilobytes). A journal written
+// before that (setup in core_runs, core_journal WITHOUT ROWID) is moved over once.
+Status JournalStore::Upgrade() {
+  const std::string journal_table =
+      " (run INTEGER NOT NULL, seq INTEGER NOT NULL, time REAL NOT NULL, kind TEXT NOT NULL,"
+      "  input TEXT NOT NULL, output TEXT NOT NULL, PRIMARY KEY (run, seq));";
+  const std::string setups_table = "CREATE TABLE core_run_setups (run INTEGER PRIMARY KEY, setup TEXT NOT NULL);";
+  // Looked at and changed in one transaction: another process opening the file meanwhile
+  // waits, then finds the tables made.
+  if (Status s = Exec("BEGIN IMMEDIATE"); !s.ok()) return s;
+  std::string sql;
+  if (!HasTable("core_runs")) {
+    sql = "CREATE TABLE core_runs ("
+          "  run INTEGER PRIMARY KEY AUTOINCREMENT, started_time REAL NOT NULL,"
+          "  entries INTEGER NOT NULL DEFAULT 0, bytes INTEGER NOT NULL DEFAULT 0,"
+          "  truncated INTEGER NOT NULL DEFAULT 0);" +
+          setups_table + "CREATE TABLE core_journal" + journal_table;
+  } else if (!HasTable("core_run_setups")) {
+    sql = setups_table +
+          "INSERT INTO core_run_setups (run, setup) SELECT run, setup FROM core_runs;"
+          "ALTER TABLE core_runs DROP COLUMN setup;"
+          "CREATE TABLE core_journal_new" + journal_table +
+          "INSERT INTO core_journal_new SELECT run, seq, time, kind, input, output FROM core_journal;"
+          "DROP TABLE core_journal;"
+          "ALTER TABLE core_journal_new RENAME TO core_journal;";
+  }
+  if (Status s = Exec(sql.c_str()); !s.ok()) {
+    Rollback();
+    return engine::IoError("making the journal's tables: " + s.error().message);
+  }
+  if (Status s = Exec("COMMIT"); !s.ok()) {
+    Rollback();
+    return s;
+  }
+  setups_apart_ = true;
+  return engine::Ok{};
+}
 
 Status JournalStore::Exec(const char* sql) {
   char* message = nullptr;
@@ -92,19 +137,24 @@ Result<std::int64_t> JournalStore::StartRun(double started_time, const std::stri
     Rollback();
     return e;
   };
-  Stmt insert(db_, "INSERT INTO core_runs (started_time, setup) VALUES (?, ?)");
+  Stmt insert(db_, "INSERT INTO core_runs (started_time) VALUES (?)");
   if (!insert.ok()) return fail("prepare run");
   insert.Real(1, started_time);
-  insert.Text(2, setup);
   if (sqlite3_step(insert.get()) != SQLITE_DONE) return fail("insert run");
   const std::int64_t run = sqlite3_last_insert_rowid(db_);
+  Stmt insert_setup(db_, "INSERT INTO core_run_setups (run, setup) VALUES (?, ?)");
+  if (!insert_setup.ok()) return fail("prepare run setup");
+  insert_setup.Int(1, run);
+  insert_setup.Text(2, setup);
+  if (sqlite3_step(insert_setup.get()) != SQLITE_DONE) return fail("insert run setup");
   // The newest keep_runs runs stay (this one included).
   Stmt cutoff(db_, "SELECT run FROM core_runs ORDER BY run DESC LIMIT 1 OFFSET ?");
   if (!cutoff.ok()) return fail("prepare retention");
   cutoff.Int(1, keep_runs - 1);
   if (sqlite3_step(cutoff.get()) == SQLITE_ROW) {
     const std::int64_t oldest_kept = sqlite3_column_int64(cutoff.get(), 0);
-    for (const char* sql : {"DELETE FROM core_journal WHERE run < ?", "DELETE FROM core_runs WHERE run < ?"}) {
+    for (const char* sql : {"DELETE FROM core_journal WHERE run < ?", "DELETE FROM core_run_setups WHERE run < ?",
+                            "DELETE FROM core_runs WHERE run < ?"}) {
       Stmt del(db_, sql);
       if (!del.ok()) return fail("prepare delete");
       del.Int(1, oldest_kept);
@@ -115,53 +165,73 @@ Result<std::int64_t> JournalStore::StartRun(double started_time, const std::stri
   return run;
 }
 
+// Append's statements, prepared once: a batch is a few entries, and parsing its SQL again each
+// time cost as much as writing them.
+struct JournalStore::AppendStatements {
+  explicit AppendStatements(sqlite3* db)
+      : begin(db, "BEGIN IMMEDIATE"),
+        insert(db, "INSERT INTO core_journal (run, seq, time, kind, input, output) VALUES (?, ?, ?, ?, ?, ?)"),
+        update(db, "UPDATE core_runs SET entries = entries + ?, bytes = bytes + ?, truncated = MAX(truncated, ?) "
+                   "WHERE run = ?"),
+        commit(db, "COMMIT") {}
+  bool ok() const { return begin.ok() && insert.ok() && update.ok() && commit.ok(); }
+  Stmt begin, insert, update, commit;
+};
+
 Result<std::uint64_t> JournalStore::Append(std::int64_t run, const std::vector<engine::JournalEntry>& entries, bool truncated) {
   if (entries.empty() && !truncated) return std::uint64_t{0};
-  if (Status s = Exec("BEGIN IMMEDIATE"); !s.ok()) return s.error();
+  if (!append_) {
+    auto prepared = std::make_unique<AppendStatements>(db_);
+    if (!prepared->ok()) return Failed("prepare append");
+    append_ = std::move(prepared);
+  }
+  AppendStatements& st = *append_;
+  // Each statement is reset after its step, so none holds the database when this returns.
+  auto step = [](Stmt& stmt) {
+    const int rc = sqlite3_step(stmt.get());
+    sqlite3_reset(stmt.get());
+    return rc;
+  };
+  if (step(st.begin) != SQLITE_DONE) return Failed("begin");
   auto fail = [this](const std::string& what) {
     engine::Error e = Failed(what);
     Rollback();
     return e;
   };
   std::uint64_t bytes = 0;
-  {
-    Stmt insert(db_, "INSERT INTO core_journal (run, seq, time, kind, input, output) VALUES (?, ?, ?, ?, ?, ?)");
-    if (!insert.ok()) return fail("prepare append");
-    for (const engine::JournalEntry& e : entries) {
-      auto input = EncodeCoreInput(e.input);
-      if (!input.ok()) {
-        Rollback();
-        return input.error();
-      }
-      insert.Int(1, run);
-      insert.Int(2, static_cast<std::int64_t>(e.seq));
-      insert.Real(3, e.input.time);
-      insert.Text(4, engine::CoreInputKindName(e.input.kind));
-      insert.Text(5, *input);
-      insert.Text(6, e.output);
-      if (sqlite3_step(insert.get()) != SQLITE_DONE) return fail("append entry " + std::to_string(e.seq));
-      sqlite3_reset(insert.get());
-      bytes += input->size() + e.output.size();
+  for (const engine::JournalEntry& e : entries) {
+    auto input = EncodeCoreInput(e.input);
+    if (!input.ok()) {
+      Rollback();
+      return input.error();
     }
+    st.insert.Int(1, run);
+    st.insert.Int(2, static_cast<std::int64_t>(e.seq));
+    st.insert.Real(3, e.input.time);
+    st.insert.Text(4, engine::CoreInputKindName(e.input.kind));
+    st.insert.Text(5, *input);
+    st.insert.Text(6, e.output);
+    if (step(st.insert) != SQLITE_DONE) return fail("append entry " + std::to_string(e.seq));
+    bytes += input->size() + e.output.size();
   }
-  Stmt update(db_, "UPDATE core_runs SET entries = entries + ?, bytes = bytes + ?, truncated = MAX(truncated, ?) "
-                   "WHERE run = ?");
-  if (!update.ok()) return fail("prepare run update");
-  update.Int(1, static_cast<std::int64_t>(entries.size()));
-  update.Int(2, static_cast<std::int64_t>(bytes));
-  update.Int(3, truncated ? 1 : 0);
-  update.Int(4, run);
-  if (sqlite3_step(update.get()) != SQLITE_DONE) return fail("update run");
+  st.update.Int(1, static_cast<std::int64_t>(entries.size()));
+  st.update.Int(2, static_cast<std::int64_t>(bytes));
+  st.update.Int(3, truncated ? 1 : 0);
+  st.update.Int(4, run);
+  if (step(st.update) != SQLITE_DONE) return fail("update run");
   if (sqlite3_changes(db_) != 1) {
     Rollback();
     return engine::NotFound("journal: no run " + std::to_string(run));
   }
-  if (Status s = Exec("COMMIT"); !s.ok()) return fail("commit");
+  if (step(st.commit) != SQLITE_DONE) return fail("commit");
   return bytes;
 }
 
 Result<std::vector<JournalRun>> JournalStore::Runs() {
-  Stmt q(db_, "SELECT run, started_time, setup, entries, bytes, truncated FROM core_runs ORDER BY run");
+  // A journal opened read-only may still have the older layout (the setup in core_runs).
+  Stmt q(db_, setups_apart_ ? "SELECT r.run, r.started_time, s.setup, r.entries, r.bytes, r.truncated "
+                              "FROM core_runs r LEFT JOIN core_run_setups s ON s.run = r.run ORDER BY r.run"
+                            : "SELECT run, started_time, setup, entries, bytes, truncated FROM core_runs ORDER BY run");
   if (!q.ok()) return Failed("list runs");
   std::vector<JournalRun> out;
   int rc;

@@ -2,11 +2,14 @@
 // connection of its own so that journal writes never wait behind, or roll back with, the
 // store's transactions.
 //
-// Tables (created here if missing): core_runs (one row per dispatchd start: its setup, entry
-// and byte counts, whether recording stopped at the size limit) and core_journal (run, seq,
-// time, kind, input, output). Retention: StartRun keeps the newest `keep_runs` runs, the new
-// one included, and deletes the others; within a run nothing is deleted (a replay starts at the
-// run's first entry).
+// Tables (created here if missing): core_runs (one row per dispatchd start: its entry and byte
+// counts, whether recording stopped at the size limit), core_run_setups (run, setup: written
+// once) and core_journal (run, seq, time, kind, input, output). A journal of the older layout
+// (the setup in core_runs, core_journal WITHOUT ROWID) is moved to this one when opened for
+// writing, and read as it is when opened read-only.
+//
+// Retention: StartRun keeps the newest `keep_runs` runs, the new one included, and deletes the
+// others; within a run nothing is deleted (a replay starts at the run's first entry).
 //
 // Errors: kIoError (the database failed; an Append writes all its entries or none),
 // kNotFound (unknown run). Not thread-safe: one user at a time (the service's journal worker,
@@ -56,12 +59,18 @@ class JournalStore {
   Result<std::vector<engine::JournalEntry>> Read(std::int64_t run, std::uint64_t after, int limit);
 
  private:
-  explicit JournalStore(sqlite3* db) : db_(db) {}
+  explicit JournalStore(sqlite3* db);
+  class Stmt;
   Status Exec(const char* sql);
+  bool HasTable(const char* name);
+  Status Upgrade();  // creates the tables, or moves an older layout over (see above)
   void Rollback() { static_cast<void>(Exec("ROLLBACK")); }  // after a failure: nothing else to do
   engine::Error Failed(const std::string& what) const;
 
   sqlite3* db_;
+  struct AppendStatements;
+  std::unique_ptr<AppendStatements> append_;  // prepared by the first Append
+  bool setups_apart_ = true;  // false: a read-only journal of the older layout
 };
 
 }  // namespace dispatch::storage

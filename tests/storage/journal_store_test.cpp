@@ -5,8 +5,10 @@
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
+#include <sqlite3.h>
 
 #include <cmath>
+#include <cstdio>
 #include <limits>
 #include <string>
 #include <vector>
@@ -251,6 +253,103 @@ TEST(JournalStoreTest, StartRunKeepsTheNewestRuns) {
   ASSERT_TRUE(gone.ok());
   EXPECT_TRUE(gone->empty()) << "a deleted run's entries go with it";
   EXPECT_FALSE((*store)->StartRun(9, "{}", 0).ok());
+}
+
+// SQL on the file itself; the rows of the first column of a query.
+std::vector<std::string> Sql(const std::string& path, const std::string& sql) {
+  sqlite3* db = nullptr;
+  std::vector<std::string> rows;
+  EXPECT_EQ(sqlite3_open(path.c_str(), &db), SQLITE_OK);
+  auto row = [](void* out, int, char** values, char**) {
+    static_cast<std::vector<std::string>*>(out)->push_back(values[0] ? values[0] : "");
+    return 0;
+  };
+  char* message = nullptr;
+  EXPECT_EQ(sqlite3_exec(db, sql.c_str(), row, &rows, &message), SQLITE_OK) << (message ? message : "");
+  sqlite3_free(message);
+  sqlite3_close(db);
+  return rows;
+}
+
+// A journal written before the setups moved out of core_runs (whose counters every Append
+// updates) and core_journal became a rowid table: read-only it reads as it is; opened for
+// writing it is moved to the current layout with every run, setup and entry, and goes on.
+TEST(JournalStoreTest, AnOlderLayoutIsReadAsItIsAndMovedOverWhenWritten) {
+  TempDir dir;
+  const std::string path = (dir.path() / "old.db").string();
+  std::string sql =
+      "CREATE TABLE core_runs (run INTEGER PRIMARY KEY AUTOINCREMENT, started_time REAL NOT NULL, setup TEXT NOT NULL,"
+      "  entries INTEGER NOT NULL DEFAULT 0, bytes INTEGER NOT NULL DEFAULT 0, truncated INTEGER NOT NULL DEFAULT 0);"
+      "CREATE TABLE core_journal (run INTEGER NOT NULL, seq INTEGER NOT NULL, time REAL NOT NULL, kind TEXT NOT NULL,"
+      "  input TEXT NOT NULL, output TEXT NOT NULL, PRIMARY KEY (run, seq)) WITHOUT ROWID;"
+      "INSERT INTO core_runs VALUES (4, 10.5, '{\"setup\": 4}', 3, 120, 1);";
+  const std::vector<JournalEntry> entries = SampleEntries();
+  for (std::size_t i = 0; i < 3; ++i) {
+    auto input = EncodeCoreInput(entries[i].input);
+    ASSERT_TRUE(input.ok());
+    std::string quoted;
+    for (char c : *input) quoted += c == '\'' ? std::string("''") : std::string(1, c);
+    char time[32];
+    std::snprintf(time, sizeof time, "%.17g", entries[i].input.time);
+    sql += "INSERT INTO core_journal VALUES (4, " + std::to_string(entries[i].seq) + ", " + time + ", '" + engine::CoreInputKindName(entries[i].input.kind) + "', '" +
+           quoted + "', '" + entries[i].output + "');";
+  }
+  Sql(path, sql);
+  auto expect_old_run = [&](JournalStore& store) {
+    auto runs = store.Runs();
+    ASSERT_TRUE(runs.ok()) << runs.error().message;
+    ASSERT_EQ(runs->size(), 1u);
+    EXPECT_EQ((*runs)[0].run, 4);
+    EXPECT_EQ((*runs)[0].started_time, 10.5);
+    EXPECT_EQ((*runs)[0].setup, "{\"setup\": 4}");
+    EXPECT_EQ((*runs)[0].entries, 3u);
+    EXPECT_EQ((*runs)[0].bytes, 120u);
+    EXPECT_TRUE((*runs)[0].truncated);
+    auto read = store.Read(4, 0, 10);
+    ASSERT_TRUE(read.ok()) << read.error().message;
+    ASSERT_EQ(read->size(), 3u);
+    for (std::size_t i = 0; i < 3; ++i) {
+      EXPECT_EQ((*read)[i].seq, entries[i].seq);
+      EXPECT_EQ((*read)[i].output, entries[i].output);
+      ExpectSameInput((*read)[i].input, entries[i].input);
+    }
+  };
+  {
+    auto read_only = JournalStore::Open(path, true);
+    ASSERT_TRUE(read_only.ok()) << read_only.error().message;
+    expect_old_run(**read_only);
+  }
+  EXPECT_EQ(Sql(path, "SELECT name FROM pragma_table_info('core_runs') WHERE name = 'setup'").size(), 1u)
+      << "read-only leaves the file as it is";
+  {
+    auto store = JournalStore::Open(path);
+    ASSERT_TRUE(store.ok()) << store.error().message;
+    expect_old_run(**store);
+    EXPECT_TRUE(Sql(path, "SELECT name FROM pragma_table_info('core_runs') WHERE name = 'setup'").empty());
+    const auto journal_sql = Sql(path, "SELECT sql FROM sqlite_master WHERE name = 'core_journal'");
+    ASSERT_EQ(journal_sql.size(), 1u);
+    EXPECT_EQ(journal_sql[0].find("WITHOUT ROWID"), std::string::npos) << journal_sql[0];
+    EXPECT_TRUE(Sql(path, "SELECT name FROM sqlite_master WHERE name = 'core_journal_new'").empty());
+    auto next = (*store)->StartRun(20.0, "{\"setup\": 5}", 2);
+    ASSERT_TRUE(next.ok()) << next.error().message;
+    EXPECT_EQ(*next, 5);
+    ASSERT_TRUE((*store)->Append(*next, entries).ok());
+    auto runs = (*store)->Runs();
+    ASSERT_TRUE(runs.ok());
+    ASSERT_EQ(runs->size(), 2u);
+    EXPECT_EQ((*runs)[1].setup, "{\"setup\": 5}");
+    EXPECT_EQ((*runs)[1].entries, entries.size());
+  }
+  // Reopened: already the current layout, nothing moves.
+  auto again = JournalStore::Open(path);
+  ASSERT_TRUE(again.ok()) << again.error().message;
+  auto read = (*again)->Read(5, 0, 100);
+  ASSERT_TRUE(read.ok());
+  EXPECT_EQ(read->size(), entries.size());
+  auto third = (*again)->StartRun(30.0, "{}", 1);
+  ASSERT_TRUE(third.ok());
+  EXPECT_EQ(Sql(path, "SELECT run FROM core_run_setups"), std::vector<std::string>{"6"})
+      << "a deleted run's setup goes with it";
 }
 
 TEST(JournalStoreTest, ReadOnlyNeedsAJournalAndCorruptRowsAreErrors) {
