@@ -2,6 +2,7 @@
 
 #include <spdlog/spdlog.h>
 
+#include <iterator>
 #include <utility>
 #include <vector>
 
@@ -14,17 +15,37 @@ CoreJournalWriter::CoreJournalWriter(storage::JournalStore& journal, std::int64_
 void CoreJournalWriter::Write(engine::JournaledCore& core) {
   if (stopped_) return;
   std::vector<engine::JournalEntry> entries = core.TakeEntries();
+  if (pending_.empty()) {
+    pending_ = std::move(entries);
+  } else {
+    pending_.insert(pending_.end(), std::make_move_iterator(entries.begin()), std::make_move_iterator(entries.end()));
+  }
   const bool full = full_.load();
   if (full) {
     core.StopRecording();
     stopped_ = true;
+    return HandOver(true);
   }
-  if (entries.empty() && !full) return;
-  worker_.Run([this, full, entries = std::move(entries)](bool) {
+  if (pending_.empty()) return;
+  const auto now = std::chrono::steady_clock::now();
+  if (pending_.size() < kMaxPending && (writing_.load() > 0 || now - last_hand_over_ < kWriteEvery)) return;
+  last_hand_over_ = now;
+  HandOver(false);
+}
+
+void CoreJournalWriter::Stop() {
+  if (!stopped_ && !pending_.empty()) HandOver(false);
+  worker_.Stop();
+}
+
+void CoreJournalWriter::HandOver(bool full) {
+  ++writing_;
+  worker_.Run([this, full, entries = std::move(pending_)](bool) {
     // Written even when the worker stops (cancelled): the journal must hold the run's end.
     // After a failed write nothing more is (a gap would make the rest unreplayable); the run
     // is marked truncated.
     auto written = failed_ ? journal_.Append(run_, {}, true) : journal_.Append(run_, entries, full);
+    --writing_;
     if (failed_) return;
     if (!written.ok()) {
       spdlog::error("journal run {}: {} entries not written, recording stops (a replay ends before them): {}", run_,
@@ -39,6 +60,7 @@ void CoreJournalWriter::Write(engine::JournaledCore& core) {
                    max_bytes_ >> 20);
     }
   });
+  pending_.clear();  // moved from
 }
 
 }  // namespace dispatch::server
