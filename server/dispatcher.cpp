@@ -185,6 +185,7 @@ void Dispatcher::Flush() {
 }
 
 void Dispatcher::Publish() {
+  const auto started = Clock::now();
   SnapshotFacts facts;
   facts.version = ++snapshot_version_;
   facts.time = Now();
@@ -195,11 +196,12 @@ void Dispatcher::Publish() {
   facts.awaiting_reconnect = &restart_wait_.awaited();
   facts.min_distance = distances_.closest();
   std::atomic_store(&snapshot_, std::shared_ptr<const Snapshot>(BuildSnapshot(*map_, *core_, sessions_, book_, facts)));
-  effects_.Published(Clock::now());
+  const auto now = Clock::now();
+  effects_.Published(now, now - started);
 }
 
 void Dispatcher::Journal(const storage::OrderEvent& event) {
-  Defer([this, event] { hub_.Publish(event); });
+  effects_.Announce([this, event] { hub_.Publish(event); });
 }
 
 void Dispatcher::CloseLink(const std::shared_ptr<RobotLink>& link, ServiceStatus status) {

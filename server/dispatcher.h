@@ -218,14 +218,17 @@ class Dispatcher {
               const std::string& actor = "");
   // The robot as stored: the core's robot and the session.
   storage::RobotRecord RecordOf(const std::string& robot_id) const;
-  // Stamps the robot's next message sequence and the time, and sends if connected.
-  void SendTo(const std::string& robot_id, RobotOutbound message);
-  void Send(std::vector<engine::RobotCommand> commands);
-  // Publishes a committed journal event to the watchers (deferred, see Defer).
+  // Stamps the robot's next message sequence and the time, and sends if connected (with
+  // `after_publish` once the snapshot is published, see Defer).
+  void SendTo(const std::string& robot_id, RobotOutbound message, bool after_publish = false);
+  void Send(std::vector<engine::RobotCommand> commands, bool after_publish = false);
+  // Publishes a committed journal event to the watchers after the next snapshot, which it does
+  // not hasten (BatchEffects::Announce).
   void Journal(const storage::OrderEvent& event);
   // Runs `effect` at the end of this batch; with `after_publish` only once the snapshot
-  // holding the batch's changes is published (replies, journal events, Welcomes and stream
-  // ends). Robot plans, grants and holds need no snapshot and do not force one.
+  // holding the batch's changes is published (replies, Welcomes, stream ends, robot messages
+  // that come with an order change). Other plans, grants and holds need no snapshot and do
+  // not force one.
   void Defer(std::function<void()> effect, bool after_publish = true) {
     effects_.Defer(std::move(effect), after_publish);
   }

@@ -32,24 +32,27 @@ bool Dispatcher::Commit(const engine::Change& change, const ServerRound* round, 
     if (*line.to == engine::OrderState::kCompleted) spdlog::info("order {} completed", line.order_id);
   }
   for (const auto& e : *events) Journal(e);
-  Send(std::move(commands));
+  // A robot told of an order change (a plan for a new assignment) hears of it after the
+  // snapshot that holds the change: whoever it tells finds it there.
+  Send(std::move(commands), /*after_publish=*/!events->empty());
   effects_.MarkChanged();
   return true;
 }
 
-void Dispatcher::Send(std::vector<engine::RobotCommand> commands) {
-  for (auto& c : commands) SendTo(c.robot, std::move(c.message));
+void Dispatcher::Send(std::vector<engine::RobotCommand> commands, bool after_publish) {
+  for (auto& c : commands) SendTo(c.robot, std::move(c.message), after_publish);
 }
 
-void Dispatcher::SendTo(const std::string& robot_id, RobotOutbound message) {
+void Dispatcher::SendTo(const std::string& robot_id, RobotOutbound message, bool after_publish) {
   RobotSession* found = sessions_.Find(robot_id);
   if (!found) return;
   RobotSession& s = *found;
   message.sequence = s.next_sequence++;
   message.server_time = Now();
   if (!s.link) return;
-  // A Welcome waits for the snapshot that holds the robot; plans, grants and holds do not.
-  const bool after_publish = message.kind == RobotOutbound::Kind::kWelcome;
+  // A Welcome waits for the snapshot that holds the robot; plans, grants and holds do not,
+  // unless they come with an order change.
+  after_publish = after_publish || message.kind == RobotOutbound::Kind::kWelcome;
   Defer([link = s.link, message = std::move(message)]() mutable { link->Send(std::move(message)); }, after_publish);
 }
 

@@ -302,6 +302,60 @@ TEST(BatchEffectsTest, AnnouncementsWaitForThePublishAndRobotMessagesDoNotForceO
   EXPECT_EQ(out.back(), "later");
 }
 
+// A publish that took long (many robots) spaces the next ones nobody waits for, to
+// kPublishShare times its time; a reply still publishes at once; a quick publish brings the
+// period back.
+TEST(BatchEffectsTest, ASlowPublishSpacesThoseNobodyWaitsFor) {
+  using Clock = BatchEffects::Clock;
+  using std::chrono::milliseconds;
+  const Clock::time_point t0 = Clock::now();
+  BatchEffects effects;
+  effects.Published(t0, milliseconds(5));
+  EXPECT_EQ(effects.period(), milliseconds(5) * BatchEffects::kPublishShare);
+  effects.MarkChanged();
+  EXPECT_FALSE(effects.PublishDue(t0 + BatchEffects::kPublishEvery));
+  EXPECT_EQ(effects.WakeBy(t0 + std::chrono::seconds(1)), t0 + milliseconds(50));
+  EXPECT_TRUE(effects.PublishDue(t0 + milliseconds(50)));
+  effects.Defer([] {}, /*after_publish=*/true);
+  EXPECT_TRUE(effects.PublishDue(t0 + milliseconds(1)));
+  effects.Published(t0 + milliseconds(1), std::chrono::microseconds(300));
+  effects.RunDeferred();
+  EXPECT_EQ(effects.period(), BatchEffects::kPublishEvery);
+  effects.MarkChanged();
+  EXPECT_TRUE(effects.PublishDue(t0 + milliseconds(1) + BatchEffects::kPublishEvery));
+}
+
+// Journal events wait for the next publish, in order, without hastening it; a reply's publish
+// lets them out too, after the batch's other effects.
+TEST(BatchEffectsTest, AnnouncementsGoOutAfterTheNextPublishWithoutHasteningIt) {
+  using Clock = BatchEffects::Clock;
+  using std::chrono::milliseconds;
+  const Clock::time_point t0 = Clock::now();
+  BatchEffects effects;
+  effects.Published(t0);
+  std::vector<std::string> out;
+  effects.MarkChanged();
+  effects.Announce([&out] { out.push_back("event 1"); });
+  effects.Announce([&out] { out.push_back("event 2"); });
+  effects.Defer([&out] { out.push_back("grant"); }, /*after_publish=*/false);
+  EXPECT_FALSE(effects.PublishDue(t0 + milliseconds(5)));
+  effects.RunDeferred();
+  EXPECT_EQ(out, (std::vector<std::string>{"grant"})) << "the events wait for the snapshot";
+  EXPECT_EQ(effects.WakeBy(t0 + std::chrono::seconds(1)), t0 + BatchEffects::kPublishEvery);
+  ASSERT_TRUE(effects.PublishDue(t0 + BatchEffects::kPublishEvery));
+  effects.Published(t0 + BatchEffects::kPublishEvery);
+  effects.Announce([&out] { out.push_back("event 3"); });  // after the publish: the next one's
+  effects.RunDeferred();
+  EXPECT_EQ(out, (std::vector<std::string>{"grant", "event 1", "event 2"}));
+  // A reply forces the publish; the event announced before it goes out with it, after it.
+  effects.MarkChanged();
+  effects.Defer([&out] { out.push_back("reply"); }, /*after_publish=*/true);
+  EXPECT_TRUE(effects.PublishDue(t0 + BatchEffects::kPublishEvery + milliseconds(1)));
+  effects.Published(t0 + BatchEffects::kPublishEvery + milliseconds(1));
+  effects.RunDeferred();
+  EXPECT_EQ(out, (std::vector<std::string>{"grant", "event 1", "event 2", "reply", "event 3"}));
+}
+
 TEST(DispatchClockTest, GoesOnFromTheStoredTimeAtItsScale) {
   using Clock = DispatchClock::Clock;
   const Clock::time_point start{};
