@@ -32,11 +32,15 @@ LorrCommands AddLorrCommands(CLI::App& app, LorrArgs& run, LorrArgs& check) {
                 "floyd (dense; lazy above 4,096 cells), dijkstra, auto, lazy or hub_labels (any floor, bounded memory)")
       ->capture_default_str()->check(CLI::IsMember(RouteTableMethodNames()));
   l->add_flag("--reassign,!--no-reassign", run.reassign,
-              "Each step, tasks not opened yet go back to the pool and their robots bid again (while the pool is "
-              "within --reassign-max-work)")
+              "Tasks not opened yet go back to the pool and their robots bid again, in steps whose pool's work "
+              "is within --reassign-max-work and the credit --reassign-work-per-step builds")
       ->capture_default_str();
   l->add_option("--reassign-max-work", run.reassign_max_work,
-                "Reassign only while min(robots, tasks)^2 x max(robots, tasks) of the pool is at most this")
+                "Reassign only a pool whose work, min(robots, tasks)^2 x max(robots, tasks), is at most this")
+      ->capture_default_str()->check(CLI::NonNegativeNumber);
+  l->add_option("--reassign-work-per-step", run.reassign_work_per_step,
+                "Reassignment work each step adds to the credit a reassignment spends (pools within it reassign "
+                "every step, larger ones every few steps)")
       ->capture_default_str()->check(CLI::NonNegativeNumber);
   commands.run = l;
   auto* c = app.add_subcommand("lorr-check", "Replay a LoRR output JSON against its problem and check every rule");
@@ -63,6 +67,7 @@ int RunLorr(const LorrArgs& a) {
   options.route_method = ParseRouteTableMethod(a.route_table).value();
   options.reassign = a.reassign;
   options.reassign_max_work = a.reassign_max_work;
+  options.reassign_work_per_step = a.reassign_work_per_step;
   const auto run_begin = std::chrono::steady_clock::now();
   Result<LifelongRecord> record = RunLifelong(*problem, options);
   if (!record) {

@@ -4,6 +4,7 @@
 //   dispatch-sim lorr --problem FILE.json --steps N [--output out.json] [--plan-ms 100]
 //       [--strategy exact|auction|greedy|psoga] [--seed S] [--route-cache-mb 4096]
 //       [--route-table floyd|...|hub_labels] [--no-reassign] [--reassign-max-work W]
+//       [--reassign-work-per-step C]
 //   dispatch-sim lorr-check --problem FILE.json --output out.json
 // `lorr` prints tasks finished, makespan, errors and planning time per step (mean, max) and
 // writes the competition's output JSON; exit 0, or 2 when the run had planner errors.
@@ -12,6 +13,8 @@
 
 #include <cstdint>
 #include <string>
+
+#include "engine/lifelong/lifelong_run.h"
 
 namespace CLI {
 class App;
@@ -29,7 +32,8 @@ struct LorrArgs {
   std::size_t route_cache_mb = 4096;
   std::string route_table = "floyd";  // RouteTableMethodNames()
   bool reassign = true;                // LifelongOptions::reassign
-  double reassign_max_work = 2e6;      // LifelongOptions::reassign_max_work
+  double reassign_max_work = LifelongOptions{}.reassign_max_work;
+  double reassign_work_per_step = LifelongOptions{}.reassign_work_per_step;
 };
 
 struct LorrCommands {

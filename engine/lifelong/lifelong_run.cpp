@@ -3,7 +3,9 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <string>
 #include <unordered_map>
+#include <utility>
 
 #include "engine/allocation/fleet_state.h"
 #include "engine/dispatch/strategy.h"
@@ -102,14 +104,17 @@ class Run {
     std::vector<int> pool = waiting_;
     std::vector<std::pair<int, int>> held;  // (robot, task): tasks back in the pool
     bool reassign = options_.reassign;
-    if (reassign) {  // only while the pool's work is within options_.reassign_max_work
+    if (reassign) {  // only a pool within the bound and the credit (LifelongOptions::reassign)
+      credit_ = std::min(credit_ + options_.reassign_work_per_step, options_.reassign_max_work);
       double robots = 0.0, tasks = static_cast<double>(waiting_.size());
       for (std::size_t r = 0; r < poses_.size(); ++r) {
         const bool unopened = task_of_[r] != -1 && open_.at(task_of_[r]).done == 0;
         robots += task_of_[r] == -1 || unopened ? 1.0 : 0.0;
         tasks += unopened ? 1.0 : 0.0;
       }
-      reassign = std::min(robots, tasks) * std::min(robots, tasks) * std::max(robots, tasks) <= options_.reassign_max_work;
+      const double work = std::min(robots, tasks) * std::min(robots, tasks) * std::max(robots, tasks);
+      reassign = work <= options_.reassign_max_work && work <= credit_;
+      if (reassign) credit_ -= work;
       record_.reassign_steps += reassign ? 1 : 0;
     }
     for (std::size_t r = 0; r < poses_.size(); ++r) {
@@ -226,6 +231,7 @@ class Run {
   std::unordered_map<int, OpenTask> open_;  // revealed, unfinished tasks by id
   std::vector<int> waiting_;                // open tasks no robot holds, in reveal order
   int next_task_ = 0;
+  double credit_ = 0.0;  // reassignment work the steps so far allow (LifelongOptions::reassign)
 };
 
 }  // namespace
@@ -236,6 +242,12 @@ Result<LifelongRecord> RunLifelong(const LorrProblem& problem, const LifelongOpt
     return InvalidArgument("plan_ms must be finite and >= 0");
   }
   if (problem.starts.empty()) return InvalidArgument("the problem has no robots");
+  for (const auto& [name, value] : {std::pair{"reassign_max_work", options.reassign_max_work},
+                                    std::pair{"reassign_work_per_step", options.reassign_work_per_step}}) {
+    if (!(value >= 0.0) || !std::isfinite(value)) {
+      return InvalidArgument(std::string(name) + " must be finite and >= 0, got " + std::to_string(value));
+    }
+  }
   Result<std::unique_ptr<Allocator>> allocator = MakeAllocator(options.strategy);
   if (!allocator) return allocator.error();
   RouteTableOptions route_options;

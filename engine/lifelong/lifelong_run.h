@@ -52,17 +52,22 @@ struct LifelongOptions {
   // kFloyd: the dense table below RouteTableOptions::lazy_threshold_points, the lazy one above;
   // kHubLabels: hub labels on any floor (memory bounded by the labels, no search per goal).
   RouteTableMethod route_method = RouteTableMethod::kFloyd;
-  // Each step, tasks whose first errand no robot has reached yet go back into the pool with
-  // the waiting ones, and their robots bid again with the free ones (the competition lets a
-  // scheduler move a task until it is opened). A robot that wins nothing keeps its task unless
-  // another robot won it. Only in steps where min(robots, tasks)^2 x max(robots, tasks) of
-  // that pool is at most reassign_max_work; on larger pools only the free robots bid. The LoRR
-  // random floor's pools (100 robots, 150 tasks: at most 1.5e6) always fit. On
-  // sortation_large_2000 a bound of 5e7 to 2e8 can settle into reassigning most steps: a fifth
-  // more tasks, but 113-124 ms per step, over the competition's 100 ms mean (README); whether
-  // it settles there depends on the first step, so 2e6 keeps the large floors' pools out.
+  // Tasks whose first errand no robot has reached yet go back into the pool with the waiting
+  // ones, and their robots bid again with the free ones (the competition lets a scheduler move
+  // a task until it is opened). A robot that wins nothing keeps its task unless another robot
+  // won it. The work of such a pool is min(robots, tasks)^2 x max(robots, tasks) (what the
+  // assignment costs; its cost matrix is robots x tasks route queries). A step reassigns when
+  // its pool's work is at most reassign_max_work and within the credit: every step adds
+  // reassign_work_per_step to it (kept at most reassign_max_work), a reassignment spends its
+  // work. So pools within reassign_work_per_step (the LoRR random floor's: 100 robots, 150
+  // tasks, at most 1.5e6) reassign every step, and larger ones every few steps, about their
+  // work / reassign_work_per_step: on sortation_large_2000 (pools of about 170 robots and
+  // 1,170 tasks, 3.5e7) every step cost 113-124 ms a step, over the competition's 100 ms mean
+  // (README). Deterministic: the rule counts work, not time. Other steps give the waiting tasks
+  // to the free robots only.
   bool reassign = true;
-  double reassign_max_work = 2e6;
+  double reassign_max_work = 1e8;
+  double reassign_work_per_step = 1e7;
 };
 
 struct LifelongError {

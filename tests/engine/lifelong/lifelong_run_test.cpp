@@ -4,6 +4,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include <limits>
 #include <map>
 #include <set>
 
@@ -150,6 +151,42 @@ TEST(LifelongRunTest, ReassignMovesOnlyTasksNotOpenedYet) {
   const LorrCheckReport refused = Check(problem, stolen.dump());
   ASSERT_FALSE(refused.ok());
   EXPECT_NE(refused.problems[0].find("held by robots 0 and 1"), std::string::npos) << refused.problems[0];
+}
+
+// Reassignment spends a credit of work (LifelongOptions::reassign_work_per_step): with none
+// it never happens and the run is the run without reassignment; with a credit as large as any
+// pool's work it happens in every step; with a small one in some steps only, and the output is
+// still valid. Bad values are refused.
+TEST(LifelongRunTest, ReassignmentSpendsACreditOfWork) {
+  const LorrProblem problem = Load(LorrExample("random.domain/random_32_32_20_100.json"));
+  LifelongOptions options;
+  options.steps = 100;
+  options.reassign = false;
+  const LifelongRecord kept = RunLifelong(problem, options).value();
+  options.reassign = true;
+  options.reassign_work_per_step = 0.0;
+  const LifelongRecord none = RunLifelong(problem, options).value();
+  EXPECT_EQ(none.reassign_steps, 0);
+  EXPECT_TRUE(none.actual_actions == kept.actual_actions);
+  options.reassign_work_per_step = options.reassign_max_work;  // 100 robots, 150 tasks: at most 1.5e6
+  EXPECT_EQ(RunLifelong(problem, options).value().reassign_steps, 100);
+  options.reassign_work_per_step = 1e5;
+  const LifelongRecord some = RunLifelong(problem, options).value();
+  EXPECT_GT(some.reassign_steps, 0);
+  EXPECT_LT(some.reassign_steps, 100);
+  const LorrCheckReport report = Check(problem, LorrOutputJson(some, problem.grid));
+  EXPECT_TRUE(report.ok()) << (report.problems.empty() ? "" : report.problems[0]);
+  EXPECT_EQ(report.tasks_finished, some.tasks_finished);
+
+  for (double bad : {-1.0, std::numeric_limits<double>::quiet_NaN(), std::numeric_limits<double>::infinity()}) {
+    options.reassign_work_per_step = bad;
+    auto refused = RunLifelong(problem, options);
+    ASSERT_FALSE(refused.ok());
+    EXPECT_NE(refused.error().message.find("reassign_work_per_step"), std::string::npos) << refused.error().message;
+  }
+  options.reassign_work_per_step = 1e7;
+  options.reassign_max_work = -1.0;
+  EXPECT_FALSE(RunLifelong(problem, options).ok());
 }
 
 // The checker finds what a run that broke the rules would write.
