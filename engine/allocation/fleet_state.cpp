@@ -256,10 +256,14 @@ Result<double> FleetState::Refined(const RobotEntry& e, const PlanTask& task, Pl
 }
 
 double FleetState::RefinedExtra(std::size_t robot, const PlanTask& task) const {
+  return RefinedExtra(robot, task, robots_.at(robot).summary.end_point);
+}
+
+double FleetState::RefinedExtra(std::size_t robot, const PlanTask& task, PointId from) const {
   const RobotEntry& e = robots_.at(robot);
   if (!free_space_ || e.info.kind != RobotKind::kFourWheelSteer || !CanServe(robot, task)) return 0.0;
   const QueueSummary& s = e.summary;
-  Result<Plan> segment = BuildPlan(*map_, *routes_, s.end_point, s.end_time, config_.speed, {task}, config_.turn_time);
+  Result<Plan> segment = BuildPlan(*map_, *routes_, from, s.end_time, config_.speed, {task}, config_.turn_time);
   if (!segment.ok()) return 0.0;  // the bid finds it unreachable on its own
   Result<double> extra = Refined(e, task, segment.value());
   return extra.ok() ? *extra : std::numeric_limits<double>::infinity();

@@ -182,14 +182,18 @@ class FleetState {
   // graph's headings at its stops); null: on the lanes, as every robot. A segment the hybrid
   // A* cannot refine (an anchor pose that does not fit the region, no path, the search limits)
   // keeps its lanes, unless its task asks for a heading: then AssignSingle fails saying why.
-  // The auction's bids price the refined legs (RefinedExtra); the batch strategies' costs and
-  // the greedy rule's distance are the lanes'.
+  // Every strategy prices the refined legs (RefinedExtra): the auction's bids, the exact
+  // assignment's costs and the greedy rule's distance; PSO-GA's fitness is the lanes'
+  // distances (robot-blind, seed 003 eq. (1)).
   void UseFreeSpace(std::shared_ptr<const FreeSpaceMotion> motion) { free_space_ = std::move(motion); }
   // Seconds robot's plan for `task` (from its queue's end) takes beyond the lanes' when
   // AssignSingle refines it through free space (turns, crabs, spins; may be < 0): what the
   // auction adds to its T_d and AssignSingle to its queue's. 0 when it would not be refined;
   // +infinity when the task asks for a heading the hybrid A* cannot plan it into.
   double RefinedExtra(std::size_t robot, const PlanTask& task) const;
+  // The same for `task` planned from point `from` (where an earlier task of a batch leaves
+  // the robot) instead of its queue's end.
+  double RefinedExtra(std::size_t robot, const PlanTask& task, PointId from) const;
 
  private:
   struct RobotEntry;

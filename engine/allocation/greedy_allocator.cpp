@@ -21,7 +21,8 @@ Result<AwardExplanation> GreedyAllocator::Allocate(const Order& order, FleetStat
     Bid b;
     b.robot = state.robot_id(i);
     b.ready_time = s.end_time;
-    b.t_d = state.routes().Cost(s.end_point, first);
+    // A four-wheel-steer robot's drive through free space, as AssignSingle will plan it.
+    b.t_d = state.routes().Cost(s.end_point, first) + (order.formation ? 0.0 : state.RefinedExtra(i, *task));
     b.queue_full = !state.HasRoom(i, order.formation);
     b.reachable = std::isfinite(b.t_d) && !b.queue_full && state.CanServe(i, *task);
     b.bid = b.t_d;

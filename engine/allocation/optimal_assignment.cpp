@@ -15,6 +15,7 @@ struct BatchTask {
   PointId drop = kNoPoint;
   double travel = 0.0;  // pick -> ... -> drop
   double work = 0.0;    // n_c * t_w + drop times
+  PlanTask task;        // for the refined legs (FleetState::RefinedExtra)
 };
 
 Result<std::vector<BatchTask>> Prepare(const FleetState& state, const std::vector<Order>& orders) {
@@ -26,7 +27,7 @@ Result<std::vector<BatchTask>> Prepare(const FleetState& state, const std::vecto
     }
     Result<PlanTask> t = PrepareOrder(o, state);
     if (!t.ok()) return t.error();
-    tasks.push_back({t->picks.front(), t->drop, state.TaskTravelTime(*t), TaskWorkTime(*t)});
+    tasks.push_back({t->picks.front(), t->drop, state.TaskTravelTime(*t), TaskWorkTime(*t), *t});
   }
   return tasks;
 }
@@ -47,7 +48,8 @@ double Total(const FleetState& state, const std::vector<BatchTask>& tasks,
     PointId at = s.end_point;
     for (std::size_t k = 0; k < tasks.size(); ++k) {
       if (robot_of_order[k] != r) continue;
-      travel += state.routes().Cost(at, tasks[k].first) + tasks[k].travel;
+      // A four-wheel-steer robot's legs through free space, as AssignSingle will plan them.
+      travel += state.routes().Cost(at, tasks[k].first) + tasks[k].travel + state.RefinedExtra(r, tasks[k].task, at);
       work += tasks[k].work;
       at = tasks[k].drop;
       if (objective == BatchObjective::kBidSum) total += c.alpha * (travel + work) + c.beta * travel;
@@ -164,7 +166,8 @@ std::vector<std::vector<double>> MarginalCosts(const FleetState& state, const st
   for (std::size_t k = 0; k < tasks.size(); ++k) {
     for (std::size_t j = 0; j < robots.size(); ++j) {
       const BatchTask& t = tasks[k];
-      const double travel = state.routes().Cost(state.summary(robots[j]).end_point, t.first) + t.travel;
+      const double travel = state.routes().Cost(state.summary(robots[j]).end_point, t.first) + t.travel +
+                            state.RefinedExtra(robots[j], t.task);
       const double value = c.alpha * (travel + t.work) + c.beta * travel;
       if (std::isfinite(value)) cost[k][j] = value;
     }
