@@ -61,13 +61,6 @@ void Dispatcher::DoSubmit(const engine::OrderRequest& request, const std::string
     return done(std::move(reply));
   }
   engine::Order order = std::move(admitted).value();
-  if (!order.stop_headings.empty() && options_.allocation.planner != engine::PlannerKind::kRules) {
-    // Only the rules planner refines plans through free space (RoundRunner::Run).
-    reply.status = MakeStatus(StatusCode::kFailedPrecondition,
-                              "order '" + order.client_id + "': a stop heading needs the rules planner (this dispatcher runs " +
-                                  engine::PlannerName(options_.allocation.planner) + ")");
-    return done(std::move(reply));
-  }
   if (auto existing = book_.FindClient(order.client_id)) return done(AnswerRepeat(std::move(existing), order));
   // Not in memory: new, or finished long ago (retired). The store decides which.
   auto inserted = store_.InsertOrder(order, actor);

@@ -39,7 +39,7 @@ Result<PlanTask> PrepareOrder(const Order& order, const FleetState& state) {
     if (!any) {
       return Error{ErrorCode::kFailedPrecondition,
                    what + "a stop asks for a heading, and no robot can be planned into it (a four-wheel-steer robot, "
-                          "planned through the map's free-space regions by the rules planner)"};
+                          "planned through the map's free-space regions)"};
     }
   }
   const RouteTable& routes = state.routes();

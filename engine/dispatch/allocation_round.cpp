@@ -91,7 +91,7 @@ FleetState* RoundRunner::Prepare(const RoundInput& input, std::vector<std::strin
     kept_origin_ = grid.origin_time;
     kept_robots_.assign(input.robots.size(), KeptRobot{});
     zone_index_ = kept_->zone_index();  // one floor, one index: the next fleet skips the grid
-    if (config_.planner == PlannerKind::kRules) kept_->UseFreeSpace(FreeSpace(notes));
+    kept_->UseFreeSpace(FreeSpace(notes));  // every planner: the planned ones keep refined segments
   }
   FleetState& fleet = *kept_;
   if (&fleet.routes() != routes_.get()) (void)fleet.UseRoutes(routes_);  // a round's heat routes

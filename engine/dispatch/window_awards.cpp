@@ -32,6 +32,15 @@ TimedRoute VisitsOf(const WarehouseMap& map, const TimeWindowRules& rules, const
   return r;
 }
 
+// Whether a waypoint of `w` from `first` on carries a heading: a segment refined through
+// free space (FleetState::UseFreeSpace), which the graph's windows cannot plan again.
+bool Posed(const std::vector<Waypoint>& w, std::size_t first) {
+  for (std::size_t k = first; k < w.size(); ++k) {
+    if (w[k].heading) return true;
+  }
+  return false;
+}
+
 // The re-planned segment as waypoints (see the header: waits become departures). `fresh`:
 // the segment starts with the robot's start waypoint; else it follows its queue, which it
 // leaves at `ready`.
@@ -82,7 +91,9 @@ struct RoundWindows {
     for (std::size_t i = 0; i < fleet.robot_count(); ++i) {
       const auto& w = fleet.plan(i).waypoints;
       const std::size_t first = i < segments.first_new.size() ? segments.first_new[i] : RoundSegments::kNothingNew;
-      replan[i] = first != RoundSegments::kNothingNew && !segments.in_formation[i];
+      // A four-wheel-steer robot's segment refined through free space (its waypoints posed)
+      // keeps its route and is reserved as it is, as a formation's.
+      replan[i] = first != RoundSegments::kNothingNew && !segments.in_formation[i] && !Posed(w, first);
       // A robot without a queue keeps its start waypoint; its new segment repeats it.
       const std::size_t upto = replan[i] ? std::max<std::size_t>(first, 1) : w.size();
       kept[i].assign(w.begin(), w.begin() + static_cast<std::ptrdiff_t>(std::min(upto, w.size())));

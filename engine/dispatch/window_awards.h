@@ -4,7 +4,9 @@
 // (Wang2019 §2-3; engine/planning/window_planner.h), awards in allocation order (the seed's
 // rule: earlier release first), each reserving its route for the next. Formation awards keep
 // their route-table routes and are reserved as they are; so are robots that win a formation in
-// the round.
+// the round, and a four-wheel-steer robot's segments refined through free space (their posed
+// waypoints are named after the graph points they pass, so their windows are those points'
+// and arcs').
 //
 // A re-planned segment keeps its stops, actions and work times; its waits become departures:
 // a robot reaching a waypoint ahead of plan waits for its planned departure (the robots'

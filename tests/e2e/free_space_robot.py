@@ -10,9 +10,9 @@ them, the pick's waypoint facing pi; fleet-sim drives them. Then a plain order i
 goes to R2: R1 is nearer by the lanes, but the bids price its route through the bay (it turns
 round there, where the lanes just drive back). Both orders complete with the robots never
 closer than eps1 (a free-space region holds one robot at a time: the traffic controller keeps
-the other out while one is in it). A heading at the drop (on the lanes) is INVALID_ARGUMENT, and a
-dispatcher running the time-window planner answers FAILED_PRECONDITION (only the rules planner
-refines plans through free space). (That a differential robot keeps
+the other out while one is in it). A heading at the drop (on the lanes) is INVALID_ARGUMENT. A
+second dispatcher, running the time-window planner, serves the order with a heading by a posed
+route too (a refined segment keeps its route and is reserved as it is). (That a differential robot keeps
 its lanes is the core test's,
 FreeSpaceRound; two robots picking at the closed end of one bay lock each other up, see the
 closing note of 2026-12-06.)
@@ -112,9 +112,20 @@ def main():
         h.log("states: " + ", ".join(f"{k}={state_name(v.state)}" for k, v in sorted(done.items())))
         h.check_min_distance(server)
 
-        # The time-window planner does not refine plans through free space: it says so.
-        planned = h.start_server(["--map", MAP, "--planner", "time-windows"], db=os.path.join(h.work, "tw.db"))
-        refused(planned, grpc.StatusCode.FAILED_PRECONDITION, "needs the rules planner", pick_heading=math.pi)
+        # The time-window planner keeps the refined segment and plans round it: the same order
+        # with a heading, served by a posed route.
+        planned = h.start_server(["--map", MAP, "--planner", "time-windows", "--time-scale", "2"],
+                                 db=os.path.join(h.work, "tw.db"))
+        h.start_fleet(planned, 1, ["--kinds", "four_wheel_steer"])
+        h.wait_for(lambda: len(planned.rest("/api/v1/robots")["robots"]) == 1, 10, "the robot listed")
+        windowed = submit(planned, "3", pick_heading=math.pi)
+        robot, waypoints = h.wait_for(lambda: route_of(planned, windowed), 20, "the order's route (time windows)")
+        at_pick = [w for w in waypoints if w.get("action") == "WAYPOINT_ACTION_PICK"]
+        check(robot == "R1" and sum("heading" in w for w in waypoints) >= 5, f"{robot}'s route: {waypoints}")
+        check(len(at_pick) == 1 and abs(abs(at_pick[0].get("heading", 0.0)) - math.pi) < 1e-6,
+              f"the pick waypoint (time windows): {at_pick}")
+        h.watch(planned, lambda o: windowed in o and o[windowed].state == COMPLETED,
+                timeout=60, what="the order with a heading completed (time windows)", order_ids=[windowed])
 
 
 if __name__ == "__main__":

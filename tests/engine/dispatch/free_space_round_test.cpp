@@ -202,8 +202,107 @@ TEST(FreeSpaceRound, TheBidsPriceTheRefinedLegs) {
   EXPECT_LT(lanes_r1, lanes.t_d) << "by the lanes alone R1 is nearer";
 }
 
+// The exact assignment and the greedy rule price the refined legs too (the lanes alone would
+// send R1, 2 m nearer K): with one order the exact strategy's cost is R2's, the greedy rule's
+// distance R1's refined drive to K.
+TEST(FreeSpaceRound, TheOtherStrategiesPriceTheRefinedLegsToo) {
+  const auto map = Bay(false);
+  const auto routes = Routes(map);
+  for (const char* strategy : {"exact", "greedy"}) {
+    SCOPED_TRACE(strategy);
+    RoundRunner runner(map, routes, AllocationConfig{}, std::move(MakeAllocator(strategy)).value());
+    RoundInput input;
+    RoundRobot r1, r2;
+    r1.id = "R1";
+    r1.start = *map->FindPoint("P1");
+    r1.kind = RobotKind::kFourWheelSteer;
+    r2.id = "R2";
+    r2.start = *map->FindPoint("P2");
+    input.robots = {r1, r2};
+    input.pending = {PickAtK(*map, "o1", 0.0)};
+    const RoundResult result = runner.Run(input);
+    ASSERT_EQ(result.awards.size(), 1u);
+    EXPECT_EQ(result.awards[0].award.winners, std::vector<std::string>{"R2"}) << result.awards[0].award.reason;
+  }
+  // Without the four-wheel-steer kind the same round goes to R1, the nearer by the lanes.
+  for (const char* strategy : {"exact", "greedy"}) {
+    SCOPED_TRACE(strategy);
+    RoundRunner runner(map, routes, AllocationConfig{}, std::move(MakeAllocator(strategy)).value());
+    RoundInput input;
+    RoundRobot r1, r2;
+    r1.id = "R1";
+    r1.start = *map->FindPoint("P1");
+    r2.id = "R2";
+    r2.start = *map->FindPoint("P2");
+    input.robots = {r1, r2};
+    input.pending = {PickAtK(*map, "o1", 0.0)};
+    const RoundResult result = runner.Run(input);
+    ASSERT_EQ(result.awards.size(), 1u);
+    EXPECT_EQ(result.awards[0].award.winners, std::vector<std::string>{"R1"}) << result.awards[0].award.reason;
+  }
+}
+
+// Issue 17 under the planned planners: the time windows re-plan a round's awards on the graph,
+// which knows no free space, so R1's refined segment (the order asks for heading pi at K)
+// keeps its poses and its turn and is reserved as it is; R2, given a plain order at K in the
+// same round, is planned to reach K only once R1 has left it (before, these planners did not
+// refine at all: nobody could serve the heading).
+TEST(FreeSpaceRound, ThePlannedPlannersKeepTheRefinedSegmentAndPlanRoundIt) {
+  const auto map = Bay(false);
+  const auto routes = Routes(map);
+  const PointId k = *map->FindPoint("K");
+  for (PlannerKind planner : {PlannerKind::kTimeWindows, PlannerKind::kConflictElimination}) {
+    SCOPED_TRACE(PlannerName(planner));
+    AllocationConfig config;
+    config.planner = planner;
+    RoundRunner runner(map, routes, config, std::move(MakeAllocator("auction")).value());
+    RoundInput input;
+    RoundRobot r1, r2;
+    r1.id = "R1";
+    r1.start = *map->FindPoint("P1");
+    r1.kind = RobotKind::kFourWheelSteer;
+    r2.id = "R2";
+    r2.start = *map->FindPoint("P2");
+    input.robots = {r1, r2};
+    auto posed = std::const_pointer_cast<Order>(PickAtK(*map, "o1", 0.0));
+    posed->stop_headings[0] = std::numbers::pi;
+    // Dropped where R1 started: a plan's last point is held for ever in the windows, and R2
+    // drops at D.
+    posed->drop = r1.start;
+    input.pending = {posed, PickAtK(*map, "o2", 0.0)};
+    const RoundResult result = runner.Run(input);
+    EXPECT_TRUE(result.notes.empty()) << result.notes.front();
+    ASSERT_EQ(result.awards.size(), 2u);
+    ASSERT_EQ(result.awards[0].award.winners, std::vector<std::string>{"R1"}) << result.awards[0].award.reason;
+    ASSERT_EQ(result.awards[1].award.winners, std::vector<std::string>{"R2"}) << result.awards[1].award.reason;
+    const std::vector<Waypoint>& steered = result.awards[0].segments.at(0);
+    std::set<MotionMode> modes;
+    double r1_leaves_k = 0.0;
+    for (const Waypoint& w : steered) {
+      if (w.mode) modes.insert(*w.mode);
+      if (w.point == k) r1_leaves_k = std::max(r1_leaves_k, w.departure());
+      if (w.action == WaypointAction::kPick) {
+        ASSERT_TRUE(w.heading.has_value());
+        EXPECT_NEAR(std::abs(*w.heading), std::numbers::pi, 1e-6);
+      }
+    }
+    EXPECT_TRUE(modes.count(MotionMode::kSpinLeft) || modes.count(MotionMode::kSpinRight) ||
+                modes.count(MotionMode::kReverse))
+        << "no turn in the bay";
+    int picks = 0;
+    for (const Waypoint& w : result.awards[1].segments.at(0)) {
+      if (w.action != WaypointAction::kPick) continue;
+      ++picks;
+      EXPECT_FALSE(w.heading.has_value());
+      EXPECT_GE(w.eta, r1_leaves_k) << "R2 reaches K while R1 is still there";
+    }
+    EXPECT_EQ(picks, 1);
+  }
+}
+
 // Orders at K every 5 s through the core, checked for safety at every step.
-Result<StreamResult> Serve(std::shared_ptr<const WarehouseMap> map, const std::vector<FleetRobot>& robots, int count) {
+Result<StreamResult> Serve(std::shared_ptr<const WarehouseMap> map, const std::vector<FleetRobot>& robots, int count,
+                           PlannerKind planner = PlannerKind::kRules) {
   std::vector<Order> orders;
   for (int k = 0; k < count; ++k) {
     Order o = *PickAtK(*map, "o" + std::to_string(k + 1), 5.0 * k);
@@ -213,6 +312,8 @@ Result<StreamResult> Serve(std::shared_ptr<const WarehouseMap> map, const std::v
   StreamConfig config;
   config.check_safety = true;
   config.max_time = 600.0;
+  config.allocation.planner = planner;
+  config.traffic.execution = DefaultPlanExecution(planner);  // as dispatchd and dispatch-sim drive it
   return SimulateOnCore(map, Routes(map), robots, orders, config);
 }
 
@@ -234,12 +335,12 @@ TEST(FreeSpaceRound, AFourWheelSteerRobotTurnsRoundInTheDeadEndOrderAfterOrder) 
 // turned round at K (and two robots in one dead end lock each other up).
 // R1 (four-wheel steer, at P1) and R2 (differential, at P2) serve `count` orders at K on the
 // core: every one completes safely, and both kinds serve the bay.
-void ExpectBothKindsServe(bool loop, int count) {
+void ExpectBothKindsServe(bool loop, int count, PlannerKind planner = PlannerKind::kRules) {
   const auto map = Bay(loop);
   auto run = Serve(map,
                    {{"R1", *map->FindPoint("P1"), 0.0, RobotKind::kFourWheelSteer},
                     {"R2", *map->FindPoint("P2"), 0.0, RobotKind::kDifferential}},
-                   count);
+                   count, planner);
   ExpectAllDoneSafely(run);
   if (!run.ok()) return;
   std::set<std::string> served;
@@ -250,6 +351,13 @@ void ExpectBothKindsServe(bool loop, int count) {
 TEST(FreeSpaceRound, BothKindsTakeTurnsInADeadEndBay) { ExpectBothKindsServe(false, 4); }
 
 TEST(FreeSpaceRound, BothKindsServeTheBayOnTheCoreSafely) { ExpectBothKindsServe(true, 6); }
+
+// The same under the time windows: the refined robot's windows keep the other one out of its
+// way, and the traffic controller's one-robot-per-region rule stays the safety net.
+TEST(FreeSpaceRound, TheTimeWindowsServeTheBayOnTheCore) {
+  ExpectBothKindsServe(false, 4, PlannerKind::kTimeWindows);
+  ExpectBothKindsServe(true, 6, PlannerKind::kTimeWindows);
+}
 
 }  // namespace
 }  // namespace dispatch::engine
