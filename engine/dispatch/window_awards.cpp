@@ -43,7 +43,8 @@ bool Posed(const std::vector<Waypoint>& w, std::size_t first) {
 
 // The re-planned segment as waypoints (see the header: waits become departures). `fresh`:
 // the segment starts with the robot's start waypoint; else it follows its queue, which it
-// leaves at `ready`.
+// leaves at `ready`. A stop may be worked at the route's first visit (where the queue ends, or
+// where a fresh robot stands) and several stops at one visit: each gets its waypoint there.
 std::vector<Waypoint> SegmentOf(const WarehouseMap& map, const WindowPlan& plan, const std::vector<Waypoint>& stops,
                                 bool fresh, double ready, const Waypoint& first) {
   std::vector<Waypoint> out;
@@ -51,6 +52,10 @@ std::vector<Waypoint> SegmentOf(const WarehouseMap& map, const WindowPlan& plan,
   std::size_t next_stop = 0;
   for (std::size_t v = 0; v < r.size(); ++v) {
     const bool last = v + 1 == r.size();
+    std::size_t stops_end = next_stop;  // the stops worked at this visit: [next_stop, stops_end)
+    while (stops_end < stops.size() && stops_end < plan.stop_visits.size() && plan.stop_visits[stops_end] == v) {
+      ++stops_end;
+    }
     Waypoint wp;
     wp.point = r[v].point;
     wp.xy = map.point(wp.point).position;
@@ -59,19 +64,29 @@ std::vector<Waypoint> SegmentOf(const WarehouseMap& map, const WindowPlan& plan,
     if (v == 0) {
       if (fresh) {
         wp.action = first.action;
+        if (stops_end > next_stop) wp.eta = r[0].arrive;  // it works here first
         out.push_back(wp);
-      } else if (r[0].depart > ready + 1e-6) {
+      } else if (stops_end == next_stop && r[0].depart > ready + 1e-6) {
         out.push_back(wp);  // it waits where its queue ended
       }
+      if (stops_end == next_stop) continue;
+    } else if (stops_end == next_stop) {
+      out.push_back(wp);
       continue;
     }
-    if (next_stop < stops.size() && next_stop < plan.stop_visits.size() && plan.stop_visits[next_stop] == v) {
-      const Waypoint& stop = stops[next_stop++];
+    // The stops here, one waypoint each: the work ends at the visit's departure (the last
+    // visit: starts at its arrival), so a wait before it is spent before the first one.
+    double dwell_after = 0.0;
+    for (std::size_t k = next_stop; k < stops_end; ++k) dwell_after += stops[k].dwell;
+    double at = last ? r[v].arrive : r[v].depart - dwell_after;
+    for (; next_stop < stops_end; ++next_stop) {
+      const Waypoint& stop = stops[next_stop];
       wp.action = stop.action;
       wp.dwell = stop.dwell;
-      wp.eta = last ? r[v].arrive : r[v].depart - stop.dwell;
+      wp.eta = at;
+      at += stop.dwell;
+      out.push_back(wp);
     }
-    out.push_back(wp);
   }
   return out;
 }

@@ -151,6 +151,31 @@ INSTANTIATE_TEST_SUITE_P(Planners, RoundRoutesTest,
 // the time-window planner by planning each robot through the routes planned before it, BIT2024
 // step 7 by constraining one robot of each conflict at a time. The same input gives the same
 // routes (the seeded choice comes from the round).
+// A robot standing at the order's pick: the route's first visit is a stop. The segment keeps
+// its pick there and its drop (found on a dense grid: such a segment came out with neither, so
+// its order never finished nor failed, and the run waited until its limit).
+TEST_P(RoundRoutesTest, AStopWhereTheRobotStandsKeepsItsWaypoint) {
+  const auto& map = *Chu2024();
+  const auto picks = PointsOfKind(map, PointKind::kPick);
+  const auto drops = PointsOfKind(map, PointKind::kDrop);
+  RoundInput input;
+  input.now = 10.0;
+  input.robots.push_back({"R1", picks.at(5), {}, 0, {}});
+  input.pending.push_back(MakeOrder("o1", picks.at(5), drops.at(2), 1.0));
+  const RoundResult table = RunRound(AllocationConfig{}, input);
+  const RoundResult other = RunRound(Config(), input);
+  ASSERT_EQ(table.awards.size(), 1u);
+  ASSERT_EQ(other.awards.size(), 1u);
+  EXPECT_TRUE(other.notes.empty()) << other.notes.front();
+  const std::vector<Stop> stops = StopsOf(other.awards[0].segments.at(0));
+  EXPECT_EQ(StopsOf(table.awards[0].segments.at(0)), stops);
+  ASSERT_EQ(stops.size(), 2u);
+  EXPECT_EQ(stops[0].point, picks.at(5));
+  EXPECT_EQ(stops[0].action, WaypointAction::kPick);
+  const auto& seg = other.awards[0].segments[0];
+  for (std::size_t i = 1; i < seg.size(); ++i) EXPECT_LE(seg[i - 1].departure(), seg[i].eta + 1e-9);
+}
+
 TEST(RoundRoutes, PlannersInTheWindowsLeaveNoConflictAmongTheRoundsRoutes) {
   const RoundInput input = BusyRound();
   EXPECT_TRUE(EarliestConflict(NewRoutes(RunRound(AllocationConfig{}, input))).has_value());
