@@ -173,6 +173,24 @@ TEST(FreeSpaceRound, AStopHeadingNoRobotCanTakeLeavesTheOrderAcceptedSayingWhy) 
   EXPECT_NE(r.notes[0].find("asks for a heading"), std::string::npos) << r.notes[0];
 }
 
+// One round on the dead-end bay: R1 at P1 (four-wheel steer when `steer`), R2 at P2 (a
+// differential drive), `orders` pending, allocated by `strategy` under `config`.
+RoundResult BayRound(const std::shared_ptr<const WarehouseMap>& map, const std::shared_ptr<const RouteTable>& routes,
+                     const std::string& strategy, const AllocationConfig& config, bool steer,
+                     std::vector<std::shared_ptr<const Order>> orders) {
+  RoundRunner runner(map, routes, config, std::move(MakeAllocator(strategy)).value());
+  RoundInput input;
+  RoundRobot r1, r2;
+  r1.id = "R1";
+  r1.start = *map->FindPoint("P1");
+  r1.kind = steer ? RobotKind::kFourWheelSteer : RobotKind::kDifferential;
+  r2.id = "R2";
+  r2.start = *map->FindPoint("P2");
+  input.robots = {r1, r2};
+  input.pending = std::move(orders);
+  return runner.Run(input);
+}
+
 // The auction prices the legs a four-wheel-steer robot will drive: by the lanes R1 (4WIS, at
 // P1) is 2 m nearer K than R2 (differential, at P2), but turning round in the dead-end bay
 // costs it more than that (a spin of pi at 1 rad/s, where the lanes just drive back), so R2
@@ -180,23 +198,14 @@ TEST(FreeSpaceRound, AStopHeadingNoRobotCanTakeLeavesTheOrderAcceptedSayingWhy) 
 TEST(FreeSpaceRound, TheBidsPriceTheRefinedLegs) {
   const auto map = Bay(false);
   const auto routes = Routes(map);
-  RoundRunner runner(map, routes, AllocationConfig{}, std::move(MakeAllocator("auction")).value());
-  RoundInput input;
-  RoundRobot r1, r2;
-  r1.id = "R1";
-  r1.start = *map->FindPoint("P1");
-  r1.kind = RobotKind::kFourWheelSteer;
-  r2.id = "R2";
-  r2.start = *map->FindPoint("P2");
-  input.robots = {r1, r2};
-  input.pending = {PickAtK(*map, "o1", 0.0)};
-  const RoundResult result = runner.Run(input);
+  const RoundResult result = BayRound(map, routes, "auction", AllocationConfig{}, true, {PickAtK(*map, "o1", 0.0)});
   ASSERT_EQ(result.awards.size(), 1u);
   EXPECT_EQ(result.awards[0].award.winners, std::vector<std::string>{"R2"}) << result.awards[0].award.reason;
+  const PointId p1 = *map->FindPoint("P1");
   const Bid& steer = result.awards[0].award.bids.at(0);
   const Bid& lanes = result.awards[0].award.bids.at(1);
   const double k = *map->FindPoint("K"), d = *map->FindPoint("D");
-  const double lanes_r1 = routes->Cost(r1.start, static_cast<PointId>(k)) +
+  const double lanes_r1 = routes->Cost(p1, static_cast<PointId>(k)) +
                           routes->Cost(static_cast<PointId>(k), static_cast<PointId>(d));
   EXPECT_GT(steer.t_d, lanes_r1 + 2.0) << "R1's bid prices its turn in the bay";
   EXPECT_LT(lanes_r1, lanes.t_d) << "by the lanes alone R1 is nearer";
@@ -208,37 +217,15 @@ TEST(FreeSpaceRound, TheBidsPriceTheRefinedLegs) {
 TEST(FreeSpaceRound, TheOtherStrategiesPriceTheRefinedLegsToo) {
   const auto map = Bay(false);
   const auto routes = Routes(map);
-  for (const char* strategy : {"exact", "greedy"}) {
-    SCOPED_TRACE(strategy);
-    RoundRunner runner(map, routes, AllocationConfig{}, std::move(MakeAllocator(strategy)).value());
-    RoundInput input;
-    RoundRobot r1, r2;
-    r1.id = "R1";
-    r1.start = *map->FindPoint("P1");
-    r1.kind = RobotKind::kFourWheelSteer;
-    r2.id = "R2";
-    r2.start = *map->FindPoint("P2");
-    input.robots = {r1, r2};
-    input.pending = {PickAtK(*map, "o1", 0.0)};
-    const RoundResult result = runner.Run(input);
-    ASSERT_EQ(result.awards.size(), 1u);
-    EXPECT_EQ(result.awards[0].award.winners, std::vector<std::string>{"R2"}) << result.awards[0].award.reason;
-  }
-  // Without the four-wheel-steer kind the same round goes to R1, the nearer by the lanes.
-  for (const char* strategy : {"exact", "greedy"}) {
-    SCOPED_TRACE(strategy);
-    RoundRunner runner(map, routes, AllocationConfig{}, std::move(MakeAllocator(strategy)).value());
-    RoundInput input;
-    RoundRobot r1, r2;
-    r1.id = "R1";
-    r1.start = *map->FindPoint("P1");
-    r2.id = "R2";
-    r2.start = *map->FindPoint("P2");
-    input.robots = {r1, r2};
-    input.pending = {PickAtK(*map, "o1", 0.0)};
-    const RoundResult result = runner.Run(input);
-    ASSERT_EQ(result.awards.size(), 1u);
-    EXPECT_EQ(result.awards[0].award.winners, std::vector<std::string>{"R1"}) << result.awards[0].award.reason;
+  for (bool steer : {true, false}) {
+    for (const char* strategy : {"exact", "greedy"}) {
+      SCOPED_TRACE(std::string(strategy) + (steer ? ", R1 four-wheel steer" : ", R1 differential"));
+      const RoundResult result = BayRound(map, routes, strategy, AllocationConfig{}, steer, {PickAtK(*map, "o1", 0.0)});
+      ASSERT_EQ(result.awards.size(), 1u);
+      // Without the four-wheel-steer kind the same round goes to R1, the nearer by the lanes.
+      EXPECT_EQ(result.awards[0].award.winners, std::vector<std::string>{steer ? "R2" : "R1"})
+          << result.awards[0].award.reason;
+    }
   }
 }
 
@@ -255,22 +242,12 @@ TEST(FreeSpaceRound, ThePlannedPlannersKeepTheRefinedSegmentAndPlanRoundIt) {
     SCOPED_TRACE(PlannerName(planner));
     AllocationConfig config;
     config.planner = planner;
-    RoundRunner runner(map, routes, config, std::move(MakeAllocator("auction")).value());
-    RoundInput input;
-    RoundRobot r1, r2;
-    r1.id = "R1";
-    r1.start = *map->FindPoint("P1");
-    r1.kind = RobotKind::kFourWheelSteer;
-    r2.id = "R2";
-    r2.start = *map->FindPoint("P2");
-    input.robots = {r1, r2};
     auto posed = std::const_pointer_cast<Order>(PickAtK(*map, "o1", 0.0));
     posed->stop_headings[0] = std::numbers::pi;
     // Dropped where R1 started: a plan's last point is held for ever in the windows, and R2
     // drops at D.
-    posed->drop = r1.start;
-    input.pending = {posed, PickAtK(*map, "o2", 0.0)};
-    const RoundResult result = runner.Run(input);
+    posed->drop = *map->FindPoint("P1");
+    const RoundResult result = BayRound(map, routes, "auction", config, true, {posed, PickAtK(*map, "o2", 0.0)});
     EXPECT_TRUE(result.notes.empty()) << result.notes.front();
     ASSERT_EQ(result.awards.size(), 2u);
     ASSERT_EQ(result.awards[0].award.winners, std::vector<std::string>{"R1"}) << result.awards[0].award.reason;
