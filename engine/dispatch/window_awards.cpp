@@ -1,6 +1,7 @@
 #include "engine/dispatch/window_awards.h"
 
 #include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <optional>
 #include <random>
@@ -10,9 +11,20 @@
 namespace dispatch::engine {
 namespace {
 
+// Seconds a robot whose plan ends at a service point (a pick or drop) holds it after its work
+// there: an idle robot by a service point steps aside at once (TrafficGate), so the windows do
+// not keep the point for ever (which left every later robot with a stop there unplanned).
+constexpr double kParkSeconds = 5.0;
+
+// How long a plan's last visit at `p` lasts from its departure: kParkSeconds at a service
+// point, else for ever (the robot stays).
+double ParkedFor(const WarehouseMap& map, PointId p) {
+  return IsServicePoint(map.point(p).kind) ? kParkSeconds : kForever;
+}
+
 // The visits of `w` as a route the table accepts: waypoints at one point in a row are one
-// visit, no arrival faster than its arc allows, the last visit for ever. Empty when two
-// points in a row are not joined by an arc (the plan is then not reserved).
+// visit, no arrival faster than its arc allows, the last visit parked (ParkedFor). Empty when
+// two points in a row are not joined by an arc (the plan is then not reserved).
 TimedRoute VisitsOf(const WarehouseMap& map, const TimeWindowRules& rules, const std::vector<Waypoint>& w) {
   TimedRoute r;
   for (const Waypoint& x : w) {
@@ -28,7 +40,7 @@ TimedRoute VisitsOf(const WarehouseMap& map, const TimeWindowRules& rules, const
     }
     r.push_back({x.point, arrive, std::max(arrive, x.departure())});
   }
-  if (!r.empty()) r.back().depart = kForever;
+  if (!r.empty()) r.back().depart += ParkedFor(map, r.back().point);
   return r;
 }
 
@@ -147,8 +159,8 @@ struct AwardJob {
 
 // The job of award `a` for robot i whose queue (as kept) ends with `end`; nullopt when the
 // award has nothing to plan.
-std::optional<AwardJob> JobOf(const RoundAward& a, std::size_t index, std::size_t i, const std::vector<Waypoint>& kept,
-                              double now) {
+std::optional<AwardJob> JobOf(const WarehouseMap& map, const RoundAward& a, std::size_t index, std::size_t i,
+                              const std::vector<Waypoint>& kept, double now) {
   const std::vector<Waypoint>& segment = a.segments[0];
   if (segment.empty() || kept.empty()) return std::nullopt;
   AwardJob job;
@@ -167,6 +179,8 @@ std::optional<AwardJob> JobOf(const RoundAward& a, std::size_t index, std::size_
     }
   }
   if (job.stops.empty()) return std::nullopt;
+  // Its last stop is held for ever only where the robot will stay (ParkedFor).
+  job.request.stay_at_end = std::isinf(ParkedFor(map, job.request.stops.back().point));
   return job;
 }
 
@@ -182,7 +196,7 @@ void PlanAwardsInWindows(const std::shared_ptr<const WarehouseMap>& map, const R
     const auto found = fleet.FindRobot(a.award.winners[0]);
     if (!found || !round.replan[*found]) continue;
     const std::size_t i = *found;
-    const auto job = JobOf(a, k, i, round.kept[i], now);
+    const auto job = JobOf(*map, a, k, i, round.kept[i], now);
     if (!job) continue;
     std::vector<Waypoint>& segment = a.segments[0];
     auto plan = PlanInWindows(round.table, routes, job->request);
@@ -238,7 +252,7 @@ void PlanAwardsByConflictElimination(const std::shared_ptr<const WarehouseMap>& 
     std::vector<Waypoint> queue = round.kept[i];
     std::vector<Planned> segs;
     for (std::size_t k : awards_of[i]) {
-      const auto job = JobOf(awards[k], k, i, queue, now);
+      const auto job = JobOf(*map, awards[k], k, i, queue, now);
       if (!job) return false;
       auto plan = PlanInWindows(*table, routes, job->request);
       if (!plan.ok()) return false;

@@ -8,6 +8,10 @@
 // waypoints are named after the graph points they pass, so their windows are those points'
 // and arcs').
 //
+// A plan's last visit is held for ever, but at a pick or drop only 5 s after the work there (an
+// idle robot by a service point steps aside at once: TrafficGate); held for ever, it left every
+// later award with a stop there unplanned (on the dense grids half of the time windows' awards).
+//
 // A re-planned segment keeps its stops, actions and work times; its waits become departures:
 // a robot reaching a waypoint ahead of plan waits for its planned departure (the robots'
 // rule, WaypointRobot and fleet-sim), so a move waypoint where it must wait carries the end of

@@ -103,7 +103,10 @@ TrafficDecision TrafficController::Impl::HeadOn(std::size_t r, int c, int oncomi
                              : kInf;
     const int keep_off = StickyCorridor(r);
     Detour d = Route(x.at, x.route.back(), StickyBan(r), c, -1, bound, keep_off != c ? keep_off : -1);
-    if (!d.points.empty() && !StartAllowed(r, d.points)) d = Detour{};
+    // A route back to where the robot stands (out of the way and back, as a time-window plan
+    // may go) has no detour: one of a single point would drop the loop, and the robot, its
+    // plan's waypoints never released, would stand there for ever.
+    if (d.points.size() < 2 || !StartAllowed(r, d.points)) d = Detour{};
     rec.replan_extra = d.points.empty() ? kInf : d.cost - old_cost;
     const bool replan =
         !d.points.empty() && (config.head_on == HeadOnPolicy::kAlwaysReplan ||

@@ -244,8 +244,7 @@ TEST(FreeSpaceRound, ThePlannedPlannersKeepTheRefinedSegmentAndPlanRoundIt) {
     config.planner = planner;
     auto posed = std::const_pointer_cast<Order>(PickAtK(*map, "o1", 0.0));
     posed->stop_headings[0] = std::numbers::pi;
-    // Dropped where R1 started: a plan's last point is held for ever in the windows, and R2
-    // drops at D.
+    // Dropped where R1 started (P1), away from R2's drop (D).
     posed->drop = *map->FindPoint("P1");
     const RoundResult result = BayRound(map, routes, "auction", config, true, {posed, PickAtK(*map, "o2", 0.0)});
     EXPECT_TRUE(result.notes.empty()) << result.notes.front();

@@ -47,8 +47,7 @@ std::vector<Stop> StopsOf(const std::vector<Waypoint>& segment) {
   return out;
 }
 
-// 8 robots at parking stations, 10 orders with distinct drops (a robot stays at its last
-// drop: a second order there would keep the table's route under the time windows).
+// 8 robots at parking stations, 10 orders with distinct drops.
 RoundInput BusyRound() {
   const auto& map = *Chu2024();
   const auto parks = PointsOfKind(map, PointKind::kPark);
@@ -174,6 +173,39 @@ TEST_P(RoundRoutesTest, AStopWhereTheRobotStandsKeepsItsWaypoint) {
   EXPECT_EQ(stops[0].action, WaypointAction::kPick);
   const auto& seg = other.awards[0].segments[0];
   for (std::size_t i = 1; i < seg.size(); ++i) EXPECT_LE(seg[i - 1].departure(), seg[i].eta + 1e-9);
+}
+
+// Two robots dropping at one drop in one round: the first one's plan holds the drop only a
+// few seconds after its work (it steps aside then), so the second is planned through the
+// windows too, reaching the drop after the first has left it. Held for ever, the drop was
+// "never free long enough" and the second kept the strategy's route.
+TEST(RoundRoutes, ASecondRobotDroppingWhereAnotherEndsIsPlannedToo) {
+  const auto& map = *Chu2024();
+  const auto parks = PointsOfKind(map, PointKind::kPark);
+  const auto picks = PointsOfKind(map, PointKind::kPick);
+  const auto drops = PointsOfKind(map, PointKind::kDrop);
+  RoundInput input;
+  input.now = 10.0;
+  input.robots.push_back({"R1", parks.at(0), {}, 0, {}});
+  input.robots.push_back({"R2", parks.at(8), {}, 0, {}});
+  input.pending.push_back(MakeOrder("o1", picks.at(3), drops.at(1), 1.0));
+  input.pending.push_back(MakeOrder("o2", picks.at(40), drops.at(1), 2.0));
+  for (Mode mode : {Mode::kTimeWindows, Mode::kConflictElimination}) {
+    SCOPED_TRACE(mode == Mode::kTimeWindows ? "time windows" : "conflict elimination");
+    const RoundResult other = RunRound(ConfigOf(mode), input);
+    EXPECT_TRUE(other.notes.empty()) << other.notes.front();
+    ASSERT_EQ(other.awards.size(), 2u);
+    ASSERT_NE(other.awards[0].award.winners, other.awards[1].award.winners);
+    double first_leaves = 0.0, second_arrives = 0.0;
+    for (const Waypoint& w : other.awards[0].segments.at(0)) {
+      if (w.action == WaypointAction::kDrop) first_leaves = w.departure();
+    }
+    for (const Waypoint& w : other.awards[1].segments.at(0)) {
+      if (w.action == WaypointAction::kDrop) second_arrives = w.eta;
+    }
+    EXPECT_GT(first_leaves, 0.0);
+    EXPECT_GE(second_arrives, first_leaves);
+  }
 }
 
 TEST(RoundRoutes, PlannersInTheWindowsLeaveNoConflictAmongTheRoundsRoutes) {

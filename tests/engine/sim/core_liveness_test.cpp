@@ -158,5 +158,22 @@ TEST(CoreLivenessTest, AnIdleRobotNudgedInAOneRobotCorridorLeavesItOrStays) {
   }
 }
 
+// Found here (2026-12-07), on the first grid with 6 robots, seed 10, the time windows: a robot
+// planned out of the way and back (c4 -> c3 -> c13 -> c3 -> c4, its pick at c4) met a head-on
+// at c4; the head-on's "detour" to its route's end, where it stood, was that point alone, so
+// the loop was dropped, its next waypoints were never released and it stood at c4 for the
+// rest of the run with every other robot waiting behind it. A head-on now has no detour of a
+// single point (TrafficController, HeadOn).
+TEST(CoreLivenessTest, ALoopBackToWhereTheRobotStandsSurvivesAHeadOn) {
+  const World w = GridWorld(DenseGrids().front());
+  std::vector<Order> orders;
+  auto r = DenseGridRun(w, 6, 10, 0.0, PlannerKind::kTimeWindows, orders);
+  ASSERT_TRUE(r.ok()) << r.error().message;
+  ExpectSane(w, orders, *r, DenseGridConfig(PlannerKind::kTimeWindows));  // nothing ran into the time limit
+  EXPECT_GE(r->completed, 38u);
+  ASSERT_TRUE(r->safety.has_value());
+  EXPECT_TRUE(r->safety->ok()) << r->safety->violations.front().Describe();
+}
+
 }  // namespace
 }  // namespace dispatch::engine::testing
