@@ -260,8 +260,8 @@ double FleetState::RefinedExtra(std::size_t robot, const PlanTask& task) const {
 }
 
 double FleetState::RefinedExtra(std::size_t robot, const PlanTask& task, PointId from) const {
+  if (!Refines(robot) || !CanServe(robot, task)) return 0.0;
   const RobotEntry& e = robots_.at(robot);
-  if (!free_space_ || e.info.kind != RobotKind::kFourWheelSteer || !CanServe(robot, task)) return 0.0;
   const QueueSummary& s = e.summary;
   Result<Plan> segment = BuildPlan(*map_, *routes_, from, s.end_time, config_.speed, {task}, config_.turn_time);
   if (!segment.ok()) return 0.0;  // the bid finds it unreachable on its own

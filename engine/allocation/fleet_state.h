@@ -194,6 +194,11 @@ class FleetState {
   // The same for `task` planned from point `from` (where an earlier task of a batch leaves
   // the robot) instead of its queue's end.
   double RefinedExtra(std::size_t robot, const PlanTask& task, PointId from) const;
+  // Whether robot's segments are refined through free space (a four-wheel-steer robot, free
+  // space in use): RefinedExtra is 0 for every other robot.
+  bool Refines(std::size_t robot) const {
+    return free_space_ && robots_.at(robot).info.kind == RobotKind::kFourWheelSteer;
+  }
 
  private:
   struct RobotEntry;

@@ -2,7 +2,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <limits>
+#include <unordered_map>
 
 #include "engine/allocation/allocator.h"
 #include "engine/common/numbers.h"
@@ -32,9 +34,30 @@ Result<std::vector<BatchTask>> Prepare(const FleetState& state, const std::vecto
   return tasks;
 }
 
+// FleetState::RefinedExtra of task k for robot r from point `from`, each asked once: the brute
+// force prices the same legs in many maps, and for a four-wheel-steer robot each is a hybrid
+// A* search (every other robot: 0 at once, not remembered).
+class RefinedLegs {
+ public:
+  RefinedLegs(const FleetState& state, const std::vector<BatchTask>& tasks) : state_(state), tasks_(tasks) {}
+  double operator()(std::size_t r, std::size_t k, PointId from) {
+    if (!state_.Refines(r)) return 0.0;
+    const std::uint64_t key =
+        (static_cast<std::uint64_t>(r) * tasks_.size() + k) * state_.map().point_count() + static_cast<std::uint64_t>(from);
+    auto [it, fresh] = known_.try_emplace(key, 0.0);
+    if (fresh) it->second = state_.RefinedExtra(r, tasks_[k].task, from);
+    return it->second;
+  }
+
+ private:
+  const FleetState& state_;
+  const std::vector<BatchTask>& tasks_;
+  std::unordered_map<std::uint64_t, double> known_;
+};
+
 // Over the robots (all, or `only`): eq. (1) of each final queue, or of each queue up to every
 // order of the batch it takes (the bid sum).
-double Total(const FleetState& state, const std::vector<BatchTask>& tasks,
+double Total(const FleetState& state, const std::vector<BatchTask>& tasks, RefinedLegs& refined,
              const std::vector<std::size_t>& robot_of_order, const std::vector<std::size_t>* only,
              BatchObjective objective) {
   const AllocationConfig& c = state.config();
@@ -49,7 +72,7 @@ double Total(const FleetState& state, const std::vector<BatchTask>& tasks,
     for (std::size_t k = 0; k < tasks.size(); ++k) {
       if (robot_of_order[k] != r) continue;
       // A four-wheel-steer robot's legs through free space, as AssignSingle will plan them.
-      travel += state.routes().Cost(at, tasks[k].first) + tasks[k].travel + state.RefinedExtra(r, tasks[k].task, at);
+      travel += state.routes().Cost(at, tasks[k].first) + tasks[k].travel + refined(r, k, at);
       work += tasks[k].work;
       at = tasks[k].drop;
       if (objective == BatchObjective::kBidSum) total += c.alpha * (travel + work) + c.beta * travel;
@@ -74,7 +97,8 @@ Result<double> BatchCost(const FleetState& state, const std::vector<Order>& orde
   }
   Result<std::vector<BatchTask>> tasks = Prepare(state, orders);
   if (!tasks.ok()) return tasks.error();
-  return Total(state, *tasks, robot_of_order, nullptr, objective);
+  RefinedLegs refined(state, *tasks);
+  return Total(state, *tasks, refined, robot_of_order, nullptr, objective);
 }
 
 Result<BatchAssignment> BruteForceAssignment(const FleetState& state,
@@ -82,6 +106,7 @@ Result<BatchAssignment> BruteForceAssignment(const FleetState& state,
                                              const OptimalAssignmentOptions& options) {
   Result<std::vector<BatchTask>> tasks = Prepare(state, orders);
   if (!tasks.ok()) return tasks.error();
+  RefinedLegs refined(state, *tasks);
   std::vector<std::size_t> robots = options.robots;
   if (robots.empty()) {
     for (std::size_t r = 0; r < state.robot_count(); ++r) robots.push_back(r);
@@ -128,7 +153,7 @@ Result<BatchAssignment> BruteForceAssignment(const FleetState& state,
         stopped = true;
         return;
       }
-      const double cost = Total(state, *tasks, map, &robots, options.objective);
+      const double cost = Total(state, *tasks, refined, map, &robots, options.objective);
       if (cost < best.cost) best = {map, cost};
       return;
     }
@@ -149,7 +174,7 @@ Result<BatchAssignment> BruteForceAssignment(const FleetState& state,
     return Unreachable("brute force: no assignment of the " + std::to_string(n) +
                        " orders has a finite cost");
   }
-  best.cost = Total(state, *tasks, best.robot_of_order, nullptr, options.objective);
+  best.cost = Total(state, *tasks, refined, best.robot_of_order, nullptr, options.objective);
   return best;
 }
 
@@ -243,7 +268,8 @@ Result<BatchAssignment> HungarianAssignment(const FleetState& state,
   for (std::size_t r = 0; r < m; ++r) all[r] = r;
   BatchAssignment result;
   result.robot_of_order = SolveRows(MarginalCosts(state, *tasks, all), n, m);
-  result.cost = Total(state, *tasks, result.robot_of_order, nullptr, BatchObjective::kQueueTotals);
+  RefinedLegs refined(state, *tasks);
+  result.cost = Total(state, *tasks, refined, result.robot_of_order, nullptr, BatchObjective::kQueueTotals);
   if (!std::isfinite(result.cost)) {
     return Unreachable("hungarian: no one-order-per-robot assignment of the " +
                        std::to_string(n) + " orders has a finite cost");

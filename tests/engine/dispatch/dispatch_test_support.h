@@ -80,6 +80,14 @@ inline std::vector<PointId> PointsOfKind(const WarehouseMap& map, PointKind kind
   return out;
 }
 
+// The floor's parking, pick and drop points, each in id order (PointsOfKind).
+struct FloorStops {
+  std::vector<PointId> parks, picks, drops;
+};
+inline FloorStops StopsOfFloor(const WarehouseMap& map) {
+  return {PointsOfKind(map, PointKind::kPark), PointsOfKind(map, PointKind::kPick), PointsOfKind(map, PointKind::kDrop)};
+}
+
 // A single-pick order as the core holds it.
 inline std::shared_ptr<const Order> MakeOrder(const std::string& id, PointId pick, PointId drop, double created,
                                               int priority = 0) {

@@ -25,7 +25,7 @@ namespace {
 using testing_util::Chu2024;
 using testing_util::Chu2024Routes;
 using testing_util::MakeOrder;
-using testing_util::PointsOfKind;
+using testing_util::StopsOfFloor;
 
 RoundResult RunRound(const AllocationConfig& config, const RoundInput& input) {
   RoundRunner runner(Chu2024(), Chu2024Routes(), config, std::move(MakeAllocator("auction")).value());
@@ -50,9 +50,7 @@ std::vector<Stop> StopsOf(const std::vector<Waypoint>& segment) {
 // 8 robots at parking stations, 10 orders with distinct drops.
 RoundInput BusyRound() {
   const auto& map = *Chu2024();
-  const auto parks = PointsOfKind(map, PointKind::kPark);
-  const auto picks = PointsOfKind(map, PointKind::kPick);
-  const auto drops = PointsOfKind(map, PointKind::kDrop);
+  const auto [parks, picks, drops] = StopsOfFloor(map);
   RoundInput input;
   input.now = 50.0;
   for (int i = 0; i < 8; ++i) {
@@ -155,8 +153,7 @@ INSTANTIATE_TEST_SUITE_P(Planners, RoundRoutesTest,
 // its order never finished nor failed, and the run waited until its limit).
 TEST_P(RoundRoutesTest, AStopWhereTheRobotStandsKeepsItsWaypoint) {
   const auto& map = *Chu2024();
-  const auto picks = PointsOfKind(map, PointKind::kPick);
-  const auto drops = PointsOfKind(map, PointKind::kDrop);
+  const auto [parks, picks, drops] = StopsOfFloor(map);
   RoundInput input;
   input.now = 10.0;
   input.robots.push_back({"R1", picks.at(5), {}, 0, {}});
@@ -181,9 +178,7 @@ TEST_P(RoundRoutesTest, AStopWhereTheRobotStandsKeepsItsWaypoint) {
 // "never free long enough" and the second kept the strategy's route.
 TEST(RoundRoutes, ASecondRobotDroppingWhereAnotherEndsIsPlannedToo) {
   const auto& map = *Chu2024();
-  const auto parks = PointsOfKind(map, PointKind::kPark);
-  const auto picks = PointsOfKind(map, PointKind::kPick);
-  const auto drops = PointsOfKind(map, PointKind::kDrop);
+  const auto [parks, picks, drops] = StopsOfFloor(map);
   RoundInput input;
   input.now = 10.0;
   input.robots.push_back({"R1", parks.at(0), {}, 0, {}});
